@@ -1,0 +1,1 @@
+//! Spec language: types, loading, validation and diagnostics.

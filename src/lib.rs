@@ -1,0 +1,2 @@
+//! pedsynth: compile a YAML dataset spec into a synthetic pedestrian-crossing dataset.
+pub mod dsl;
