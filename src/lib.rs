@@ -1,3 +1,6 @@
-//! pedsynth: compile a YAML dataset spec into a synthetic pedestrian-crossing dataset.
+//! pedsynth: compile a YAML dataset spec into a synthetic pedestrian-crossing dataset, without CARLA.
+//!
+//! Pipeline: `dsl` (spec → validated, defaulted `Spec`) → `world` (road networks) → planner → executor.
+pub mod commands;
 pub mod dsl;
 pub mod world;

@@ -1,2 +1,76 @@
-//! Command-line entry point: parses arguments and calls the library.
-fn main() {}
+//! Command-line entry point: parses arguments (clap) and calls the library's commands.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use pedsynth::commands;
+use pedsynth::dsl::LoadOptions;
+
+/// Synthetic pedestrian-crossing datasets for autonomous-driving research.
+#[derive(Parser)]
+#[command(name = "pedsynth", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Options shared by the commands that load a spec.
+#[derive(clap::Args)]
+struct SpecArgs {
+    /// Override a spec value, e.g. `--set crossing.target_ratio=0.5` (YAML value; repeatable).
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    overrides: Vec<String>,
+    /// Accept a spec beyond the sanity limits (clip count, image size, estimated dataset size).
+    #[arg(long)]
+    allow_large: bool,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate specs; print a summary line per valid spec and every problem of the invalid ones.
+    Validate {
+        /// Spec files.
+        #[arg(required = true)]
+        specs: Vec<PathBuf>,
+        /// Print the fully defaulted spec instead of the summary.
+        #[arg(long)]
+        resolved: bool,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
+    /// Print the spec language's JSON Schema (draft-07).
+    Schema,
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(err) => {
+            let _ = err.print();
+            let code = if err.use_stderr() {
+                commands::exit::INVALID
+            } else {
+                commands::exit::OK
+            };
+            return ExitCode::from(code as u8);
+        }
+    };
+    let mut out = std::io::stdout().lock();
+    let mut err = std::io::stderr().lock();
+    let code = match cli.command {
+        Command::Validate {
+            specs,
+            resolved,
+            spec_args,
+        } => {
+            let options = LoadOptions {
+                overrides: spec_args.overrides,
+                allow_large: spec_args.allow_large,
+            };
+            commands::validate(&specs, &options, resolved, &mut out, &mut err)
+        }
+        Command::Schema => commands::schema(&mut out),
+    };
+    ExitCode::from(code as u8)
+}
