@@ -12,10 +12,7 @@ const WIDTH: usize = 100;
 
 fn bad_specs() -> Vec<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad_specs");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
     files.sort();
     files
 }
@@ -23,10 +20,7 @@ fn bad_specs() -> Vec<PathBuf> {
 /// The relative path diagnostics are rendered with (no absolute paths in goldens).
 fn display_name(path: &Path) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    path.strip_prefix(root)
-        .unwrap()
-        .to_string_lossy()
-        .into_owned()
+    path.strip_prefix(root).unwrap().to_string_lossy().into_owned()
 }
 
 /// `(code, line, column)` from the `# expect: CODE at L:C` header; an empty file expects `empty` at 1:1.
@@ -56,12 +50,7 @@ fn load(path: &Path, overrides: &[&str]) -> Result<dsl::LoadedSpec, SpecErrors> 
         overrides: overrides.iter().map(|s| s.to_string()).collect(),
         allow_large: false,
     };
-    dsl::load_bytes(
-        &bytes,
-        &display_name(path),
-        path.parent().unwrap(),
-        &options,
-    )
+    dsl::load_bytes(&bytes, &display_name(path), path.parent().unwrap(), &options)
 }
 
 #[test]
@@ -116,10 +105,7 @@ fn overrides_are_validated_and_named_as_the_culprit() {
     // A good override changes the value.
     let loaded = load(
         &quickstart,
-        &[
-            "crossing.target_ratio=0.5",
-            "dataset.weathers=[dawn, night_foggy]",
-        ],
+        &["crossing.target_ratio=0.5", "dataset.weathers=[dawn, night_foggy]"],
     )
     .unwrap();
     assert_eq!(loaded.spec.crossing.target_ratio, 0.5);
@@ -158,25 +144,14 @@ fn the_cli_exits_2_on_bad_specs_and_0_on_good_ones() {
         .args(&good)
         .output()
         .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(
-        String::from_utf8_lossy(&out.stdout).lines().count(),
-        good.len()
-    );
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), good.len());
     let missing = Command::new(bin)
         .current_dir(root)
         .args(["validate", "specs/no_such_spec.yaml"])
         .output()
         .unwrap();
     assert_eq!(missing.status.code(), Some(2));
-    let bad_args = Command::new(bin)
-        .args(["validate", "--no-such-flag"])
-        .output()
-        .unwrap();
+    let bad_args = Command::new(bin).args(["validate", "--no-such-flag"]).output().unwrap();
     assert_eq!(bad_args.status.code(), Some(2));
 }

@@ -45,13 +45,7 @@ impl<'s> Checker<'s> {
         schema
     }
 
-    fn check(
-        &self,
-        node: &Node,
-        schema: &'s Json,
-        path: &mut Vec<PathSeg>,
-        problems: &mut Vec<Found>,
-    ) {
+    fn check(&self, node: &Node, schema: &'s Json, path: &mut Vec<PathSeg>, problems: &mut Vec<Found>) {
         let schema = self.resolve(schema);
         if let Some(alternatives) = schema
             .get("anyOf")
@@ -116,12 +110,9 @@ impl<'s> Checker<'s> {
                         };
                         problems.push((
                             Some(path.clone()),
-                            Problem::new(
-                                code::UNKNOWN_KEY,
-                                format!("unknown key `{}` {place}", key.name),
-                            )
-                            .at(key.span, "unknown key")
-                            .help(suggestion(&key.name, &known)),
+                            Problem::new(code::UNKNOWN_KEY, format!("unknown key `{}` {place}", key.name))
+                                .at(key.span, "unknown key")
+                                .help(suggestion(&key.name, &known)),
                         ));
                     }
                     Some(extra @ Json::Object(_)) => self.check(value, extra, path, problems),
@@ -209,19 +200,11 @@ impl<'s> Checker<'s> {
         }
     }
 
-    fn check_names(
-        &self,
-        node: &Node,
-        names: &[Json],
-        path: &[PathSeg],
-        problems: &mut Vec<Found>,
-    ) {
+    fn check_names(&self, node: &Node, names: &[Json], path: &[PathSeg], problems: &mut Vec<Found>) {
         let names: Vec<&str> = names.iter().filter_map(Json::as_str).collect();
         match &node.value {
             Value::Str(s) if names.contains(&s.as_str()) => {}
-            Value::Str(s) => {
-                problems.push((Some(path.to_vec()), unknown_name(node, s, &names, path)))
-            }
+            Value::Str(s) => problems.push((Some(path.to_vec()), unknown_name(node, s, &names, path))),
             _ => problems.push((Some(path.to_vec()), wrong_type(node, &["string"], path))),
         }
     }
@@ -345,10 +328,7 @@ fn wrong_type(node: &Node, expected: &[&str], path: &[PathSeg]) -> Problem {
     };
     Problem::new(
         code::WRONG_TYPE,
-        format!(
-            "`{}` must be {expected}, found {found}",
-            super::tree::DisplayPath(path)
-        ),
+        format!("`{}` must be {expected}, found {found}", super::tree::DisplayPath(path)),
     )
     .at(node.span, format!("expected {expected}"))
 }
@@ -363,20 +343,12 @@ fn unknown_name(node: &Node, name: &str, names: &[&str], path: &[PathSeg]) -> Pr
     }) {
         Some("towns") => "town",
         Some("weathers") => "weather",
-        Some(key)
-            if key.ends_with("split")
-                || path.iter().any(|s| s == &PathSeg::Key("splits".into())) =>
-        {
-            "split"
-        }
+        Some(key) if key.ends_with("split") || path.iter().any(|s| s == &PathSeg::Key("splits".into())) => "split",
         _ => "value",
     };
     Problem::new(
         code::UNKNOWN_NAME,
-        format!(
-            "unknown {what} `{name}` at `{}`",
-            super::tree::DisplayPath(path)
-        ),
+        format!("unknown {what} `{name}` at `{}`", super::tree::DisplayPath(path)),
     )
     .at(node.span, format!("unknown {what}"))
     .help(suggestion(name, names))

@@ -4,9 +4,7 @@
 use std::fmt;
 use std::sync::Arc;
 
-use miette::{
-    Diagnostic, GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceCode,
-};
+use miette::{Diagnostic, GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceCode};
 
 use super::tree::Span;
 
@@ -135,10 +133,7 @@ impl Diagnostic for SpecProblem {
         Some(Box::new(self.problem.code))
     }
     fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.problem
-            .help
-            .as_ref()
-            .map(|h| Box::new(h) as Box<dyn fmt::Display>)
+        self.problem.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
     }
     fn source_code(&self) -> Option<&dyn SourceCode> {
         self.source.as_ref().map(|s| s as &dyn SourceCode)
@@ -146,18 +141,14 @@ impl Diagnostic for SpecProblem {
     fn labels(&self) -> Option<Box<dyn Iterator<Item = LabeledSpan> + '_>> {
         self.source.as_ref()?;
         let (primary_span, primary_note) = self.problem.label.as_ref()?;
-        let primary = LabeledSpan::new_primary_with_span(
-            Some(primary_note.clone()),
-            (primary_span.offset, primary_span.len),
-        );
+        let primary =
+            LabeledSpan::new_primary_with_span(Some(primary_note.clone()), (primary_span.offset, primary_span.len));
         let secondary = self
             .problem
             .secondary
             .iter()
             .filter(|(span, _)| span.source == primary_span.source)
-            .map(|(span, note)| {
-                LabeledSpan::new_with_span(Some(note.clone()), (span.offset, span.len))
-            });
+            .map(|(span, note)| LabeledSpan::new_with_span(Some(note.clone()), (span.offset, span.len)));
         Some(Box::new(std::iter::once(primary).chain(secondary)))
     }
 }
@@ -243,10 +234,7 @@ impl Diagnostic for SpecErrors {
 }
 
 /// The closest candidate to `word`, if one is close enough to be a plausible typo.
-pub fn did_you_mean<'a>(
-    word: &str,
-    candidates: impl IntoIterator<Item = &'a str>,
-) -> Option<&'a str> {
+pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let lower = word.to_ascii_lowercase();
     candidates
         .into_iter()
@@ -257,16 +245,13 @@ pub fn did_you_mean<'a>(
 }
 
 /// "did you mean `x`?" or a list of the valid choices when nothing is close.
-pub fn suggestion<'a>(word: &str, candidates: &[&'a str]) -> String {
+pub fn suggestion(word: &str, candidates: &[&str]) -> String {
     match did_you_mean(word, candidates.iter().copied()) {
         Some(c) => format!("did you mean `{c}`?"),
         None if candidates.len() <= 12 => {
             let list: Vec<String> = candidates.iter().map(|c| format!("`{c}`")).collect();
             format!("expected one of {}", list.join(", "))
         }
-        None => format!(
-            "expected one of {} names (see `pedsynth schema`)",
-            candidates.len()
-        ),
+        None => format!("expected one of {} names (see `pedsynth schema`)", candidates.len()),
     }
 }

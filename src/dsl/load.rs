@@ -55,20 +55,14 @@ pub fn load_file(path: &Path, options: &LoadOptions) -> Result<LoadedSpec, SpecE
     match std::fs::read(path) {
         Ok(bytes) => load_bytes(&bytes, &name, &base_dir, options),
         Err(err) => {
-            let problem = Problem::new(code::IO, format!("cannot read spec `{name}`: {err}"))
-                .help("check the path");
+            let problem = Problem::new(code::IO, format!("cannot read spec `{name}`: {err}")).help("check the path");
             Err(SpecErrors::new(name, vec![problem], &Sources::default()))
         }
     }
 }
 
 /// Loads and validates a spec from bytes; `name` labels diagnostics and `base_dir` resolves relative paths.
-pub fn load_bytes(
-    bytes: &[u8],
-    name: &str,
-    base_dir: &Path,
-    options: &LoadOptions,
-) -> Result<LoadedSpec, SpecErrors> {
+pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptions) -> Result<LoadedSpec, SpecErrors> {
     let mut sources = Sources::default();
     let text = match std::str::from_utf8(bytes) {
         Ok(text) => text,
@@ -90,8 +84,7 @@ pub fn load_bytes(
         }
     };
     sources.add(name, text);
-    let fail =
-        |problems: Vec<Problem>, sources: &Sources| Err(SpecErrors::new(name, problems, sources));
+    let fail = |problems: Vec<Problem>, sources: &Sources| Err(SpecErrors::new(name, problems, sources));
 
     let mut root = match tree::parse(text, 0) {
         Ok(root) => root,
@@ -116,7 +109,7 @@ pub fn load_bytes(
     for (i, text) in options.overrides.iter().enumerate() {
         let id = sources.add(format!("--set #{}", i + 1), text.clone());
         if let Err(problem) = apply_override(&mut root, text, id) {
-            problems.push(problem);
+            problems.push(*problem);
         }
     }
 
@@ -133,8 +126,7 @@ pub fn load_bytes(
                 path.truncate(index);
             }
             // A mix missing one of its keys would also fail its sum check: prune the whole mix.
-            if path.len() >= 2 && matches!(&path[path.len() - 2], PathSeg::Key(k) if is_mix_key(k))
-            {
+            if path.len() >= 2 && matches!(&path[path.len() - 2], PathSeg::Key(k) if is_mix_key(k)) {
                 path.pop();
             }
             pruned.push(path);
@@ -208,30 +200,33 @@ fn is_mix_key(key: &str) -> bool {
 fn check_version(root: &Node) -> Option<Problem> {
     let node = root.get("version")?;
     match node.value {
-        Value::Int(v) if v == i64::from(SPEC_VERSION) => None,
+        Value::Int(v) if v == i128::from(SPEC_VERSION) => None,
         Value::Int(_) | Value::Float(_) | Value::Str(_) => Some(
-            Problem::new(code::UNSUPPORTED_VERSION, format!("unsupported spec version; this pedsynth reads version {SPEC_VERSION}"))
-                .at(node.span, "unsupported version")
-                .help(format!("write `version: {SPEC_VERSION}`, or use the pedsynth release that reads this version")),
+            Problem::new(
+                code::UNSUPPORTED_VERSION,
+                format!("unsupported spec version; this pedsynth reads version {SPEC_VERSION}"),
+            )
+            .at(node.span, "unsupported version")
+            .help(format!(
+                "write `version: {SPEC_VERSION}`, or use the pedsynth release that reads this version"
+            )),
         ),
         _ => None, // a wrong type is reported by the structural check
     }
 }
 
 /// Applies one `key.path=value` override; the value is YAML.
-fn apply_override(root: &mut Node, text: &str, source: usize) -> Result<(), Problem> {
+fn apply_override(root: &mut Node, text: &str, source: usize) -> Result<(), Box<Problem>> {
     let whole = Span {
         source,
         offset: 0,
         len: text.len(),
     };
     let Some(eq) = text.find('=') else {
-        return Err(Problem::new(
-            code::BAD_OVERRIDE,
-            "an override must look like `key.path=value`",
-        )
-        .at(whole, "no `=` here")
-        .help("e.g. --set crossing.target_ratio=0.5"));
+        let problem = Problem::new(code::BAD_OVERRIDE, "an override must look like `key.path=value`")
+            .at(whole, "no `=` here")
+            .help("e.g. --set crossing.target_ratio=0.5");
+        return Err(Box::new(problem));
     };
     let key_span = Span {
         source,
@@ -239,9 +234,10 @@ fn apply_override(root: &mut Node, text: &str, source: usize) -> Result<(), Prob
         len: eq,
     };
     let path = tree::parse_path(&text[..eq]).map_err(|msg| {
-        Problem::new(code::BAD_OVERRIDE, msg)
+        let problem = Problem::new(code::BAD_OVERRIDE, msg)
             .at(key_span, "bad key path")
-            .help("e.g. --set crossing.target_ratio=0.5")
+            .help("e.g. --set crossing.target_ratio=0.5");
+        Box::new(problem)
     })?;
     let value_text = &text[eq + 1..];
     let value_span = Span {
@@ -256,7 +252,7 @@ fn apply_override(root: &mut Node, text: &str, source: usize) -> Result<(), Prob
             if let Some((span, _)) = problem.label.as_mut() {
                 span.offset += eq + 1;
             }
-            return Err(problem);
+            return Err(Box::new(problem));
         }
     };
     shift_spans(&mut value, eq + 1);
@@ -264,11 +260,8 @@ fn apply_override(root: &mut Node, text: &str, source: usize) -> Result<(), Prob
         value.span = value_span;
     }
     root.set(&path, value, key_span).map_err(|msg| {
-        Problem::new(
-            code::BAD_OVERRIDE,
-            format!("cannot apply override to `{}`: {msg}", DisplayPath(&path)),
-        )
-        .at(key_span, "here")
+        let message = format!("cannot apply override to `{}`: {msg}", DisplayPath(&path));
+        Box::new(Problem::new(code::BAD_OVERRIDE, message).at(key_span, "here"))
     })
 }
 
@@ -310,16 +303,11 @@ fn yaml_problem(err: &serde_saphyr::Error, text: &str, source: usize) -> Problem
             format!("duplicate key `{}`", key.as_deref().unwrap_or("?")),
             "a key may appear once in a mapping; remove one of them",
         ),
-        other
-            if matches!(other, serde_saphyr::Error::Budget { .. })
-                || other.render().contains("budget breached") =>
-        {
-            (
-                code::YAML_BUDGET,
-                "the YAML is too large or expands too much (an alias bomb?)".to_owned(),
-                "specs are small documents: avoid deep nesting and repeated aliases",
-            )
-        }
+        other if matches!(other, serde_saphyr::Error::Budget { .. }) || other.render().contains("budget breached") => (
+            code::YAML_BUDGET,
+            "the YAML is too large or expands too much (an alias bomb?)".to_owned(),
+            "specs are small documents: avoid deep nesting and repeated aliases",
+        ),
         other => {
             let rendered = other.render();
             let message = match rendered.rfind(" at line ") {
@@ -348,10 +336,6 @@ fn offset_of(text: &str, line: usize, column: usize) -> usize {
         .map(str::len)
         .sum();
     let rest = &text[line_start.min(text.len())..];
-    let col: usize = rest
-        .chars()
-        .take(column.saturating_sub(1))
-        .map(char::len_utf8)
-        .sum();
+    let col: usize = rest.chars().take(column.saturating_sub(1)).map(char::len_utf8).sum();
     (line_start + col).min(text.len())
 }

@@ -40,8 +40,8 @@ pub enum Value {
     Null,
     /// `true` / `false`.
     Bool(bool),
-    /// An integer.
-    Int(i64),
+    /// An integer (wide enough for every i64 and u64).
+    Int(i128),
     /// A floating-point number.
     Float(f64),
     /// A string.
@@ -105,11 +105,7 @@ impl Node {
     /// The child at `key` of a mapping.
     pub fn get(&self, key: &str) -> Option<&Node> {
         match &self.value {
-            Value::Map(entries) => entries
-                .iter()
-                .rev()
-                .find(|(k, _)| k.name == key)
-                .map(|(_, v)| v),
+            Value::Map(entries) => entries.iter().rev().find(|(k, _)| k.name == key).map(|(_, v)| v),
             _ => None,
         }
     }
@@ -199,9 +195,7 @@ impl Node {
                 }
             }
             (PathSeg::Index(_), other) => Err(format!("cannot index into {}", other.kind())),
-            (PathSeg::Key(k), other) => {
-                Err(format!("cannot set key `{k}` inside {}", other.kind()))
-            }
+            (PathSeg::Key(k), other) => Err(format!("cannot set key `{k}` inside {}", other.kind())),
         }
     }
 
@@ -213,11 +207,9 @@ impl Node {
         let mut node = self;
         for seg in parent {
             let next = match (seg, &mut node.value) {
-                (PathSeg::Key(k), Value::Map(entries)) => entries
-                    .iter_mut()
-                    .rev()
-                    .find(|(key, _)| &key.name == k)
-                    .map(|(_, v)| v),
+                (PathSeg::Key(k), Value::Map(entries)) => {
+                    entries.iter_mut().rev().find(|(key, _)| &key.name == k).map(|(_, v)| v)
+                }
                 (PathSeg::Index(i), Value::Seq(items)) => items.get_mut(*i),
                 _ => None,
             };
@@ -245,13 +237,16 @@ impl Node {
         match &self.value {
             Value::Null => serde_json::Value::Null,
             Value::Bool(b) => serde_json::Value::Bool(*b),
-            Value::Int(i) => serde_json::Value::from(*i),
-            Value::Float(x) => serde_json::Number::from_f64(*x)
-                .map_or(serde_json::Value::Null, serde_json::Value::Number),
-            Value::Str(s) => serde_json::Value::String(s.clone()),
-            Value::Seq(items) => {
-                serde_json::Value::Array(items.iter().map(Node::to_json).collect())
+            Value::Int(i) => match (i64::try_from(*i), u64::try_from(*i)) {
+                (Ok(i), _) => serde_json::Value::from(i),
+                (_, Ok(u)) => serde_json::Value::from(u),
+                _ => serde_json::Number::from_f64(*i as f64).map_or(serde_json::Value::Null, serde_json::Value::Number),
+            },
+            Value::Float(x) => {
+                serde_json::Number::from_f64(*x).map_or(serde_json::Value::Null, serde_json::Value::Number)
             }
+            Value::Str(s) => serde_json::Value::String(s.clone()),
+            Value::Seq(items) => serde_json::Value::Array(items.iter().map(Node::to_json).collect()),
             Value::Map(entries) => {
                 let mut map = serde_json::Map::new();
                 for (k, v) in entries {
@@ -275,10 +270,7 @@ pub fn parse_path(text: &str) -> Result<Vec<PathSeg>, String> {
             return Err(format!("empty segment in key path `{text}`"));
         }
         if !name.is_empty() {
-            if !name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-            {
+            if !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
                 return Err(format!("`{name}` is not a valid key in key path `{text}`"));
             }
             match name.parse::<usize>() {
@@ -335,7 +327,7 @@ struct RawNode(Spanned<RawValue>);
 enum RawValue {
     Null,
     Bool(bool),
-    Int(i64),
+    Int(i128),
     Float(f64),
     Str(String),
     Seq(Vec<RawNode>),
@@ -347,9 +339,7 @@ struct RawKey(Result<String, &'static str>);
 
 impl RawNode {
     fn into_node(self, source: SourceId) -> Node {
-        let Spanned {
-            value, referenced, ..
-        } = self.0;
+        let Spanned { value, referenced, .. } = self.0;
         let span = span_of(&referenced, source);
         let value = match value {
             RawValue::Null => Value::Null,
@@ -357,9 +347,7 @@ impl RawNode {
             RawValue::Int(i) => Value::Int(i),
             RawValue::Float(x) => Value::Float(x),
             RawValue::Str(s) => Value::Str(s),
-            RawValue::Seq(items) => {
-                Value::Seq(items.into_iter().map(|n| n.into_node(source)).collect())
-            }
+            RawValue::Seq(items) => Value::Seq(items.into_iter().map(|n| n.into_node(source)).collect()),
             RawValue::Map(entries) => Value::Map(
                 entries
                     .into_iter()
@@ -408,16 +396,16 @@ impl<'de> Visitor<'de> for RawVisitor {
         Ok(RawValue::Bool(b))
     }
     fn visit_i64<E: de::Error>(self, i: i64) -> Result<RawValue, E> {
-        Ok(RawValue::Int(i))
+        Ok(RawValue::Int(i128::from(i)))
     }
     fn visit_u64<E: de::Error>(self, u: u64) -> Result<RawValue, E> {
-        Ok(i64::try_from(u).map_or(RawValue::Float(u as f64), RawValue::Int))
+        Ok(RawValue::Int(i128::from(u)))
     }
     fn visit_i128<E: de::Error>(self, i: i128) -> Result<RawValue, E> {
-        Ok(i64::try_from(i).map_or(RawValue::Float(i as f64), RawValue::Int))
+        Ok(RawValue::Int(i))
     }
     fn visit_u128<E: de::Error>(self, u: u128) -> Result<RawValue, E> {
-        Ok(i64::try_from(u).map_or(RawValue::Float(u as f64), RawValue::Int))
+        Ok(i128::try_from(u).map_or(RawValue::Float(u as f64), RawValue::Int))
     }
     fn visit_f64<E: de::Error>(self, x: f64) -> Result<RawValue, E> {
         Ok(RawValue::Float(x))

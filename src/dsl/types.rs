@@ -120,10 +120,7 @@ impl Default for Dataset {
         Dataset {
             name: "pedsynth".to_owned(),
             seed: 0,
-            towns: BuiltinTown::ALL
-                .iter()
-                .map(|t| TownRef::Builtin(*t))
-                .collect(),
+            towns: BuiltinTown::ALL.iter().map(|t| TownRef::Builtin(*t)).collect(),
             weathers: WeatherSelection::All(AllKeyword::All),
             clips: Clips::default(),
             clip_duration_s: Range(10.0, 15.0),
@@ -160,9 +157,7 @@ impl TownRef {
 }
 
 /// The built-in procedural towns. They are modelled on the paper's CARLA towns but are not CARLA's maps.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum BuiltinTown {
     /// Small two-lane town with T-junctions (like CARLA's Town01).
@@ -205,9 +200,7 @@ pub struct OpenDriveTown {
 }
 
 /// Dataset split.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Split {
     /// Training split.
@@ -264,9 +257,7 @@ impl WeatherRef {
 }
 
 /// The paper's 12 weather conditions (Table "Twelve weather configurations").
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum WeatherPreset {
     /// Optimal baseline (easy).
@@ -296,9 +287,7 @@ pub enum WeatherPreset {
 }
 
 /// Difficulty class of a weather.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Difficulty {
     /// Easy.
@@ -419,10 +408,7 @@ impl WeatherSelection {
     /// The selected weathers, `all` expanded to the 12 presets.
     pub fn resolved(&self) -> Vec<WeatherRef> {
         match self {
-            WeatherSelection::All(_) => WeatherPreset::ALL
-                .iter()
-                .map(|p| WeatherRef::Preset(*p))
-                .collect(),
+            WeatherSelection::All(_) => WeatherPreset::ALL.iter().map(|p| WeatherRef::Preset(*p)).collect(),
             WeatherSelection::List(list) => list.clone(),
         }
     }
@@ -485,10 +471,7 @@ impl Default for Pedestrians {
                 .iter()
                 .map(|(name, (share, _))| (name.clone(), *share))
                 .collect(),
-            archetypes: archetypes
-                .into_iter()
-                .map(|(name, (_, a))| (name, a))
-                .collect(),
+            archetypes: archetypes.into_iter().map(|(name, (_, a))| (name, a)).collect(),
             speed_profiles: SpeedProfiles::default(),
         }
     }
@@ -551,29 +534,22 @@ impl Archetype {
     /// probability are the paper's table; τ_ttc and patience spread the paper's ranges (3–6 s, 6–18 s) from
     /// risk-taking to cautious; distraction probabilities are pedsynth's choice.
     pub fn paper_table() -> BTreeMap<String, (f64, Archetype)> {
-        let row = |share,
-                   speed: (f64, f64),
-                   hes: (f64, f64),
-                   att,
-                   cross,
-                   ttc: (f64, f64),
-                   pat: (f64, f64),
-                   dis,
-                   body| {
-            (
-                share,
-                Archetype {
-                    speed_mps: Range(speed.0, speed.1),
-                    hesitation_s: Range(hes.0, hes.1),
-                    attention: att,
-                    crossing_probability: cross,
-                    ttc_threshold_s: Range(ttc.0, ttc.1),
-                    patience_s: Range(pat.0, pat.1),
-                    distraction_probability: dis,
-                    body,
-                },
-            )
-        };
+        let row =
+            |share, speed: (f64, f64), hes: (f64, f64), att, cross, ttc: (f64, f64), pat: (f64, f64), dis, body| {
+                (
+                    share,
+                    Archetype {
+                        speed_mps: Range(speed.0, speed.1),
+                        hesitation_s: Range(hes.0, hes.1),
+                        attention: att,
+                        crossing_probability: cross,
+                        ttc_threshold_s: Range(ttc.0, ttc.1),
+                        patience_s: Range(pat.0, pat.1),
+                        distraction_probability: dis,
+                        body,
+                    },
+                )
+            };
         BTreeMap::from([
             (
                 "business_person".to_owned(),
@@ -1040,14 +1016,12 @@ pub struct DrivingProfiles {
 
 impl Default for DrivingProfiles {
     fn default() -> Self {
-        let p = |speed: (f64, f64), gap: (f64, f64), headway: (f64, f64), lights, walkers| {
-            DrivingProfile {
-                speed_difference_pct: Range(speed.0, speed.1),
-                min_gap_m: Range(gap.0, gap.1),
-                time_headway_s: Range(headway.0, headway.1),
-                ignore_lights_probability: lights,
-                ignore_walkers_probability: walkers,
-            }
+        let p = |speed: (f64, f64), gap: (f64, f64), headway: (f64, f64), lights, walkers| DrivingProfile {
+            speed_difference_pct: Range(speed.0, speed.1),
+            min_gap_m: Range(gap.0, gap.1),
+            time_headway_s: Range(headway.0, headway.1),
+            ignore_lights_probability: lights,
+            ignore_walkers_probability: walkers,
         };
         DrivingProfiles {
             aggressive: p((-30.0, -15.0), (0.5, 1.0), (0.8, 1.1), 0.2, 0.05),
@@ -1477,5 +1451,80 @@ impl Default for Limits {
             max_image_pixels: 3840 * 2160,
             max_dataset_bytes: 2_000_000_000_000,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn builtin_town_names_match_the_world_module() {
+        let names: Vec<&str> = BuiltinTown::ALL.iter().map(|t| t.name()).collect();
+        assert_eq!(names, crate::world::BUILTIN_TOWN_NAMES);
+        for town in BuiltinTown::ALL {
+            assert_eq!(
+                serde_json::to_value(town).unwrap(),
+                serde_json::Value::from(town.name())
+            );
+        }
+        for preset in WeatherPreset::ALL {
+            assert_eq!(
+                serde_json::to_value(preset).unwrap(),
+                serde_json::Value::from(preset.name())
+            );
+        }
+    }
+
+    #[test]
+    fn defaults_are_the_papers_values() {
+        let spec = Spec::default();
+        assert_eq!(spec.dataset.weathers.resolved().len(), 12);
+        assert_eq!(spec.dataset.fps, 30);
+        assert_eq!(spec.dataset.clip_duration_s, Range(10.0, 15.0));
+        assert_eq!(spec.dataset.splits["town03_like"], Split::Val);
+        assert_eq!(spec.dataset.splits["town05_like"], Split::Test);
+        let mix: f64 = spec.pedestrians.archetype_mix.values().sum();
+        assert!((mix - 1.0).abs() < 1e-12);
+        assert_eq!(spec.pedestrians.archetype_mix["business_person"], 0.30);
+        let young = &spec.pedestrians.archetypes["young_person"];
+        assert_eq!(
+            (young.speed_mps, young.attention, young.crossing_probability),
+            (Range(1.2, 2.0), 0.4, 0.90)
+        );
+        let elderly = &spec.pedestrians.archetypes["elderly_person"];
+        assert_eq!(
+            (
+                elderly.hesitation_s,
+                elderly.patience_s.max(),
+                elderly.ttc_threshold_s.max()
+            ),
+            (Range(1.0, 2.0), 18.0, 6.0)
+        );
+        let c = &spec.crossing;
+        assert_eq!(
+            (
+                c.layers.crosser_allocation.max_crosser_ratio,
+                c.layers.groups.probability
+            ),
+            (0.9, 0.4)
+        );
+        assert_eq!((c.retreat.probability, c.retreat.window_fraction), (0.15, 0.4));
+        assert_eq!(c.lookahead.points_m, vec![0.5, 1.5, 2.5]);
+        assert_eq!(c.decision_window_m, Range(10.0, 40.0));
+        assert_eq!(WeatherPreset::NightClear.params().sun_altitude_deg, -40.0);
+        assert_eq!(
+            (
+                spec.sensors.rgb.width_px,
+                spec.sensors.rgb.height_px,
+                spec.sensors.rgb.fov_deg
+            ),
+            (1280, 720, 90.0)
+        );
+        assert_eq!(
+            (spec.sensors.lidar.channels, spec.sensors.lidar.points_per_second),
+            (64, 1_000_000)
+        );
+        assert_eq!(spec.annotations.visibility.min_box_far_px, Range(8.0, 15.0));
     }
 }

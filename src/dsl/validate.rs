@@ -14,13 +14,7 @@ use super::types::*;
 const MIX_TOLERANCE: f64 = 1e-6;
 
 /// Validates `spec` (already merged onto the defaults); `tree` is the user's YAML for locating problems.
-pub fn validate(
-    spec: &Spec,
-    tree: &Node,
-    base_dir: &Path,
-    options: &LoadOptions,
-    problems: &mut Vec<Problem>,
-) {
+pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, options: &LoadOptions, problems: &mut Vec<Problem>) {
     let mut v = Validator { tree, problems };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
@@ -55,8 +49,7 @@ pub fn clip_count(spec: &Spec) -> u64 {
 /// estimate). Assumes ~1 byte per pixel for a PNG frame, 16 bytes per kept LiDAR point, events on 2% of the
 /// pixels per frame at 13 bytes each, and ~300 bytes of tables per pedestrian-frame.
 pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
-    let frames =
-        clip_count(spec) as f64 * spec.dataset.clip_duration_s.mid() * f64::from(spec.dataset.fps);
+    let frames = clip_count(spec) as f64 * spec.dataset.clip_duration_s.mid() * f64::from(spec.dataset.fps);
     let s = &spec.sensors;
     let pixels = f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px);
     let mut per_frame = 300.0 * f64::from(spec.pedestrians.per_clip.max());
@@ -119,9 +112,7 @@ impl Validator<'_> {
 
     fn key_span(&self, path: &str) -> Span {
         let p = Self::path(path);
-        self.tree
-            .key_span_at(&p)
-            .unwrap_or_else(|| self.tree.span_at(&p))
+        self.tree.key_span_at(&p).unwrap_or_else(|| self.tree.span_at(&p))
     }
 
     /// `lo ≤ value ≤ hi`.
@@ -156,10 +147,7 @@ impl Validator<'_> {
                     fmt_num(value)
                 ),
             )
-            .at(
-                self.span(path),
-                format!("out of range (0, {}]", fmt_num(hi)),
-            )
+            .at(self.span(path), format!("out of range (0, {}]", fmt_num(hi)))
             .help(format!("`{path}` is {what}"));
             self.problems.push(problem);
         }
@@ -177,11 +165,7 @@ impl Validator<'_> {
         if self.problems.len() == before && r.min() > r.max() {
             let problem = Problem::new(
                 code::EMPTY_RANGE,
-                format!(
-                    "`{path}` has min {} > max {}",
-                    fmt_num(r.min()),
-                    fmt_num(r.max())
-                ),
+                format!("`{path}` has min {} > max {}", fmt_num(r.min()), fmt_num(r.max())),
             )
             .at(self.span(&format!("{path}[0]")), "min")
             .also(self.span(&format!("{path}[1]")), "max")
@@ -245,12 +229,9 @@ impl Validator<'_> {
         }
         if d.towns.is_empty() {
             self.problems.push(
-                Problem::new(
-                    code::OUT_OF_RANGE,
-                    "`dataset.towns` must name at least one town",
-                )
-                .at(self.span("dataset.towns"), "no towns")
-                .help("e.g. towns: [town01_like]"),
+                Problem::new(code::OUT_OF_RANGE, "`dataset.towns` must name at least one town")
+                    .at(self.span("dataset.towns"), "no towns")
+                    .help("e.g. towns: [town01_like]"),
             );
         }
         let mut seen = BTreeSet::new();
@@ -278,24 +259,18 @@ impl Validator<'_> {
             }
             if !seen.insert(town.name().to_owned()) {
                 self.problems.push(
-                    Problem::new(
-                        code::DUPLICATE_NAME,
-                        format!("town `{}` is listed twice", town.name()),
-                    )
-                    .at(self.span(&path), "listed again here")
-                    .help("list each town once; use `dataset.clips` to get more clips"),
+                    Problem::new(code::DUPLICATE_NAME, format!("town `{}` is listed twice", town.name()))
+                        .at(self.span(&path), "listed again here")
+                        .help("list each town once; use `dataset.clips` to get more clips"),
                 );
             }
         }
         let weathers = d.weathers.resolved();
         if weathers.is_empty() {
             self.problems.push(
-                Problem::new(
-                    code::OUT_OF_RANGE,
-                    "`dataset.weathers` must name at least one weather",
-                )
-                .at(self.span("dataset.weathers"), "no weathers")
-                .help("e.g. weathers: [clear_noon], or weathers: all"),
+                Problem::new(code::OUT_OF_RANGE, "`dataset.weathers` must name at least one weather")
+                    .at(self.span("dataset.weathers"), "no weathers")
+                    .help("e.g. weathers: [clear_noon], or weathers: all"),
             );
         }
         let mut seen_weather = BTreeSet::new();
@@ -330,11 +305,8 @@ impl Validator<'_> {
             }
             if !seen_weather.insert(w.name().to_owned()) {
                 self.problems.push(
-                    Problem::new(
-                        code::DUPLICATE_NAME,
-                        format!("weather `{}` is listed twice", w.name()),
-                    )
-                    .at(self.span(&path), "listed again here"),
+                    Problem::new(code::DUPLICATE_NAME, format!("weather `{}` is listed twice", w.name()))
+                        .at(self.span(&path), "listed again here"),
                 );
             }
         }
@@ -352,13 +324,7 @@ impl Validator<'_> {
             600.0,
             "a clip duration in seconds",
         );
-        self.num(
-            "dataset.fps",
-            f64::from(d.fps),
-            1.0,
-            240.0,
-            "the frame rate",
-        );
+        self.num("dataset.fps", f64::from(d.fps), 1.0, 240.0, "the frame rate");
         let known: Vec<&str> = d
             .towns
             .iter()
@@ -403,11 +369,7 @@ impl Validator<'_> {
                 self.problems.push(problem);
             }
         }
-        let shares: Vec<(&str, f64)> = p
-            .archetype_mix
-            .iter()
-            .map(|(n, s)| (n.as_str(), *s))
-            .collect();
+        let shares: Vec<(&str, f64)> = p.archetype_mix.iter().map(|(n, s)| (n.as_str(), *s)).collect();
         self.mix("pedestrians.archetype_mix", &shares);
         for (name, a) in &p.archetypes {
             let base = format!("pedestrians.archetypes.{name}");
@@ -427,10 +389,7 @@ impl Validator<'_> {
                 "a hesitation duration in seconds",
             );
             self.probability(&format!("{base}.attention"), a.attention);
-            self.probability(
-                &format!("{base}.crossing_probability"),
-                a.crossing_probability,
-            );
+            self.probability(&format!("{base}.crossing_probability"), a.crossing_probability);
             self.range(
                 &format!("{base}.ttc_threshold_s"),
                 a.ttc_threshold_s,
@@ -445,10 +404,7 @@ impl Validator<'_> {
                 600.0,
                 "a waiting time in seconds",
             );
-            self.probability(
-                &format!("{base}.distraction_probability"),
-                a.distraction_probability,
-            );
+            self.probability(&format!("{base}.distraction_probability"), a.distraction_probability);
         }
         let sp = &p.speed_profiles;
         self.mix(
@@ -494,11 +450,7 @@ impl Validator<'_> {
         let b = &l.behaviour_mix.mix;
         self.mix(
             "crossing.layers.behaviour_mix.mix",
-            &[
-                ("normal", b.normal),
-                ("sudden", b.sudden),
-                ("jaywalk", b.jaywalk),
-            ],
+            &[("normal", b.normal), ("sudden", b.sudden), ("jaywalk", b.jaywalk)],
         );
         self.probability(
             "crossing.layers.midroad_jaywalkers.share_of_crossers",
@@ -591,13 +543,8 @@ impl Validator<'_> {
 
         let before = self.problems.len();
         let (lo, hi) = reachable_crossing_ratio(c);
-        let tolerance = if l.crosser_allocation.enabled {
-            1e-9
-        } else {
-            0.02
-        };
-        let target_valid =
-            (0.0..=1.0).contains(&c.target_ratio) && (0.0..=1.0).contains(&c.baseline_ratio);
+        let tolerance = if l.crosser_allocation.enabled { 1e-9 } else { 0.02 };
+        let target_valid = (0.0..=1.0).contains(&c.target_ratio) && (0.0..=1.0).contains(&c.baseline_ratio);
         if self.problems.len() == before
             && target_valid
             && (c.target_ratio > hi + tolerance || c.target_ratio < lo - tolerance)
@@ -608,8 +555,7 @@ impl Validator<'_> {
                     fmt_num(lo)
                 )
             } else if c.target_ratio > hi {
-                "raise `crossing.layers.crosser_allocation.max_crosser_ratio`, or lower the target"
-                    .to_owned()
+                "raise `crossing.layers.crosser_allocation.max_crosser_ratio`, or lower the target".to_owned()
             } else {
                 "lower `crossing.baseline_ratio`, or raise the target".to_owned()
             };
@@ -658,13 +604,7 @@ impl Validator<'_> {
                 90.0,
                 "a percentage below the speed limit (negative: faster)",
             );
-            self.range(
-                &format!("{base}.min_gap_m"),
-                p.min_gap_m,
-                0.1,
-                50.0,
-                "a gap in metres",
-            );
+            self.range(&format!("{base}.min_gap_m"), p.min_gap_m, 0.1, 50.0, "a gap in metres");
             self.range(
                 &format!("{base}.time_headway_s"),
                 p.time_headway_s,
@@ -699,12 +639,7 @@ impl Validator<'_> {
             15.0,
             "a deceleration in m/s²",
         );
-        self.positive(
-            "traffic.idm.exponent",
-            t.idm.exponent,
-            10.0,
-            "the IDM exponent δ",
-        );
+        self.positive("traffic.idm.exponent", t.idm.exponent, 10.0, "the IDM exponent δ");
         self.range(
             "traffic.ego.speed_below_limit_pct",
             t.ego.speed_below_limit_pct,
@@ -712,12 +647,7 @@ impl Validator<'_> {
             90.0,
             "a percentage below the speed limit",
         );
-        self.positive(
-            "traffic.ego.min_gap_m",
-            t.ego.min_gap_m,
-            50.0,
-            "a gap in metres",
-        );
+        self.positive("traffic.ego.min_gap_m", t.ego.min_gap_m, 50.0, "a gap in metres");
         self.positive(
             "traffic.ego.brake_ahead_m",
             t.ego.brake_ahead_m,
@@ -748,20 +678,8 @@ impl Validator<'_> {
             10.0,
             "a position in metres",
         );
-        self.num(
-            &format!("{base}.left_m"),
-            m.left_m,
-            -5.0,
-            5.0,
-            "a position in metres",
-        );
-        self.num(
-            &format!("{base}.up_m"),
-            m.up_m,
-            0.0,
-            10.0,
-            "a height in metres",
-        );
+        self.num(&format!("{base}.left_m"), m.left_m, -5.0, 5.0, "a position in metres");
+        self.num(&format!("{base}.up_m"), m.up_m, 0.0, 10.0, "a height in metres");
         self.num(
             &format!("{base}.pitch_deg"),
             m.pitch_deg,
@@ -816,12 +734,7 @@ impl Validator<'_> {
             256.0,
             "a number of laser channels",
         );
-        self.positive(
-            "sensors.lidar.range_m",
-            l.range_m,
-            1000.0,
-            "a range in metres",
-        );
+        self.positive("sensors.lidar.range_m", l.range_m, 1000.0, "a range in metres");
         self.num(
             "sensors.lidar.points_per_second",
             f64::from(l.points_per_second),
@@ -878,14 +791,8 @@ impl Validator<'_> {
             "an attenuation rate per metre",
         );
         self.probability("sensors.lidar.dropoff_general_rate", l.dropoff_general_rate);
-        self.probability(
-            "sensors.lidar.dropoff_intensity_limit",
-            l.dropoff_intensity_limit,
-        );
-        self.probability(
-            "sensors.lidar.dropoff_zero_intensity",
-            l.dropoff_zero_intensity,
-        );
+        self.probability("sensors.lidar.dropoff_intensity_limit", l.dropoff_intensity_limit);
+        self.probability("sensors.lidar.dropoff_zero_intensity", l.dropoff_zero_intensity);
         self.num(
             "sensors.lidar.noise_stddev_m",
             l.noise_stddev_m,
@@ -978,10 +885,7 @@ impl Validator<'_> {
                     limits.max_clips
                 ),
             )
-            .at(
-                self.span("dataset.clips.count"),
-                format!("{clips} clips in all"),
-            )
+            .at(self.span("dataset.clips.count"), format!("{clips} clips in all"))
             .help("pass --allow-large if you mean it, or raise `limits.max_clips`");
             self.problems.push(problem);
         }
@@ -1002,7 +906,11 @@ impl Validator<'_> {
         if bytes > limits.max_dataset_bytes as f64 {
             let problem = Problem::new(
                 code::TOO_LARGE,
-                format!("the dataset would take about {:.1} TB, above the limit of {:.1} TB", bytes / 1e12, limits.max_dataset_bytes as f64 / 1e12),
+                format!(
+                    "the dataset would take about {:.1} TB, above the limit of {:.1} TB",
+                    bytes / 1e12,
+                    limits.max_dataset_bytes as f64 / 1e12
+                ),
             )
             .at(self.key_span("dataset.clips"), "too much data")
             .help("pass --allow-large if you mean it, disable sensors, or raise `limits.max_dataset_bytes`");
