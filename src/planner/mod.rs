@@ -1,0 +1,620 @@
+//! The planner: compiles a validated spec and its towns into a deterministic [`Plan`] of seeded clip scripts.
+//!
+//! The planner is pure: no IO, no threads, no clocks. Towns are loaded by the caller and passed in.
+//!
+//! Clips are grouped in *strata*, one per (town, weather) cell. Within a stratum every mix (archetypes,
+//! crossers, behaviours, speed profiles, driving profiles) is allocated with exact quotas (largest remainder)
+//! and then shuffled with the stratum's seeded stream, so planned proportions equal the targets up to one unit
+//! of rounding per stratum. Every random stream is keyed by the dataset seed and a stable identity (the
+//! stratum or clip id), so adding a weather or a town leaves every other stratum's clips byte-identical, and
+//! `--only CLIP_ID` re-plans exactly the same script.
+
+pub mod quota;
+pub mod script;
+pub mod seeds;
+pub mod stats;
+
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+
+use glam::DVec2;
+use rand::Rng;
+use rand_chacha::ChaCha20Rng;
+
+use crate::dsl::types::{ClipsPer, Spec, TownRef, WeatherRef};
+use crate::world::routes::{Route, Side, SpawnPoint};
+use crate::world::{LaneType, RoadNetwork};
+pub use script::*;
+
+/// A town ready for planning: its road network and derived spawn candidates.
+pub struct TownContext {
+    /// The road network.
+    pub network: RoadNetwork,
+    /// Vehicle spawn candidates (driving lanes outside junctions).
+    pub spawn_points: Vec<SpawnPoint>,
+}
+
+impl TownContext {
+    /// Prepares a town for planning.
+    pub fn new(network: RoadNetwork) -> Self {
+        let spawn_points = network.driving_spawn_points(10.0);
+        TownContext { network, spawn_points }
+    }
+}
+
+/// Why a clip could not be planned.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlanProblem {
+    /// The clip (or `*` for the whole plan).
+    pub clip_id: String,
+    /// What went wrong.
+    pub reason: String,
+}
+
+impl std::fmt::Display for PlanProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "clip {}: {}", self.clip_id, self.reason)
+    }
+}
+
+/// One (town, weather) cell and its clips.
+#[derive(Clone, Debug)]
+struct Stratum {
+    town: TownRef,
+    weather: WeatherRef,
+    clip_ids: Vec<String>,
+}
+
+/// Which clips the spec asks for, grouped by stratum, in plan order.
+fn strata(spec: &Spec) -> Vec<Stratum> {
+    let weathers = spec.dataset.weathers.resolved();
+    let towns = &spec.dataset.towns;
+    let count = spec.dataset.clips.count as usize;
+    let mut cells: BTreeMap<(usize, usize), Vec<String>> = BTreeMap::new();
+    for (wi, weather) in weathers.iter().enumerate() {
+        for (ti, town) in towns.iter().enumerate() {
+            let n = match spec.dataset.clips.per {
+                ClipsPer::TownAndWeather => count,
+                // `count` clips per weather spread round-robin over the towns, starting at a town chosen by the
+                // weather's name so that a small count does not always favour the first town.
+                ClipsPer::Weather => {
+                    let offset = (seeds::seed_u64(spec.dataset.seed, &format!("town-offset/{}", weather.name())) % towns.len() as u64) as usize;
+                    let first = (ti + towns.len() - offset) % towns.len();
+                    if first < count { (count - first).div_ceil(towns.len()) } else { 0 }
+                }
+            };
+            let ids = (0..n).map(|k| format!("{}-{}-{k:04}", town.name(), weather.name())).collect();
+            cells.insert((ti, wi), ids);
+        }
+    }
+    cells
+        .into_iter()
+        .filter(|(_, ids)| !ids.is_empty())
+        .map(|((ti, wi), clip_ids)| Stratum { town: towns[ti].clone(), weather: weathers[wi].clone(), clip_ids })
+        .collect()
+}
+
+/// Compiles `spec` into a plan. `towns` maps each town name of the spec to its prepared road network.
+/// With `only`, plans just that clip (its stratum is allocated in full, so the script is identical).
+pub fn plan(spec: &Spec, spec_hash: &str, towns: &BTreeMap<String, TownContext>, only: Option<&str>) -> Result<Plan, Vec<PlanProblem>> {
+    let mut clips = Vec::new();
+    let mut problems = Vec::new();
+    let all = strata(spec);
+    if let Some(id) = only
+        && !all.iter().any(|s| s.clip_ids.iter().any(|c| c == id))
+    {
+        return Err(vec![PlanProblem { clip_id: id.to_owned(), reason: "no such clip in this spec".to_owned() }]);
+    }
+    for stratum in &all {
+        if only.is_some_and(|id| !stratum.clip_ids.iter().any(|c| c == id)) {
+            continue;
+        }
+        let Some(town) = towns.get(stratum.town.name()) else {
+            problems.push(PlanProblem { clip_id: "*".to_owned(), reason: format!("town `{}` was not loaded", stratum.town.name()) });
+            continue;
+        };
+        match plan_stratum(spec, stratum, town) {
+            Ok(scripts) => clips.extend(scripts.into_iter().filter(|c| only.is_none_or(|id| c.clip_id == id))),
+            Err(mut p) => problems.append(&mut p),
+        }
+    }
+    if !problems.is_empty() {
+        return Err(problems);
+    }
+    Ok(Plan {
+        format_version: PLAN_FORMAT_VERSION,
+        pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
+        dataset: spec.dataset.name.clone(),
+        seed: spec.dataset.seed,
+        spec_hash: spec_hash.to_owned(),
+        target_crossing_ratio: spec.crossing.target_ratio,
+        clips,
+    })
+}
+
+/// Per-clip draws that the stratum's quotas depend on.
+struct ClipBasics {
+    clip_id: String,
+    seed: u64,
+    frame_count: u32,
+    pedestrians: usize,
+    vehicles: usize,
+}
+
+/// Per-pedestrian allocations made at the stratum level.
+#[derive(Clone)]
+struct PedAlloc {
+    archetype: usize,
+    speed_profile: SpeedProfile,
+    source: CrosserSource,
+    behaviour: Behaviour,
+}
+
+/// The share of pedestrians layer 1 allocates as crossers so that, with the baseline, the target is met.
+pub fn allocated_crosser_ratio(spec: &Spec) -> f64 {
+    let c = &spec.crossing;
+    let l1 = &c.layers.crosser_allocation;
+    if !l1.enabled {
+        return 0.0;
+    }
+    let b = c.baseline_ratio;
+    let r = if b >= 1.0 { 0.0 } else { (c.target_ratio - b) / (1.0 - b) };
+    r.clamp(0.0, l1.max_crosser_ratio)
+}
+
+fn plan_stratum(spec: &Spec, stratum: &Stratum, town: &TownContext) -> Result<Vec<ClipScript>, Vec<PlanProblem>> {
+    let seed = spec.dataset.seed;
+    let d = &spec.dataset;
+    let basics: Vec<ClipBasics> = stratum
+        .clip_ids
+        .iter()
+        .map(|id| {
+            let clip_seed = seeds::seed_u64(seed, id);
+            let mut rng = seeds::clip_rng(clip_seed, "basics");
+            let duration_s = rng.random_range(d.clip_duration_s.min()..=d.clip_duration_s.max());
+            let frame_count = ((duration_s * f64::from(d.fps)).round() as u32).max(1);
+            let p = &spec.pedestrians.per_clip;
+            let v = &spec.traffic.vehicles_per_clip;
+            ClipBasics {
+                clip_id: id.clone(),
+                seed: clip_seed,
+                frame_count,
+                pedestrians: rng.random_range(p.min()..=p.max()) as usize,
+                vehicles: rng.random_range(v.min()..=v.max()) as usize,
+            }
+        })
+        .collect();
+
+    let allocs = allocate_pedestrians(spec, stratum, &basics);
+    let total_vehicles: usize = basics.iter().map(|b| b.vehicles).sum();
+    let m = &spec.traffic.profile_mix;
+    let mut stratum_rng = seeds::rng_for(seed, &format!("stratum/{}/{}/vehicles", stratum.town.name(), stratum.weather.name()));
+    let profiles = quota::allocate(total_vehicles, &[m.aggressive, m.normal, m.cautious], &mut stratum_rng);
+
+    let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
+    let mut scripts = Vec::new();
+    let mut problems = Vec::new();
+    let (mut ped_cursor, mut veh_cursor) = (0, 0);
+    for b in &basics {
+        let peds = &allocs[ped_cursor..ped_cursor + b.pedestrians];
+        let vehs = &profiles[veh_cursor..veh_cursor + b.vehicles];
+        ped_cursor += b.pedestrians;
+        veh_cursor += b.vehicles;
+        match plan_clip(spec, stratum, town, b, peds, vehs, &archetype_names) {
+            Ok(script) => scripts.push(script),
+            Err(reason) => problems.push(PlanProblem { clip_id: b.clip_id.clone(), reason }),
+        }
+    }
+    if problems.is_empty() { Ok(scripts) } else { Err(problems) }
+}
+
+fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -> Vec<PedAlloc> {
+    let n: usize = basics.iter().map(|b| b.pedestrians).sum();
+    let p = &spec.pedestrians;
+    let c = &spec.crossing;
+    let tag = |what: &str| format!("stratum/{}/{}/{what}", stratum.town.name(), stratum.weather.name());
+    let seed = spec.dataset.seed;
+
+    let shares: Vec<f64> = p.archetype_mix.values().copied().collect();
+    let archetypes = quota::allocate(n, &shares, &mut seeds::rng_for(seed, &tag("archetypes")));
+    let sm = &p.speed_profiles.mix;
+    let speed = quota::allocate(n, &[sm.cautious, sm.normal, sm.rushed, sm.distracted], &mut seeds::rng_for(seed, &tag("speed")));
+
+    // Crossers: layer 1 allocates what the target needs beyond the baseline; the archetype's crossing
+    // propensity weights who is chosen. The rest cross at the baseline rate, as CARLA's walkers do.
+    let weights: Vec<f64> = archetypes
+        .iter()
+        .map(|&a| p.archetypes.get(p.archetype_mix.keys().nth(a).map_or("", String::as_str)).map_or(0.5, |x| x.crossing_probability.max(1e-3)))
+        .collect();
+    let mut rng = seeds::rng_for(seed, &tag("crossers"));
+    let r = allocated_crosser_ratio(spec);
+    let allocated = quota::largest_remainder(n, &[r, 1.0 - r])[0];
+    let allocated_mask = quota::weighted_choice(allocated, &weights, &mut rng);
+    let rest: Vec<usize> = (0..n).filter(|&i| !allocated_mask[i]).collect();
+    let b = c.baseline_ratio;
+    let baseline = quota::largest_remainder(rest.len(), &[b, 1.0 - b])[0];
+    let rest_weights: Vec<f64> = rest.iter().map(|&i| weights[i]).collect();
+    let baseline_mask = quota::weighted_choice(baseline, &rest_weights, &mut rng);
+
+    let crossers: Vec<usize> = (0..n).filter(|&i| allocated_mask[i]).collect();
+    let mix = &c.layers.behaviour_mix;
+    let behaviours: Vec<Behaviour> = if mix.enabled {
+        let kinds = [Behaviour::Normal, Behaviour::Sudden, Behaviour::Jaywalk];
+        quota::allocate(crossers.len(), &[mix.mix.normal, mix.mix.sudden, mix.mix.jaywalk], &mut seeds::rng_for(seed, &tag("behaviours")))
+            .into_iter()
+            .map(|k| kinds[k])
+            .collect()
+    } else {
+        vec![Behaviour::Normal; crossers.len()]
+    };
+    let l3 = &c.layers.midroad_jaywalkers;
+    let midroad = if l3.enabled {
+        let k = quota::largest_remainder(crossers.len(), &[l3.share_of_crossers, 1.0 - l3.share_of_crossers])[0];
+        quota::weighted_choice(k, &vec![1.0; crossers.len()], &mut seeds::rng_for(seed, &tag("midroad")))
+    } else {
+        vec![false; crossers.len()]
+    };
+
+    let mut out: Vec<PedAlloc> = (0..n)
+        .map(|i| PedAlloc {
+            archetype: archetypes[i],
+            speed_profile: SpeedProfile::ALL[speed[i]],
+            source: CrosserSource::None,
+            behaviour: Behaviour::None,
+        })
+        .collect();
+    for (k, &i) in crossers.iter().enumerate() {
+        out[i].source = CrosserSource::Allocated;
+        out[i].behaviour = if midroad[k] { Behaviour::MidroadJaywalker } else { behaviours[k] };
+    }
+    for (k, &i) in rest.iter().enumerate() {
+        if baseline_mask[k] {
+            out[i].source = CrosserSource::Baseline;
+            out[i].behaviour = Behaviour::Normal;
+        }
+    }
+    out
+}
+
+/// The ego's planned cruise speed upper bound, for route length checks, m/s.
+const MAX_URBAN_SPEED_MPS: f64 = 14.0;
+
+fn plan_clip(
+    spec: &Spec,
+    stratum: &Stratum,
+    town: &TownContext,
+    basics: &ClipBasics,
+    peds: &[PedAlloc],
+    vehicle_profiles: &[usize],
+    archetype_names: &[&String],
+) -> Result<ClipScript, String> {
+    let mut rng = seeds::clip_rng(basics.seed, "plan");
+    let net = &town.network;
+    let fps = spec.dataset.fps;
+    let duration_s = f64::from(basics.frame_count) / f64::from(fps);
+    let l1 = &spec.crossing.layers.crosser_allocation;
+    let ahead_max = l1.spawn_ahead_m.max().max(spec.annotations.visibility.max_distance_m);
+    let needed_m = ahead_max + MAX_URBAN_SPEED_MPS * duration_s + spec.traffic.ego.route_margin_m;
+
+    // The ego route, with room ahead for every pedestrian.
+    let route = net.random_route(&mut rng, needed_m).ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+    let ego_spec = &spec.traffic.ego;
+    let ego = EgoScript {
+        route: route_script(&route, 0.0),
+        speed_below_limit_pct: rng.random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
+        min_gap_m: ego_spec.min_gap_m,
+        brake_ahead_m: ego_spec.brake_ahead_m,
+        brake_lateral_m: ego_spec.brake_lateral_m,
+    };
+
+    let pedestrians = plan_pedestrians(spec, net, &route, peds, archetype_names, duration_s, &mut rng)?;
+    let vehicles = plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng)?;
+
+    Ok(ClipScript {
+        clip_id: basics.clip_id.clone(),
+        seed: basics.seed,
+        town: stratum.town.name().to_owned(),
+        weather: stratum.weather.name().to_owned(),
+        weather_params: stratum.weather.params(),
+        split: spec.dataset.splits.get(stratum.town.name()).copied().unwrap_or(spec.dataset.default_split),
+        fps,
+        frame_count: basics.frame_count,
+        ego,
+        vehicles,
+        pedestrians,
+    })
+}
+
+fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
+    let mut lanes: Vec<u32> = Vec::new();
+    for p in &route.points {
+        if lanes.last() != Some(&p.lane) {
+            lanes.push(p.lane);
+        }
+    }
+    let pose = route.pose_at(start_s_m);
+    RouteScript { lanes, length_m: route.length_m(), start_s_m, start: pose.pos, start_heading_rad: pose.heading_rad }
+}
+
+/// Minimum distance between two pedestrians' spawn points, metres.
+const PED_SPACING_M: f64 = 1.0;
+/// Attempts to place one pedestrian before the clip is declared infeasible.
+const PLACEMENT_ATTEMPTS: usize = 60;
+
+#[allow(clippy::too_many_arguments)]
+fn plan_pedestrians(
+    spec: &Spec,
+    net: &RoadNetwork,
+    route: &Route,
+    peds: &[PedAlloc],
+    archetype_names: &[&String],
+    duration_s: f64,
+    rng: &mut ChaCha20Rng,
+) -> Result<Vec<PedestrianScript>, String> {
+    let p = &spec.pedestrians;
+    let c = &spec.crossing;
+    let spawn_ahead = c.layers.crosser_allocation.spawn_ahead_m;
+    let far_m = spec.annotations.visibility.max_distance_m.min(route.length_m() - 1.0);
+    let mut scripts: Vec<PedestrianScript> = Vec::with_capacity(peds.len());
+    let mut crosser_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
+    let groups = form_groups(spec, peds, rng);
+
+    for (i, alloc) in peds.iter().enumerate() {
+        let id = i as u32;
+        let name = archetype_names.get(alloc.archetype).map_or("casual_person", |s| s.as_str());
+        let a = p.archetypes.get(name).cloned().unwrap_or_default();
+        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| if r.max() > r.min() { rng.random_range(r.min()..=r.max()) } else { r.min() };
+        let base_speed_mps = draw(rng, a.speed_mps);
+        let hesitation_s = draw(rng, a.hesitation_s);
+        let ttc_threshold_s = draw(rng, a.ttc_threshold_s);
+        let safety_margin_s = draw(rng, c.gap_acceptance.safety_margin_s);
+        let patience_s = draw(rng, a.patience_s);
+        let distracted_at_s = if alloc.speed_profile == SpeedProfile::Distracted {
+            Some(0.0)
+        } else if rng.random_bool(a.distraction_probability.clamp(0.0, 1.0)) {
+            Some(rng.random_range(0.0..duration_s.max(0.1)))
+        } else {
+            None
+        };
+        let group = groups[i];
+        let role = if alloc.source == CrosserSource::None { Role::NonCrosser } else { Role::Crosser };
+
+        // Placement.
+        let leader = group.filter(|g| g.leader != id).and_then(|g| scripts.get(g.leader as usize));
+        let placed = if let Some(leader) = leader {
+            place_follower(net, leader, &scripts, rng)
+        } else {
+            match (role, alloc.behaviour) {
+                (Role::Crosser, Behaviour::MidroadJaywalker) => place_midroad(net, route, spawn_ahead, c.layers.midroad_jaywalkers.lateral_offset_m, &scripts, rng),
+                (Role::Crosser, _) => {
+                    let (lo, hi) = if alloc.source == CrosserSource::Allocated { (spawn_ahead.min(), spawn_ahead.max()) } else { (0.0, far_m) };
+                    let placed = place_crosser(net, route, lo, hi.min(far_m), crosser_side, &scripts, rng);
+                    crosser_side = if crosser_side == Side::Left { Side::Right } else { Side::Left };
+                    placed
+                }
+                (Role::NonCrosser, _) => place_sidewalk(net, route, 0.0, far_m, &scripts, rng),
+            }
+        };
+        let (spawn, heading, ahead, crossing, place) = placed.ok_or_else(|| {
+            format!("cannot place pedestrian {id} ({}, {}) on a {} near the ego's route", name, alloc.behaviour.name(), if alloc.behaviour == Behaviour::MidroadJaywalker { "driving lane" } else { "sidewalk" })
+        })?;
+        let crossing = if role == Role::Crosser { crossing } else { None };
+        if role == Role::Crosser && crossing.is_none() {
+            return Err(format!("pedestrian {id} is a crosser but has no road to cross"));
+        }
+        scripts.push(PedestrianScript {
+            id,
+            archetype: name.to_owned(),
+            body: a.body,
+            base_speed_mps,
+            hesitation_s,
+            attention: a.attention,
+            ttc_threshold_s,
+            safety_margin_s,
+            patience_s,
+            distracted_at_s,
+            role,
+            crosser_source: alloc.source,
+            behaviour: alloc.behaviour,
+            group,
+            speed_profile: alloc.speed_profile,
+            spawn_place: place,
+            spawn,
+            spawn_heading_rad: heading,
+            ahead_of_ego_m: ahead,
+            crossing,
+        });
+    }
+    Ok(scripts)
+}
+
+type Placement = (DVec2, f64, f64, Option<CrossingScript>, SpawnPlace);
+
+fn far_from_others(p: DVec2, scripts: &[PedestrianScript]) -> bool {
+    scripts.iter().all(|s| s.spawn.distance(p) >= PED_SPACING_M)
+}
+
+fn crossing_script(c: &crate::world::routes::Crossing) -> CrossingScript {
+    CrossingScript { near_curb: c.near_curb, far_curb: c.far_curb, end: c.end, direction: c.direction, carriageway_width_m: c.carriageway_width_m }
+}
+
+fn is_lane(net: &RoadNetwork, p: DVec2, kind: LaneType) -> bool {
+    net.lane_at(p).is_some_and(|h| h.lane_type == kind)
+}
+
+fn place_crosser(net: &RoadNetwork, route: &Route, lo: f64, hi: f64, side: Side, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+    for attempt in 0..PLACEMENT_ATTEMPTS {
+        let s = if hi > lo { rng.random_range(lo..hi) } else { lo };
+        let side = if attempt % 2 == 0 { side } else if side == Side::Left { Side::Right } else { Side::Left };
+        let Some(sample) = net.sidewalk_beside(route, s, side) else { continue };
+        if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
+            continue;
+        }
+        let Some(crossing) = net.crossing_at(sample.pos) else { continue };
+        if crossing.carriageway_width_m < 2.0 {
+            continue;
+        }
+        let heading = crossing.direction.to_angle();
+        return Some((sample.pos, heading, s, Some(crossing_script(&crossing)), SpawnPlace::Sidewalk));
+    }
+    None
+}
+
+fn place_sidewalk(net: &RoadNetwork, route: &Route, lo: f64, hi: f64, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        let s = if hi > lo { rng.random_range(lo..hi) } else { lo };
+        let side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
+        let Some(sample) = net.sidewalk_beside(route, s, side) else { continue };
+        if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
+            continue;
+        }
+        let along = route.pose_at(s).heading_rad;
+        let heading = if rng.random_bool(0.5) { along } else { wrap_angle(along + PI) };
+        let crossing = net.crossing_at(sample.pos).map(|c| crossing_script(&c));
+        return Some((sample.pos, heading, s, crossing, SpawnPlace::Sidewalk));
+    }
+    None
+}
+
+fn place_midroad(net: &RoadNetwork, route: &Route, ahead: crate::dsl::types::Range, lateral_m: f64, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        let s = rng.random_range(ahead.min()..=ahead.max()).min(route.length_m() - 1.0);
+        let origin_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
+        let Some(sample) = net.sidewalk_beside(route, s, origin_side) else { continue };
+        let Some(crossing) = net.crossing_at(sample.pos) else { continue };
+        if crossing.carriageway_width_m < 2.0 {
+            continue;
+        }
+        // Spawn in a driving lane at the ego lane's centre ± the lateral offset, on the crossing line.
+        let pose = route.pose_at(s);
+        let target = pose.pos + crossing.direction * rng.random_range(-lateral_m..=lateral_m);
+        let t = (target - crossing.near_curb).dot(crossing.direction).clamp(0.5, crossing.carriageway_width_m - 0.5);
+        let spawn = crossing.near_curb + crossing.direction * t;
+        if !is_lane(net, spawn, LaneType::Driving) || !far_from_others(spawn, scripts) {
+            continue;
+        }
+        return Some((spawn, crossing.direction.to_angle(), s, Some(crossing_script(&crossing)), SpawnPlace::DrivingLane));
+    }
+    None
+}
+
+fn place_follower(net: &RoadNetwork, leader: &PedestrianScript, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+    let along = DVec2::from_angle(leader.spawn_heading_rad).perp();
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        let offset = rng.random_range(1.0..2.5) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        let back = rng.random_range(-0.6..0.3);
+        let p = leader.spawn + along * offset + DVec2::from_angle(leader.spawn_heading_rad) * back;
+        let kind = if leader.spawn_place == SpawnPlace::DrivingLane { LaneType::Driving } else { LaneType::Sidewalk };
+        if !is_lane(net, p, kind) || !far_from_others(p, scripts) {
+            continue;
+        }
+        let crossing = if kind == LaneType::Sidewalk { net.crossing_at(p).map(|c| crossing_script(&c)) } else { leader.crossing.clone() };
+        if crossing.is_none() {
+            continue;
+        }
+        return Some((p, leader.spawn_heading_rad, leader.ahead_of_ego_m, crossing, leader.spawn_place));
+    }
+    None
+}
+
+/// Layer 4: groups of 2–3 among a clip's allocated crossers of the same behaviour, the first member leading.
+fn form_groups(spec: &Spec, peds: &[PedAlloc], rng: &mut ChaCha20Rng) -> Vec<Option<GroupRef>> {
+    let mut out = vec![None; peds.len()];
+    let g = &spec.crossing.layers.groups;
+    if !g.enabled {
+        return out;
+    }
+    let mut next_group = 0u32;
+    for behaviour in [Behaviour::Normal, Behaviour::Sudden, Behaviour::Jaywalk, Behaviour::MidroadJaywalker] {
+        let members: Vec<usize> = (0..peds.len())
+            .filter(|&i| peds[i].source == CrosserSource::Allocated && peds[i].behaviour == behaviour && rng.random_bool(g.probability.clamp(0.0, 1.0)))
+            .collect();
+        let mut k = 0;
+        while members.len() - k >= 2 {
+            let triple = members.len() - k >= 3 && rng.random_bool((g.size_mix.triples / (g.size_mix.pairs + g.size_mix.triples).max(1e-12)).clamp(0.0, 1.0));
+            let size = if triple { 3 } else { 2 };
+            let leader = members[k] as u32;
+            for &m in &members[k..k + size] {
+                out[m] = Some(GroupRef { group_id: next_group, leader });
+            }
+            next_group += 1;
+            k += size;
+        }
+    }
+    out
+}
+
+/// Minimum distance between vehicle spawns, metres.
+const VEHICLE_SPACING_M: f64 = 10.0;
+
+fn plan_vehicles(
+    spec: &Spec,
+    town: &TownContext,
+    ego_route: &Route,
+    peds: &[PedestrianScript],
+    profiles: &[usize],
+    needed_m: f64,
+    rng: &mut ChaCha20Rng,
+) -> Result<Vec<VehicleScript>, String> {
+    let net = &town.network;
+    let ego_start = ego_route.points[0].pos;
+    // Candidates within 150 m of the ego start, away from it and from pedestrians on the road.
+    let candidates: Vec<&SpawnPoint> = town
+        .spawn_points
+        .iter()
+        .filter(|sp| {
+            let d = sp.pos.distance(ego_start);
+            d > VEHICLE_SPACING_M && d < 150.0 && peds.iter().all(|p| p.spawn_place != SpawnPlace::DrivingLane || p.spawn.distance(sp.pos) > 15.0)
+        })
+        .collect();
+    let mut out: Vec<VehicleScript> = Vec::with_capacity(profiles.len());
+    let mut taken: Vec<DVec2> = vec![ego_start];
+    for (i, &profile_index) in profiles.iter().enumerate() {
+        let kind = DrivingProfileKind::ALL[profile_index];
+        let p = match kind {
+            DrivingProfileKind::Aggressive => &spec.traffic.profiles.aggressive,
+            DrivingProfileKind::Normal => &spec.traffic.profiles.normal,
+            DrivingProfileKind::Cautious => &spec.traffic.profiles.cautious,
+        };
+        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| if r.max() > r.min() { rng.random_range(r.min()..=r.max()) } else { r.min() };
+        let mut placed = None;
+        for _ in 0..PLACEMENT_ATTEMPTS {
+            if candidates.is_empty() {
+                break;
+            }
+            let sp = candidates[rng.random_range(0..candidates.len())];
+            if taken.iter().any(|t| t.distance(sp.pos) < VEHICLE_SPACING_M) {
+                continue;
+            }
+            let Some(route) = net.route_from(sp.lane, needed_m, rng) else { continue };
+            let start_s = route.points.iter().min_by(|a, b| a.pos.distance_squared(sp.pos).total_cmp(&b.pos.distance_squared(sp.pos))).map_or(0.0, |q| q.s_m);
+            placed = Some((sp.pos, route_script(&route, start_s)));
+            break;
+        }
+        let Some((pos, route)) = placed else {
+            return Err(format!("cannot place vehicle {i} on a free driving lane within 150 m of the ego"));
+        };
+        taken.push(pos);
+        out.push(VehicleScript {
+            id: i as u32,
+            profile: kind,
+            speed_difference_pct: draw(rng, p.speed_difference_pct),
+            min_gap_m: draw(rng, p.min_gap_m),
+            time_headway_s: draw(rng, p.time_headway_s),
+            ignores_lights: rng.random_bool(p.ignore_lights_probability.clamp(0.0, 1.0)),
+            ignores_walkers: rng.random_bool(p.ignore_walkers_probability.clamp(0.0, 1.0)),
+            route,
+        });
+    }
+    Ok(out)
+}
+
+fn wrap_angle(a: f64) -> f64 {
+    let mut a = a % (2.0 * PI);
+    if a > PI {
+        a -= 2.0 * PI;
+    } else if a <= -PI {
+        a += 2.0 * PI;
+    }
+    a
+}

@@ -1,0 +1,303 @@
+//! The plan and its clip scripts: everything the executor needs to simulate one clip, fully determined and
+//! seeded. A plan serialises to stable JSON (`pedsynth plan --emit`), which the executor accepts as input.
+//!
+//! Positions are world coordinates (right-handed, x east, y north, metres); headings are radians
+//! counter-clockwise from +x.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::dsl::types::{Body, Split, WeatherParams};
+
+/// Version of the plan format.
+pub const PLAN_FORMAT_VERSION: u32 = 1;
+
+/// A compiled dataset: the clip scripts in a stable order (town, weather, index).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// Plan format version.
+    pub format_version: u32,
+    /// pedsynth version that made the plan.
+    pub pedsynth_version: String,
+    /// Dataset name.
+    pub dataset: String,
+    /// Dataset seed.
+    pub seed: u64,
+    /// blake3 of the resolved spec.
+    pub spec_hash: String,
+    /// Target sequence-level crossing ratio.
+    pub target_crossing_ratio: f64,
+    /// The clips.
+    pub clips: Vec<ClipScript>,
+}
+
+/// One clip.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClipScript {
+    /// Stable, human-readable id: `<town>-<weather>-<NNNN>`.
+    pub clip_id: String,
+    /// The clip's seed, derived from the dataset seed and the clip id.
+    pub seed: u64,
+    /// Town name.
+    pub town: String,
+    /// Weather name.
+    pub weather: String,
+    /// Resolved weather parameters.
+    pub weather_params: WeatherParams,
+    /// Dataset split.
+    pub split: Split,
+    /// Frames per second.
+    pub fps: u32,
+    /// Number of frames.
+    pub frame_count: u32,
+    /// The ego vehicle.
+    pub ego: EgoScript,
+    /// Traffic vehicles.
+    pub vehicles: Vec<VehicleScript>,
+    /// Pedestrians.
+    pub pedestrians: Vec<PedestrianScript>,
+}
+
+impl ClipScript {
+    /// Duration in seconds.
+    pub fn duration_s(&self) -> f64 {
+        f64::from(self.frame_count) / f64::from(self.fps.max(1))
+    }
+}
+
+/// A route along the lane graph: the lanes in order (indices into the town's lane list) and where on the
+/// resulting polyline the agent starts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RouteScript {
+    /// Lane indices, in driving order.
+    pub lanes: Vec<u32>,
+    /// Length of the route, metres.
+    pub length_m: f64,
+    /// Start position along the route, metres.
+    pub start_s_m: f64,
+    /// Start position.
+    pub start: DVec2,
+    /// Start heading, radians.
+    pub start_heading_rad: f64,
+}
+
+/// The ego vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EgoScript {
+    /// Route.
+    pub route: RouteScript,
+    /// Percentage below the speed limit it drives at.
+    pub speed_below_limit_pct: f64,
+    /// Minimum gap to a leader, metres.
+    pub min_gap_m: f64,
+    /// Brakes for a crossing pedestrian closer than this ahead, metres.
+    pub brake_ahead_m: f64,
+    /// ... and within this lateral distance, metres.
+    pub brake_lateral_m: f64,
+}
+
+/// Driving profiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DrivingProfileKind {
+    /// Aggressive.
+    Aggressive,
+    /// Normal.
+    Normal,
+    /// Cautious.
+    Cautious,
+}
+
+impl DrivingProfileKind {
+    /// All profiles in spec order.
+    pub const ALL: [DrivingProfileKind; 3] = [Self::Aggressive, Self::Normal, Self::Cautious];
+    /// The profile's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Aggressive => "aggressive",
+            Self::Normal => "normal",
+            Self::Cautious => "cautious",
+        }
+    }
+}
+
+/// One traffic vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VehicleScript {
+    /// Vehicle id within the clip (the ego is not counted).
+    pub id: u32,
+    /// Driving profile.
+    pub profile: DrivingProfileKind,
+    /// Percentage below the speed limit (negative: faster).
+    pub speed_difference_pct: f64,
+    /// IDM minimum gap s0, metres.
+    pub min_gap_m: f64,
+    /// IDM time headway T, seconds.
+    pub time_headway_s: f64,
+    /// Whether it ignores traffic lights.
+    pub ignores_lights: bool,
+    /// Whether it ignores pedestrians.
+    pub ignores_walkers: bool,
+    /// Route.
+    pub route: RouteScript,
+}
+
+/// Role of a pedestrian.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// Planned to cross the road in front of the ego.
+    Crosser,
+    /// Stays on the sidewalk.
+    NonCrosser,
+}
+
+/// Crossing behaviour type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Behaviour {
+    /// Checks traffic and crosses when the gap is accepted.
+    Normal,
+    /// Enters the road abruptly without checking.
+    Sudden,
+    /// Crosses mid-block.
+    Jaywalk,
+    /// Injected directly in a driving lane (layer 3).
+    MidroadJaywalker,
+    /// A non-crosser.
+    None,
+}
+
+impl Behaviour {
+    /// All behaviour types.
+    pub const ALL: [Behaviour; 5] = [Self::Normal, Self::Sudden, Self::Jaywalk, Self::MidroadJaywalker, Self::None];
+    /// The behaviour's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Normal => "normal",
+            Self::Sudden => "sudden",
+            Self::Jaywalk => "jaywalk",
+            Self::MidroadJaywalker => "midroad_jaywalker",
+            Self::None => "none",
+        }
+    }
+}
+
+/// Which mechanism made a pedestrian a crosser.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CrosserSource {
+    /// Layer 1 (crosser allocation).
+    Allocated,
+    /// The CARLA-like baseline.
+    Baseline,
+    /// Not a crosser.
+    None,
+}
+
+/// Situational speed profiles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedProfile {
+    /// 0.8×.
+    Cautious,
+    /// 1.0×.
+    Normal,
+    /// 1.3×.
+    Rushed,
+    /// 0.9×, with phone pauses.
+    Distracted,
+}
+
+impl SpeedProfile {
+    /// All profiles in spec order.
+    pub const ALL: [SpeedProfile; 4] = [Self::Cautious, Self::Normal, Self::Rushed, Self::Distracted];
+    /// The profile's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Cautious => "cautious",
+            Self::Normal => "normal",
+            Self::Rushed => "rushed",
+            Self::Distracted => "distracted",
+        }
+    }
+}
+
+/// A crossing group.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct GroupRef {
+    /// Group id within the clip.
+    pub group_id: u32,
+    /// Pedestrian id of the leader.
+    pub leader: u32,
+}
+
+/// Where a pedestrian starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpawnPlace {
+    /// On a sidewalk.
+    Sidewalk,
+    /// In a driving lane (injected mid-road jaywalker).
+    DrivingLane,
+}
+
+/// A planned crossing: from the spawn point across the carriageway to the far sidewalk.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CrossingScript {
+    /// Where the pedestrian leaves the near sidewalk.
+    pub near_curb: DVec2,
+    /// Where the pedestrian reaches the far sidewalk.
+    pub far_curb: DVec2,
+    /// A point on the far sidewalk (the crossing's goal).
+    pub end: DVec2,
+    /// Unit direction of the crossing.
+    pub direction: DVec2,
+    /// Width of the carriageway crossed, metres.
+    pub carriageway_width_m: f64,
+}
+
+/// One pedestrian.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PedestrianScript {
+    /// Pedestrian id within the clip.
+    pub id: u32,
+    /// Archetype name.
+    pub archetype: String,
+    /// Body model.
+    pub body: Body,
+    /// Base walking speed, m/s.
+    pub base_speed_mps: f64,
+    /// Hesitation at the curb, seconds.
+    pub hesitation_s: f64,
+    /// Attention 0–1.
+    pub attention: f64,
+    /// Gap-acceptance threshold τ_ttc, seconds.
+    pub ttc_threshold_s: f64,
+    /// Safety margin Δ_safety, seconds.
+    pub safety_margin_s: f64,
+    /// Patience cap, seconds.
+    pub patience_s: f64,
+    /// Whether the pedestrian becomes distracted (phone use), and when, seconds into the clip.
+    pub distracted_at_s: Option<f64>,
+    /// Role.
+    pub role: Role,
+    /// Which mechanism made it a crosser.
+    pub crosser_source: CrosserSource,
+    /// Behaviour type.
+    pub behaviour: Behaviour,
+    /// Crossing group, if any.
+    pub group: Option<GroupRef>,
+    /// Initial situational speed profile.
+    pub speed_profile: SpeedProfile,
+    /// Where it starts.
+    pub spawn_place: SpawnPlace,
+    /// Start position.
+    pub spawn: DVec2,
+    /// Start heading, radians.
+    pub spawn_heading_rad: f64,
+    /// Distance ahead of the ego's start along its route, metres.
+    pub ahead_of_ego_m: f64,
+    /// The planned crossing (crossers only).
+    pub crossing: Option<CrossingScript>,
+}
