@@ -1,0 +1,73 @@
+//! Library side of `pedsynth town list` and `pedsynth town show`: text and JSON output, and the PNG map
+//! written atomically (temporary file, then rename). `main.rs` only parses arguments and calls these.
+
+use std::path::Path;
+
+use crate::world::{BUILTIN_TOWN_NAMES, RoadNetwork, WorldError, builtin};
+
+/// The text `pedsynth town list` prints: one line per built-in town with its character and size.
+pub fn town_list_text() -> String {
+    let mut out = String::from(
+        "Built-in towns (procedural, modelled on the paper's CARLA towns; not CARLA's maps):\n",
+    );
+    for name in BUILTIN_TOWN_NAMES {
+        let desc = builtin::description(name).unwrap_or("");
+        match RoadNetwork::builtin(name) {
+            Some(net) => {
+                let s = net.summary();
+                out.push_str(&format!(
+                    "  {name:<12} {desc} — {:.2} km driving lanes, {:.2} km sidewalk, {} junctions\n",
+                    s.driving_lane_km, s.sidewalk_km, s.junction_count
+                ));
+            }
+            None => out.push_str(&format!("  {name:<12} {desc}\n")),
+        }
+    }
+    out.push_str("Any OpenDRIVE file (.xodr 1.4-1.7) can be given by path instead, e.g. ../shared/maps/carla/Town01.xodr\n");
+    out
+}
+
+/// `pedsynth town show NAME_OR_XODR [--png out.png] [--json]`: loads the town, writes the PNG map if asked
+/// and returns the text to print (the JSON summary if `json`, else a human-readable summary).
+pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<String, WorldError> {
+    let net = RoadNetwork::load(name_or_path)?;
+    if let Some(path) = png {
+        let bytes = net.render_png(2.0, 4096);
+        write_atomically(path, &bytes)?;
+    }
+    let s = net.summary();
+    if json {
+        return Ok(serde_json::to_string_pretty(&s).expect("summary serialises") + "\n");
+    }
+    let mut out = format!(
+        "{}: {} roads, {} lanes, {} junctions, {} crosswalks, {} obstacles\n  driving lanes {:.2} km, sidewalks {:.2} km\n  bounds x {:.1}..{:.1} m, y {:.1}..{:.1} m\n",
+        s.name,
+        s.road_count,
+        s.lane_count,
+        s.junction_count,
+        s.crosswalk_count,
+        s.obstacle_count,
+        s.driving_lane_km,
+        s.sidewalk_km,
+        s.bounds_m[0],
+        s.bounds_m[2],
+        s.bounds_m[1],
+        s.bounds_m[3]
+    );
+    if let Some(path) = png {
+        out.push_str(&format!("  map written to {}\n", path.display()));
+    }
+    Ok(out)
+}
+
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WorldError> {
+    let io = |source| WorldError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp);
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}

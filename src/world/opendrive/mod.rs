@@ -1,0 +1,20 @@
+//! OpenDRIVE (.xodr 1.4–1.7) import: [`parse`] turns XML into raw records with line numbers, [`geometry`]
+//! evaluates reference lines and cubic profiles, and [`build`] turns raw records into the road-network model.
+//! The caps below protect against hostile input (OOM, absurd values).
+
+pub(crate) mod build;
+pub(crate) mod geometry;
+pub(crate) mod parse;
+
+/// Largest .xodr file we read.
+pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;
+/// Most XML nodes we parse.
+pub const MAX_NODES: u32 = 20_000_000;
+/// Most lane pieces a network may have (about 4 GB of lanes at 1 m steps would be absurd anyway).
+pub const MAX_PIECES: usize = 4_000_000;
+/// Longest road or geometry record.
+pub const MAX_LENGTH_M: f64 = 100_000.0;
+/// Widest lane.
+pub const MAX_WIDTH_M: f64 = 50.0;
+/// Largest absolute coordinate.
+pub const MAX_ABS_COORD_M: f64 = 10_000_000.0;

@@ -1,0 +1,185 @@
+//! Checks shared by the CARLA-map and built-in-town tests: lane classification of sampled points, routes,
+//! crossing vectors.
+#![allow(dead_code)]
+
+use glam::DVec2;
+use pedsynth::world::{LaneType, RoadNetwork};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Directory holding the real CARLA maps (beside the repository, never copied into it).
+pub fn carla_dir() -> std::path::PathBuf {
+    std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/maps/carla"))
+}
+
+/// A point inside lane piece `pi`: `along` ∈ [0,1] between its stations, `across` ∈ [0,1] inner→outer.
+pub fn point_in_piece(net: &RoadNetwork, pi: usize, along: f64, across: f64) -> DVec2 {
+    let c = net.pieces[pi].corners;
+    let inner = c[0].lerp(c[1], along);
+    let outer = c[3].lerp(c[2], along);
+    inner.lerp(outer, across)
+}
+
+/// Samples up to `n` points on lanes of type `t` (pieces at least 0.6 m wide, the middle 60 % of the width)
+/// and returns (matching, total).
+pub fn classification(net: &RoadNetwork, t: LaneType, n: usize, seed: u64) -> (usize, usize) {
+    let pieces: Vec<usize> = (0..net.pieces.len())
+        .filter(|&i| {
+            let p = &net.pieces[i];
+            net.lanes[p.lane as usize].lane_type == t && p.width_m[0].min(p.width_m[1]) > 0.6
+        })
+        .collect();
+    assert!(!pieces.is_empty(), "{}: no {t:?} pieces", net.name);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut ok = 0;
+    let mut misses = Vec::new();
+    for _ in 0..n {
+        let pi = pieces[rng.random_range(0..pieces.len())];
+        let p = point_in_piece(
+            net,
+            pi,
+            rng.random_range(0.05..0.95),
+            rng.random_range(0.2..0.8),
+        );
+        let z = net.pieces[pi].z_m as f64;
+        match net.lane_at_3d(p.extend(z)) {
+            Some(h) if h.lane_type == t => ok += 1,
+            other => misses.push((p, other.map(|h| h.lane_type))),
+        }
+    }
+    if !misses.is_empty() {
+        eprintln!(
+            "{}: {t:?} misclassified {} of {n}, e.g. {:?}",
+            net.name,
+            misses.len(),
+            &misses[..misses.len().min(5)]
+        );
+    }
+    (ok, n)
+}
+
+pub fn assert_classification(net: &RoadNetwork) {
+    for t in [LaneType::Driving, LaneType::Sidewalk] {
+        let (ok, n) = classification(net, t, 4000, 7);
+        let rate = ok as f64 / n as f64;
+        assert!(
+            rate >= 0.995,
+            "{}: {t:?} classification rate {rate:.4} < 0.995",
+            net.name
+        );
+    }
+}
+
+pub fn assert_route(net: &RoadNetwork, min_m: f64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for k in 0..5 {
+        let r = net
+            .random_route(&mut rng, min_m)
+            .unwrap_or_else(|| panic!("{}: no route of {min_m} m (try {k})", net.name));
+        assert!(r.length_m() >= min_m);
+        let mut on_driving = 0;
+        for w in r.points.windows(2) {
+            let gap = (w[1].pos - w[0].pos).length();
+            assert!(
+                gap < 3.0,
+                "{}: route jumps {gap:.2} m at s={:.1}",
+                net.name,
+                w[0].s_m
+            );
+            assert!(w[1].s_m > w[0].s_m);
+        }
+        for p in &r.points {
+            match net.lane_at_3d(p.pos.extend(p.z_m)) {
+                Some(h) if h.lane_type == LaneType::Driving => on_driving += 1,
+                other => eprintln!(
+                    "{}: route point {:?} (lane {}) classifies as {:?}",
+                    net.name,
+                    p.pos,
+                    p.lane,
+                    other.map(|h| (h.lane_type, h.lane))
+                ),
+            }
+        }
+        let frac = on_driving as f64 / r.points.len() as f64;
+        assert!(
+            frac >= 0.99,
+            "{}: only {frac:.3} of route points on driving lanes",
+            net.name
+        );
+        let mid = r.pose_at(0.5 * r.length_m());
+        assert!(mid.pos.is_finite());
+    }
+}
+
+/// Crossing vectors from sidewalk points outside junctions: where one is found, it starts on the sidewalk,
+/// ends on another sidewalk lane, crosses a plausible carriageway and is perpendicular to the sidewalk. At
+/// least `min_found` of the samples must yield a crossing.
+pub fn assert_crossings(net: &RoadNetwork, min_found: f64) {
+    let pieces: Vec<usize> = (0..net.pieces.len())
+        .filter(|&i| {
+            let p = &net.pieces[i];
+            let l = &net.lanes[p.lane as usize];
+            l.lane_type == LaneType::Sidewalk
+                && !l.in_junction
+                && p.width_m[0].min(p.width_m[1]) > 1.0
+        })
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let n = 600;
+    let mut found = 0;
+    for _ in 0..n {
+        let pi = pieces[rng.random_range(0..pieces.len())];
+        let p = point_in_piece(net, pi, 0.5, 0.5);
+        let p3 = p.extend(net.pieces[pi].z_m as f64);
+        let Some(start) = net.lane_at_3d(p3) else {
+            continue;
+        };
+        if start.lane_type != LaneType::Sidewalk {
+            continue;
+        }
+        let Some(c) = net.crossing_at_3d(p3) else {
+            continue;
+        };
+        found += 1;
+        let end = net
+            .lane_at_3d(c.end.extend(p3.z))
+            .unwrap_or_else(|| panic!("{}: crossing end {:?} off every lane", net.name, c.end));
+        assert_eq!(
+            end.lane_type,
+            LaneType::Sidewalk,
+            "{}: crossing from {p:?} ends on {:?}",
+            net.name,
+            end.lane_type
+        );
+        assert_ne!(end.lane, start.lane);
+        assert!(
+            (2.0..60.0).contains(&c.carriageway_width_m),
+            "{}: carriageway {:.2} m at {p:?}",
+            net.name,
+            c.carriageway_width_m
+        );
+        let h = start.heading_rad;
+        let along = DVec2::new(h.cos(), h.sin());
+        assert!(
+            along.dot(c.direction).abs() < 0.2,
+            "{}: crossing not perpendicular at {p:?}",
+            net.name
+        );
+    }
+    let frac = found as f64 / n as f64;
+    eprintln!(
+        "{}: crossings found for {found}/{n} sidewalk points",
+        net.name
+    );
+    assert!(
+        frac >= min_found,
+        "{}: crossings found for only {frac:.2} of sidewalk points",
+        net.name
+    );
+}
+
+pub fn assert_queries(net: &RoadNetwork) {
+    assert_classification(net);
+    assert_route(net, 500.0);
+    assert_crossings(net, 0.5);
+}
