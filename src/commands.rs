@@ -1,10 +1,14 @@
 //! The command implementations behind the CLI: each takes parsed arguments and output streams and returns a
 //! process exit code (0 ok, 1 other failure, 2 invalid input).
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::PathBuf;
 
+use crate::dsl::types::TownRef;
 use crate::dsl::{self, LoadOptions, LoadedSpec, validate};
+use crate::planner::{self, Plan, TownContext};
+use crate::world::RoadNetwork;
 
 /// Process exit codes.
 pub mod exit {
@@ -93,5 +97,178 @@ pub fn schema(out: &mut dyn Write) -> i32 {
     match out.write_all(dsl::schema::spec_schema_text().as_bytes()) {
         Ok(()) => exit::OK,
         Err(_) => exit::FAILURE,
+    }
+}
+
+/// Renders any diagnostic without colour at the fixed width.
+pub fn render_diagnostic(diagnostic: &dyn miette::Diagnostic) -> String {
+    let handler = miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
+        .with_width(DIAGNOSTIC_WIDTH)
+        .with_links(false);
+    let mut out = String::new();
+    let _ = handler.render_report(&mut out, diagnostic);
+    out
+}
+
+/// Loads every town a spec names (built-in towns are generated, OpenDRIVE maps read relative to the spec).
+pub fn load_towns(loaded: &LoadedSpec) -> Result<BTreeMap<String, TownContext>, String> {
+    let mut towns = BTreeMap::new();
+    for town in &loaded.spec.dataset.towns {
+        let network = match town {
+            TownRef::Builtin(t) => RoadNetwork::builtin(t.name())
+                .ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
+            TownRef::OpenDrive(t) => {
+                let mut network = RoadNetwork::from_xodr_file(&loaded.resolve_path(&t.opendrive))
+                    .map_err(|e| render_diagnostic(&e))?;
+                network.name = t.name.clone();
+                network
+            }
+        };
+        towns.insert(town.name().to_owned(), TownContext::new(network));
+    }
+    Ok(towns)
+}
+
+/// Options of `pedsynth plan`.
+#[derive(Clone, Debug, Default)]
+pub struct PlanArgs {
+    /// Print JSON instead of tables.
+    pub json: bool,
+    /// Write the plan to this file.
+    pub emit: Option<PathBuf>,
+    /// Plan only this clip.
+    pub only: Option<String>,
+}
+
+/// Loads a spec and its towns and compiles the plan; problems are rendered to `err` and become the exit code.
+pub fn compile_plan(
+    spec_path: &std::path::Path,
+    options: &LoadOptions,
+    only: Option<&str>,
+    err: &mut dyn Write,
+) -> Result<(LoadedSpec, Plan), i32> {
+    let loaded = match dsl::load_file(spec_path, options) {
+        Ok(loaded) => loaded,
+        Err(errors) => {
+            let _ = err.write_all(errors.render_plain(DIAGNOSTIC_WIDTH).as_bytes());
+            return Err(exit::INVALID);
+        }
+    };
+    let towns = match load_towns(&loaded) {
+        Ok(towns) => towns,
+        Err(message) => {
+            let _ = writeln!(err, "{message}");
+            return Err(exit::INVALID);
+        }
+    };
+    match planner::plan(&loaded.spec, &loaded.hash(), &towns, only) {
+        Ok(plan) => Ok((loaded, plan)),
+        Err(problems) => {
+            let _ = writeln!(
+                err,
+                "{}: the spec cannot be planned ({} problem{}):",
+                loaded.name,
+                problems.len(),
+                if problems.len() == 1 { "" } else { "s" }
+            );
+            for p in &problems {
+                let _ = writeln!(err, "  × pedsynth::plan::infeasible: {p}");
+            }
+            let _ = writeln!(
+                err,
+                "  help: widen the spawn distances, lower the pedestrian or vehicle counts, or use a larger town"
+            );
+            Err(exit::INVALID)
+        }
+    }
+}
+
+/// `pedsynth plan SPEC`: prints dry-run statistics, and writes the plan with `--emit`.
+pub fn plan(
+    spec_path: &std::path::Path,
+    options: &LoadOptions,
+    args: &PlanArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> i32 {
+    let (loaded, plan) = match compile_plan(spec_path, options, args.only.as_deref(), err) {
+        Ok(x) => x,
+        Err(code) => return code,
+    };
+    if let Some(path) = &args.emit {
+        let mut json = serde_json::to_string_pretty(&plan).unwrap_or_default();
+        json.push('\n');
+        if let Err(e) = write_atomically(path, json.as_bytes()) {
+            let _ = writeln!(err, "cannot write plan to {}: {e}", path.display());
+            return exit::FAILURE;
+        }
+    }
+    let stats = planner::stats::compute(&plan, &loaded.spec);
+    let text = if args.json {
+        let mut t = serde_json::to_string_pretty(&stats).unwrap_or_default();
+        t.push('\n');
+        t
+    } else {
+        planner::stats::render_text(&stats)
+    };
+    match out.write_all(text.as_bytes()) {
+        Ok(()) => exit::OK,
+        Err(_) => exit::FAILURE,
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a complete file
+/// or nothing appears at `path`.
+pub fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// `pedsynth town list`.
+pub fn town_list(out: &mut dyn Write) -> i32 {
+    match out.write_all(crate::world::town_list_text().as_bytes()) {
+        Ok(()) => exit::OK,
+        Err(_) => exit::FAILURE,
+    }
+}
+
+/// `pedsynth town show NAME_OR_XODR [--png OUT] [--json]`.
+pub fn town_show(
+    town: &str,
+    png: Option<&std::path::Path>,
+    json: bool,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> i32 {
+    match crate::world::town_show(town, png, json) {
+        Ok(text) => match out.write_all(text.as_bytes()) {
+            Ok(()) => exit::OK,
+            Err(_) => exit::FAILURE,
+        },
+        Err(e) => {
+            let _ = err.write_all(render_diagnostic(&e).as_bytes());
+            if matches!(e, crate::world::WorldError::Io { .. }) {
+                exit::FAILURE
+            } else {
+                exit::INVALID
+            }
+        }
     }
 }

@@ -3,4 +3,5 @@
 //! Pipeline: `dsl` (spec → validated, defaulted `Spec`) → `world` (road networks) → planner → executor.
 pub mod commands;
 pub mod dsl;
+pub mod planner;
 pub mod world;

@@ -39,8 +39,46 @@ enum Command {
         #[command(flatten)]
         spec_args: SpecArgs,
     },
+    /// Compile a spec into a plan and print dry-run statistics (nothing is simulated).
+    Plan {
+        /// Spec file.
+        spec: PathBuf,
+        /// Print stable JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+        /// Write the plan (clip scripts) to this JSON file.
+        #[arg(long, value_name = "PLAN.json")]
+        emit: Option<PathBuf>,
+        /// Plan only this clip (e.g. `town01_like-clear_noon-0001`).
+        #[arg(long, value_name = "CLIP_ID")]
+        only: Option<String>,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
+    /// Inspect towns.
+    Town {
+        #[command(subcommand)]
+        command: TownCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum TownCommand {
+    /// List the built-in towns.
+    List,
+    /// Summarise a town (built-in name or .xodr path); draw it with --png.
+    Show {
+        /// Built-in town name or path to an OpenDRIVE file.
+        town: String,
+        /// Write a top-down map to this PNG file.
+        #[arg(long, value_name = "OUT.png")]
+        png: Option<PathBuf>,
+        /// Print summary figures as JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -70,7 +108,32 @@ fn main() -> ExitCode {
             };
             commands::validate(&specs, &options, resolved, &mut out, &mut err)
         }
+        Command::Plan {
+            spec,
+            json,
+            emit,
+            only,
+            spec_args,
+        } => {
+            let options = LoadOptions {
+                overrides: spec_args.overrides,
+                allow_large: spec_args.allow_large,
+            };
+            commands::plan(
+                &spec,
+                &options,
+                &commands::PlanArgs { json, emit, only },
+                &mut out,
+                &mut err,
+            )
+        }
         Command::Schema => commands::schema(&mut out),
+        Command::Town {
+            command: TownCommand::List,
+        } => commands::town_list(&mut out),
+        Command::Town {
+            command: TownCommand::Show { town, png, json },
+        } => commands::town_show(&town, png.as_deref(), json, &mut out, &mut err),
     };
     ExitCode::from(code as u8)
 }

@@ -18,12 +18,13 @@ use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
 use glam::DVec2;
-use rand::Rng;
+use rand::RngExt;
+use rand::seq::SliceRandom;
 use rand_chacha::ChaCha20Rng;
 
 use crate::dsl::types::{ClipsPer, Spec, TownRef, WeatherRef};
-use crate::world::routes::{Route, Side, SpawnPoint};
 use crate::world::{LaneType, RoadNetwork};
+use crate::world::{Route, Side, SpawnPoint};
 pub use script::*;
 
 /// A town ready for planning: its road network and derived spawn candidates.
@@ -78,39 +79,61 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
                 // `count` clips per weather spread round-robin over the towns, starting at a town chosen by the
                 // weather's name so that a small count does not always favour the first town.
                 ClipsPer::Weather => {
-                    let offset = (seeds::seed_u64(spec.dataset.seed, &format!("town-offset/{}", weather.name())) % towns.len() as u64) as usize;
+                    let offset = (seeds::seed_u64(spec.dataset.seed, &format!("town-offset/{}", weather.name()))
+                        % towns.len() as u64) as usize;
                     let first = (ti + towns.len() - offset) % towns.len();
-                    if first < count { (count - first).div_ceil(towns.len()) } else { 0 }
+                    if first < count {
+                        (count - first).div_ceil(towns.len())
+                    } else {
+                        0
+                    }
                 }
             };
-            let ids = (0..n).map(|k| format!("{}-{}-{k:04}", town.name(), weather.name())).collect();
+            let ids = (0..n)
+                .map(|k| format!("{}-{}-{k:04}", town.name(), weather.name()))
+                .collect();
             cells.insert((ti, wi), ids);
         }
     }
     cells
         .into_iter()
         .filter(|(_, ids)| !ids.is_empty())
-        .map(|((ti, wi), clip_ids)| Stratum { town: towns[ti].clone(), weather: weathers[wi].clone(), clip_ids })
+        .map(|((ti, wi), clip_ids)| Stratum {
+            town: towns[ti].clone(),
+            weather: weathers[wi].clone(),
+            clip_ids,
+        })
         .collect()
 }
 
 /// Compiles `spec` into a plan. `towns` maps each town name of the spec to its prepared road network.
 /// With `only`, plans just that clip (its stratum is allocated in full, so the script is identical).
-pub fn plan(spec: &Spec, spec_hash: &str, towns: &BTreeMap<String, TownContext>, only: Option<&str>) -> Result<Plan, Vec<PlanProblem>> {
+pub fn plan(
+    spec: &Spec,
+    spec_hash: &str,
+    towns: &BTreeMap<String, TownContext>,
+    only: Option<&str>,
+) -> Result<Plan, Vec<PlanProblem>> {
     let mut clips = Vec::new();
     let mut problems = Vec::new();
     let all = strata(spec);
     if let Some(id) = only
         && !all.iter().any(|s| s.clip_ids.iter().any(|c| c == id))
     {
-        return Err(vec![PlanProblem { clip_id: id.to_owned(), reason: "no such clip in this spec".to_owned() }]);
+        return Err(vec![PlanProblem {
+            clip_id: id.to_owned(),
+            reason: "no such clip in this spec".to_owned(),
+        }]);
     }
     for stratum in &all {
         if only.is_some_and(|id| !stratum.clip_ids.iter().any(|c| c == id)) {
             continue;
         }
         let Some(town) = towns.get(stratum.town.name()) else {
-            problems.push(PlanProblem { clip_id: "*".to_owned(), reason: format!("town `{}` was not loaded", stratum.town.name()) });
+            problems.push(PlanProblem {
+                clip_id: "*".to_owned(),
+                reason: format!("town `{}` was not loaded", stratum.town.name()),
+            });
             continue;
         };
         match plan_stratum(spec, stratum, town) {
@@ -148,6 +171,8 @@ struct PedAlloc {
     speed_profile: SpeedProfile,
     source: CrosserSource,
     behaviour: Behaviour,
+    /// Stratum-wide index of the group's leader.
+    group: Option<usize>,
 }
 
 /// The share of pedestrians layer 1 allocates as crossers so that, with the baseline, the target is met.
@@ -158,7 +183,11 @@ pub fn allocated_crosser_ratio(spec: &Spec) -> f64 {
         return 0.0;
     }
     let b = c.baseline_ratio;
-    let r = if b >= 1.0 { 0.0 } else { (c.target_ratio - b) / (1.0 - b) };
+    let r = if b >= 1.0 {
+        0.0
+    } else {
+        (c.target_ratio - b) / (1.0 - b)
+    };
     r.clamp(0.0, l1.max_crosser_ratio)
 }
 
@@ -188,7 +217,10 @@ fn plan_stratum(spec: &Spec, stratum: &Stratum, town: &TownContext) -> Result<Ve
     let allocs = allocate_pedestrians(spec, stratum, &basics);
     let total_vehicles: usize = basics.iter().map(|b| b.vehicles).sum();
     let m = &spec.traffic.profile_mix;
-    let mut stratum_rng = seeds::rng_for(seed, &format!("stratum/{}/{}/vehicles", stratum.town.name(), stratum.weather.name()));
+    let mut stratum_rng = seeds::rng_for(
+        seed,
+        &format!("stratum/{}/{}/vehicles", stratum.town.name(), stratum.weather.name()),
+    );
     let profiles = quota::allocate(total_vehicles, &[m.aggressive, m.normal, m.cautious], &mut stratum_rng);
 
     let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
@@ -200,12 +232,28 @@ fn plan_stratum(spec: &Spec, stratum: &Stratum, town: &TownContext) -> Result<Ve
         let vehs = &profiles[veh_cursor..veh_cursor + b.vehicles];
         ped_cursor += b.pedestrians;
         veh_cursor += b.vehicles;
-        match plan_clip(spec, stratum, town, b, peds, vehs, &archetype_names) {
+        match plan_clip(
+            spec,
+            stratum,
+            town,
+            b,
+            peds,
+            ped_cursor - b.pedestrians,
+            vehs,
+            &archetype_names,
+        ) {
             Ok(script) => scripts.push(script),
-            Err(reason) => problems.push(PlanProblem { clip_id: b.clip_id.clone(), reason }),
+            Err(reason) => problems.push(PlanProblem {
+                clip_id: b.clip_id.clone(),
+                reason,
+            }),
         }
     }
-    if problems.is_empty() { Ok(scripts) } else { Err(problems) }
+    if problems.is_empty() {
+        Ok(scripts)
+    } else {
+        Err(problems)
+    }
 }
 
 fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -> Vec<PedAlloc> {
@@ -218,13 +266,23 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
     let shares: Vec<f64> = p.archetype_mix.values().copied().collect();
     let archetypes = quota::allocate(n, &shares, &mut seeds::rng_for(seed, &tag("archetypes")));
     let sm = &p.speed_profiles.mix;
-    let speed = quota::allocate(n, &[sm.cautious, sm.normal, sm.rushed, sm.distracted], &mut seeds::rng_for(seed, &tag("speed")));
+    let speed = quota::allocate(
+        n,
+        &[sm.cautious, sm.normal, sm.rushed, sm.distracted],
+        &mut seeds::rng_for(seed, &tag("speed")),
+    );
 
     // Crossers: layer 1 allocates what the target needs beyond the baseline; the archetype's crossing
     // propensity weights who is chosen. The rest cross at the baseline rate, as CARLA's walkers do.
     let weights: Vec<f64> = archetypes
         .iter()
-        .map(|&a| p.archetypes.get(p.archetype_mix.keys().nth(a).map_or("", String::as_str)).map_or(0.5, |x| x.crossing_probability.max(1e-3)))
+        .map(|&a| {
+            p.archetype_mix
+                .keys()
+                .nth(a)
+                .and_then(|name| p.archetypes.get(name))
+                .map_or(0.5, |x| x.crossing_probability.max(1e-3))
+        })
         .collect();
     let mut rng = seeds::rng_for(seed, &tag("crossers"));
     let r = allocated_crosser_ratio(spec);
@@ -236,41 +294,111 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
     let rest_weights: Vec<f64> = rest.iter().map(|&i| weights[i]).collect();
     let baseline_mask = quota::weighted_choice(baseline, &rest_weights, &mut rng);
 
-    let crossers: Vec<usize> = (0..n).filter(|&i| allocated_mask[i]).collect();
-    let mix = &c.layers.behaviour_mix;
-    let behaviours: Vec<Behaviour> = if mix.enabled {
-        let kinds = [Behaviour::Normal, Behaviour::Sudden, Behaviour::Jaywalk];
-        quota::allocate(crossers.len(), &[mix.mix.normal, mix.mix.sudden, mix.mix.jaywalk], &mut seeds::rng_for(seed, &tag("behaviours")))
-            .into_iter()
-            .map(|k| kinds[k])
-            .collect()
-    } else {
-        vec![Behaviour::Normal; crossers.len()]
-    };
-    let l3 = &c.layers.midroad_jaywalkers;
-    let midroad = if l3.enabled {
-        let k = quota::largest_remainder(crossers.len(), &[l3.share_of_crossers, 1.0 - l3.share_of_crossers])[0];
-        quota::weighted_choice(k, &vec![1.0; crossers.len()], &mut seeds::rng_for(seed, &tag("midroad")))
-    } else {
-        vec![false; crossers.len()]
-    };
-
     let mut out: Vec<PedAlloc> = (0..n)
         .map(|i| PedAlloc {
             archetype: archetypes[i],
             speed_profile: SpeedProfile::ALL[speed[i]],
             source: CrosserSource::None,
             behaviour: Behaviour::None,
+            group: None,
         })
         .collect();
-    for (k, &i) in crossers.iter().enumerate() {
-        out[i].source = CrosserSource::Allocated;
-        out[i].behaviour = if midroad[k] { Behaviour::MidroadJaywalker } else { behaviours[k] };
-    }
     for (k, &i) in rest.iter().enumerate() {
         if baseline_mask[k] {
             out[i].source = CrosserSource::Baseline;
             out[i].behaviour = Behaviour::Normal;
+        }
+    }
+
+    // Layer 4: group units among each clip's allocated crossers. A group starts at a crosser with probability
+    // q, chosen so that the expected share of grouped crossers is the spec's group probability.
+    let g = &c.layers.groups;
+    let mut group_rng = seeds::rng_for(seed, &tag("groups"));
+    let triple_share = g.size_mix.triples / (g.size_mix.pairs + g.size_mix.triples).max(1e-12);
+    let mean_size = 2.0 + triple_share;
+    let f = g.probability.clamp(0.0, 1.0);
+    let q = if g.enabled {
+        (f / (mean_size - f * (mean_size - 1.0))).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut units: Vec<Vec<usize>> = Vec::new();
+    let mut first = 0;
+    for clip in basics {
+        let crossers: Vec<usize> = (first..first + clip.pedestrians)
+            .filter(|&i| allocated_mask[i])
+            .collect();
+        first += clip.pedestrians;
+        let mut k = 0;
+        while k < crossers.len() {
+            let left = crossers.len() - k;
+            let size = if left >= 2 && group_rng.random_bool(q) {
+                if left >= 3 && group_rng.random_bool(triple_share.clamp(0.0, 1.0)) {
+                    3
+                } else {
+                    2
+                }
+            } else {
+                1
+            };
+            units.push(crossers[k..k + size].to_vec());
+            k += size;
+        }
+    }
+
+    // Behaviours with exact quotas over allocated crossers: layer 3's mid-road share, then layer 2's mix. A
+    // group shares one behaviour: groups take the behaviour with the most room left, singles fill the rest.
+    let total: usize = units.iter().map(Vec::len).sum();
+    let l3 = &c.layers.midroad_jaywalkers;
+    let midroad = if l3.enabled {
+        quota::largest_remainder(total, &[l3.share_of_crossers, 1.0 - l3.share_of_crossers])[0]
+    } else {
+        0
+    };
+    let mix = &c.layers.behaviour_mix;
+    let mix_shares = if mix.enabled {
+        [mix.mix.normal, mix.mix.sudden, mix.mix.jaywalk]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let rest_counts = quota::largest_remainder(total - midroad, &mix_shares);
+    let kinds = [
+        Behaviour::MidroadJaywalker,
+        Behaviour::Normal,
+        Behaviour::Sudden,
+        Behaviour::Jaywalk,
+    ];
+    let mut remaining = [midroad, rest_counts[0], rest_counts[1], rest_counts[2]];
+    let mut behaviour_rng = seeds::rng_for(seed, &tag("behaviours"));
+    let (mut groups, mut singles): (Vec<Vec<usize>>, Vec<Vec<usize>>) = units.into_iter().partition(|u| u.len() > 1);
+    groups.sort_by_key(|u| std::cmp::Reverse(u.len()));
+    let mut assigned: Vec<(Vec<usize>, Behaviour)> = Vec::new();
+    for unit in groups {
+        let best = (0..kinds.len())
+            .filter(|&k| remaining[k] >= unit.len())
+            .max_by_key(|&k| (remaining[k], std::cmp::Reverse(k)));
+        match best {
+            Some(k) => {
+                remaining[k] -= unit.len();
+                assigned.push((unit, kinds[k]));
+            }
+            None => singles.extend(unit.into_iter().map(|i| vec![i])),
+        }
+    }
+    let mut pool: Vec<Behaviour> = kinds
+        .iter()
+        .zip(remaining)
+        .flat_map(|(k, n)| std::iter::repeat_n(*k, n))
+        .collect();
+    pool.shuffle(&mut behaviour_rng);
+    assigned.extend(singles.into_iter().zip(pool));
+    for (unit, behaviour) in assigned {
+        for &i in &unit {
+            out[i].source = CrosserSource::Allocated;
+            out[i].behaviour = behaviour;
+            if unit.len() > 1 {
+                out[i].group = Some(unit[0]);
+            }
         }
     }
     out
@@ -279,12 +407,14 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
 /// The ego's planned cruise speed upper bound, for route length checks, m/s.
 const MAX_URBAN_SPEED_MPS: f64 = 14.0;
 
+#[allow(clippy::too_many_arguments)]
 fn plan_clip(
     spec: &Spec,
     stratum: &Stratum,
     town: &TownContext,
     basics: &ClipBasics,
     peds: &[PedAlloc],
+    first_ped: usize,
     vehicle_profiles: &[usize],
     archetype_names: &[&String],
 ) -> Result<ClipScript, String> {
@@ -297,17 +427,29 @@ fn plan_clip(
     let needed_m = ahead_max + MAX_URBAN_SPEED_MPS * duration_s + spec.traffic.ego.route_margin_m;
 
     // The ego route, with room ahead for every pedestrian.
-    let route = net.random_route(&mut rng, needed_m).ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+    let route = net
+        .random_route(&mut rng, needed_m)
+        .ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
     let ego_spec = &spec.traffic.ego;
     let ego = EgoScript {
         route: route_script(&route, 0.0),
-        speed_below_limit_pct: rng.random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
+        speed_below_limit_pct: rng
+            .random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
         min_gap_m: ego_spec.min_gap_m,
         brake_ahead_m: ego_spec.brake_ahead_m,
         brake_lateral_m: ego_spec.brake_lateral_m,
     };
 
-    let pedestrians = plan_pedestrians(spec, net, &route, peds, archetype_names, duration_s, &mut rng)?;
+    let pedestrians = plan_pedestrians(
+        spec,
+        net,
+        &route,
+        peds,
+        first_ped,
+        archetype_names,
+        duration_s,
+        &mut rng,
+    )?;
     let vehicles = plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng)?;
 
     Ok(ClipScript {
@@ -316,7 +458,12 @@ fn plan_clip(
         town: stratum.town.name().to_owned(),
         weather: stratum.weather.name().to_owned(),
         weather_params: stratum.weather.params(),
-        split: spec.dataset.splits.get(stratum.town.name()).copied().unwrap_or(spec.dataset.default_split),
+        split: spec
+            .dataset
+            .splits
+            .get(stratum.town.name())
+            .copied()
+            .unwrap_or(spec.dataset.default_split),
         fps,
         frame_count: basics.frame_count,
         ego,
@@ -333,7 +480,13 @@ fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
         }
     }
     let pose = route.pose_at(start_s_m);
-    RouteScript { lanes, length_m: route.length_m(), start_s_m, start: pose.pos, start_heading_rad: pose.heading_rad }
+    RouteScript {
+        lanes,
+        length_m: route.length_m(),
+        start_s_m,
+        start: pose.pos,
+        start_heading_rad: pose.heading_rad,
+    }
 }
 
 /// Minimum distance between two pedestrians' spawn points, metres.
@@ -347,6 +500,7 @@ fn plan_pedestrians(
     net: &RoadNetwork,
     route: &Route,
     peds: &[PedAlloc],
+    first_ped: usize,
     archetype_names: &[&String],
     duration_s: f64,
     rng: &mut ChaCha20Rng,
@@ -357,13 +511,24 @@ fn plan_pedestrians(
     let far_m = spec.annotations.visibility.max_distance_m.min(route.length_m() - 1.0);
     let mut scripts: Vec<PedestrianScript> = Vec::with_capacity(peds.len());
     let mut crosser_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
-    let groups = form_groups(spec, peds, rng);
+    // Group ids are numbered by leader, in pedestrian order.
+    let mut leaders: Vec<usize> = peds.iter().filter_map(|a| a.group).collect();
+    leaders.sort_unstable();
+    leaders.dedup();
 
     for (i, alloc) in peds.iter().enumerate() {
         let id = i as u32;
-        let name = archetype_names.get(alloc.archetype).map_or("casual_person", |s| s.as_str());
+        let name = archetype_names
+            .get(alloc.archetype)
+            .map_or("casual_person", |s| s.as_str());
         let a = p.archetypes.get(name).cloned().unwrap_or_default();
-        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| if r.max() > r.min() { rng.random_range(r.min()..=r.max()) } else { r.min() };
+        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| {
+            if r.max() > r.min() {
+                rng.random_range(r.min()..=r.max())
+            } else {
+                r.min()
+            }
+        };
         let base_speed_mps = draw(rng, a.speed_mps);
         let hesitation_s = draw(rng, a.hesitation_s);
         let ttc_threshold_s = draw(rng, a.ttc_threshold_s);
@@ -376,27 +541,60 @@ fn plan_pedestrians(
         } else {
             None
         };
-        let group = groups[i];
-        let role = if alloc.source == CrosserSource::None { Role::NonCrosser } else { Role::Crosser };
+        let group = alloc.group.map(|leader| GroupRef {
+            group_id: leaders.iter().position(|&l| l == leader).unwrap_or(0) as u32,
+            leader: (leader - first_ped) as u32,
+        });
+        let role = if alloc.source == CrosserSource::None {
+            Role::NonCrosser
+        } else {
+            Role::Crosser
+        };
 
         // Placement.
-        let leader = group.filter(|g| g.leader != id).and_then(|g| scripts.get(g.leader as usize));
+        let leader = group
+            .filter(|g| g.leader != id)
+            .and_then(|g| scripts.get(g.leader as usize));
         let placed = if let Some(leader) = leader {
             place_follower(net, leader, &scripts, rng)
         } else {
             match (role, alloc.behaviour) {
-                (Role::Crosser, Behaviour::MidroadJaywalker) => place_midroad(net, route, spawn_ahead, c.layers.midroad_jaywalkers.lateral_offset_m, &scripts, rng),
+                (Role::Crosser, Behaviour::MidroadJaywalker) => place_midroad(
+                    net,
+                    route,
+                    spawn_ahead,
+                    c.layers.midroad_jaywalkers.lateral_offset_m,
+                    &scripts,
+                    rng,
+                ),
                 (Role::Crosser, _) => {
-                    let (lo, hi) = if alloc.source == CrosserSource::Allocated { (spawn_ahead.min(), spawn_ahead.max()) } else { (0.0, far_m) };
+                    let (lo, hi) = if alloc.source == CrosserSource::Allocated {
+                        (spawn_ahead.min(), spawn_ahead.max())
+                    } else {
+                        (0.0, far_m)
+                    };
                     let placed = place_crosser(net, route, lo, hi.min(far_m), crosser_side, &scripts, rng);
-                    crosser_side = if crosser_side == Side::Left { Side::Right } else { Side::Left };
+                    crosser_side = if crosser_side == Side::Left {
+                        Side::Right
+                    } else {
+                        Side::Left
+                    };
                     placed
                 }
                 (Role::NonCrosser, _) => place_sidewalk(net, route, 0.0, far_m, &scripts, rng),
             }
         };
         let (spawn, heading, ahead, crossing, place) = placed.ok_or_else(|| {
-            format!("cannot place pedestrian {id} ({}, {}) on a {} near the ego's route", name, alloc.behaviour.name(), if alloc.behaviour == Behaviour::MidroadJaywalker { "driving lane" } else { "sidewalk" })
+            format!(
+                "cannot place pedestrian {id} ({}, {}) on a {} near the ego's route",
+                name,
+                alloc.behaviour.name(),
+                if alloc.behaviour == Behaviour::MidroadJaywalker {
+                    "driving lane"
+                } else {
+                    "sidewalk"
+                }
+            )
         })?;
         let crossing = if role == Role::Crosser { crossing } else { None };
         if role == Role::Crosser && crossing.is_none() {
@@ -434,114 +632,168 @@ fn far_from_others(p: DVec2, scripts: &[PedestrianScript]) -> bool {
     scripts.iter().all(|s| s.spawn.distance(p) >= PED_SPACING_M)
 }
 
-fn crossing_script(c: &crate::world::routes::Crossing) -> CrossingScript {
-    CrossingScript { near_curb: c.near_curb, far_curb: c.far_curb, end: c.end, direction: c.direction, carriageway_width_m: c.carriageway_width_m }
+fn crossing_script(c: &crate::world::Crossing) -> CrossingScript {
+    CrossingScript {
+        near_curb: c.near_curb,
+        far_curb: c.far_curb,
+        end: c.end,
+        direction: c.direction,
+        carriageway_width_m: c.carriageway_width_m,
+    }
 }
 
 fn is_lane(net: &RoadNetwork, p: DVec2, kind: LaneType) -> bool {
     net.lane_at(p).is_some_and(|h| h.lane_type == kind)
 }
 
-fn place_crosser(net: &RoadNetwork, route: &Route, lo: f64, hi: f64, side: Side, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+fn place_crosser(
+    net: &RoadNetwork,
+    route: &Route,
+    lo: f64,
+    hi: f64,
+    side: Side,
+    scripts: &[PedestrianScript],
+    rng: &mut ChaCha20Rng,
+) -> Option<Placement> {
     for attempt in 0..PLACEMENT_ATTEMPTS {
         let s = if hi > lo { rng.random_range(lo..hi) } else { lo };
-        let side = if attempt % 2 == 0 { side } else if side == Side::Left { Side::Right } else { Side::Left };
-        let Some(sample) = net.sidewalk_beside(route, s, side) else { continue };
+        let side = if attempt % 2 == 0 {
+            side
+        } else if side == Side::Left {
+            Side::Right
+        } else {
+            Side::Left
+        };
+        let Some(sample) = net.sidewalk_beside(route, s, side) else {
+            continue;
+        };
         if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
             continue;
         }
-        let Some(crossing) = net.crossing_at(sample.pos) else { continue };
+        let Some(crossing) = net.crossing_at(sample.pos) else {
+            continue;
+        };
         if crossing.carriageway_width_m < 2.0 {
             continue;
         }
         let heading = crossing.direction.to_angle();
-        return Some((sample.pos, heading, s, Some(crossing_script(&crossing)), SpawnPlace::Sidewalk));
+        return Some((
+            sample.pos,
+            heading,
+            s,
+            Some(crossing_script(&crossing)),
+            SpawnPlace::Sidewalk,
+        ));
     }
     None
 }
 
-fn place_sidewalk(net: &RoadNetwork, route: &Route, lo: f64, hi: f64, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+fn place_sidewalk(
+    net: &RoadNetwork,
+    route: &Route,
+    lo: f64,
+    hi: f64,
+    scripts: &[PedestrianScript],
+    rng: &mut ChaCha20Rng,
+) -> Option<Placement> {
     for _ in 0..PLACEMENT_ATTEMPTS {
         let s = if hi > lo { rng.random_range(lo..hi) } else { lo };
         let side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
-        let Some(sample) = net.sidewalk_beside(route, s, side) else { continue };
+        let Some(sample) = net.sidewalk_beside(route, s, side) else {
+            continue;
+        };
         if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
             continue;
         }
         let along = route.pose_at(s).heading_rad;
-        let heading = if rng.random_bool(0.5) { along } else { wrap_angle(along + PI) };
+        let heading = if rng.random_bool(0.5) {
+            along
+        } else {
+            wrap_angle(along + PI)
+        };
         let crossing = net.crossing_at(sample.pos).map(|c| crossing_script(&c));
         return Some((sample.pos, heading, s, crossing, SpawnPlace::Sidewalk));
     }
     None
 }
 
-fn place_midroad(net: &RoadNetwork, route: &Route, ahead: crate::dsl::types::Range, lateral_m: f64, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+fn place_midroad(
+    net: &RoadNetwork,
+    route: &Route,
+    ahead: crate::dsl::types::Range,
+    lateral_m: f64,
+    scripts: &[PedestrianScript],
+    rng: &mut ChaCha20Rng,
+) -> Option<Placement> {
     for _ in 0..PLACEMENT_ATTEMPTS {
         let s = rng.random_range(ahead.min()..=ahead.max()).min(route.length_m() - 1.0);
         let origin_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
-        let Some(sample) = net.sidewalk_beside(route, s, origin_side) else { continue };
-        let Some(crossing) = net.crossing_at(sample.pos) else { continue };
+        let Some(sample) = net.sidewalk_beside(route, s, origin_side) else {
+            continue;
+        };
+        let Some(crossing) = net.crossing_at(sample.pos) else {
+            continue;
+        };
         if crossing.carriageway_width_m < 2.0 {
             continue;
         }
         // Spawn in a driving lane at the ego lane's centre ± the lateral offset, on the crossing line.
         let pose = route.pose_at(s);
         let target = pose.pos + crossing.direction * rng.random_range(-lateral_m..=lateral_m);
-        let t = (target - crossing.near_curb).dot(crossing.direction).clamp(0.5, crossing.carriageway_width_m - 0.5);
+        let t = (target - crossing.near_curb)
+            .dot(crossing.direction)
+            .clamp(0.5, crossing.carriageway_width_m - 0.5);
         let spawn = crossing.near_curb + crossing.direction * t;
         if !is_lane(net, spawn, LaneType::Driving) || !far_from_others(spawn, scripts) {
             continue;
         }
-        return Some((spawn, crossing.direction.to_angle(), s, Some(crossing_script(&crossing)), SpawnPlace::DrivingLane));
+        return Some((
+            spawn,
+            crossing.direction.to_angle(),
+            s,
+            Some(crossing_script(&crossing)),
+            SpawnPlace::DrivingLane,
+        ));
     }
     None
 }
 
-fn place_follower(net: &RoadNetwork, leader: &PedestrianScript, scripts: &[PedestrianScript], rng: &mut ChaCha20Rng) -> Option<Placement> {
+fn place_follower(
+    net: &RoadNetwork,
+    leader: &PedestrianScript,
+    scripts: &[PedestrianScript],
+    rng: &mut ChaCha20Rng,
+) -> Option<Placement> {
     let along = DVec2::from_angle(leader.spawn_heading_rad).perp();
     for _ in 0..PLACEMENT_ATTEMPTS {
         let offset = rng.random_range(1.0..2.5) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
         let back = rng.random_range(-0.6..0.3);
         let p = leader.spawn + along * offset + DVec2::from_angle(leader.spawn_heading_rad) * back;
-        let kind = if leader.spawn_place == SpawnPlace::DrivingLane { LaneType::Driving } else { LaneType::Sidewalk };
+        let kind = if leader.spawn_place == SpawnPlace::DrivingLane {
+            LaneType::Driving
+        } else {
+            LaneType::Sidewalk
+        };
         if !is_lane(net, p, kind) || !far_from_others(p, scripts) {
             continue;
         }
-        let crossing = if kind == LaneType::Sidewalk { net.crossing_at(p).map(|c| crossing_script(&c)) } else { leader.crossing.clone() };
+        let crossing = if kind == LaneType::Sidewalk {
+            net.crossing_at(p).map(|c| crossing_script(&c))
+        } else {
+            leader.crossing.clone()
+        };
         if crossing.is_none() {
             continue;
         }
-        return Some((p, leader.spawn_heading_rad, leader.ahead_of_ego_m, crossing, leader.spawn_place));
+        return Some((
+            p,
+            leader.spawn_heading_rad,
+            leader.ahead_of_ego_m,
+            crossing,
+            leader.spawn_place,
+        ));
     }
     None
-}
-
-/// Layer 4: groups of 2–3 among a clip's allocated crossers of the same behaviour, the first member leading.
-fn form_groups(spec: &Spec, peds: &[PedAlloc], rng: &mut ChaCha20Rng) -> Vec<Option<GroupRef>> {
-    let mut out = vec![None; peds.len()];
-    let g = &spec.crossing.layers.groups;
-    if !g.enabled {
-        return out;
-    }
-    let mut next_group = 0u32;
-    for behaviour in [Behaviour::Normal, Behaviour::Sudden, Behaviour::Jaywalk, Behaviour::MidroadJaywalker] {
-        let members: Vec<usize> = (0..peds.len())
-            .filter(|&i| peds[i].source == CrosserSource::Allocated && peds[i].behaviour == behaviour && rng.random_bool(g.probability.clamp(0.0, 1.0)))
-            .collect();
-        let mut k = 0;
-        while members.len() - k >= 2 {
-            let triple = members.len() - k >= 3 && rng.random_bool((g.size_mix.triples / (g.size_mix.pairs + g.size_mix.triples).max(1e-12)).clamp(0.0, 1.0));
-            let size = if triple { 3 } else { 2 };
-            let leader = members[k] as u32;
-            for &m in &members[k..k + size] {
-                out[m] = Some(GroupRef { group_id: next_group, leader });
-            }
-            next_group += 1;
-            k += size;
-        }
-    }
-    out
 }
 
 /// Minimum distance between vehicle spawns, metres.
@@ -564,7 +816,11 @@ fn plan_vehicles(
         .iter()
         .filter(|sp| {
             let d = sp.pos.distance(ego_start);
-            d > VEHICLE_SPACING_M && d < 150.0 && peds.iter().all(|p| p.spawn_place != SpawnPlace::DrivingLane || p.spawn.distance(sp.pos) > 15.0)
+            d > VEHICLE_SPACING_M
+                && d < 150.0
+                && peds
+                    .iter()
+                    .all(|p| p.spawn_place != SpawnPlace::DrivingLane || p.spawn.distance(sp.pos) > 15.0)
         })
         .collect();
     let mut out: Vec<VehicleScript> = Vec::with_capacity(profiles.len());
@@ -576,7 +832,13 @@ fn plan_vehicles(
             DrivingProfileKind::Normal => &spec.traffic.profiles.normal,
             DrivingProfileKind::Cautious => &spec.traffic.profiles.cautious,
         };
-        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| if r.max() > r.min() { rng.random_range(r.min()..=r.max()) } else { r.min() };
+        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| {
+            if r.max() > r.min() {
+                rng.random_range(r.min()..=r.max())
+            } else {
+                r.min()
+            }
+        };
         let mut placed = None;
         for _ in 0..PLACEMENT_ATTEMPTS {
             if candidates.is_empty() {
@@ -586,13 +848,29 @@ fn plan_vehicles(
             if taken.iter().any(|t| t.distance(sp.pos) < VEHICLE_SPACING_M) {
                 continue;
             }
-            let Some(route) = net.route_from(sp.lane, needed_m, rng) else { continue };
-            let start_s = route.points.iter().min_by(|a, b| a.pos.distance_squared(sp.pos).total_cmp(&b.pos.distance_squared(sp.pos))).map_or(0.0, |q| q.s_m);
-            placed = Some((sp.pos, route_script(&route, start_s)));
+            let Some(route) = net.route_from(sp.lane, needed_m, rng) else {
+                continue;
+            };
+            let start_s = route
+                .points
+                .iter()
+                .min_by(|a, b| {
+                    a.pos
+                        .distance_squared(sp.pos)
+                        .total_cmp(&b.pos.distance_squared(sp.pos))
+                })
+                .map_or(0.0, |q| q.s_m);
+            let script = route_script(&route, start_s);
+            if taken.iter().any(|t| t.distance(script.start) < VEHICLE_SPACING_M) {
+                continue;
+            }
+            placed = Some((script.start, script));
             break;
         }
         let Some((pos, route)) = placed else {
-            return Err(format!("cannot place vehicle {i} on a free driving lane within 150 m of the ego"));
+            return Err(format!(
+                "cannot place vehicle {i} on a free driving lane within 150 m of the ego"
+            ));
         };
         taken.push(pos);
         out.push(VehicleScript {

@@ -2,8 +2,8 @@
 //! by category order), then spread them in a seeded random order. Planned proportions equal the targets up to
 //! one unit of rounding, however small the stratum.
 
-use rand::Rng;
 use rand::seq::SliceRandom;
+use rand::{Rng, RngExt};
 
 /// Counts per category: `floor(n × share)` plus one for the largest remainders until they sum to `n`.
 /// Shares need not be normalised; categories with share 0 get 0. Returns all zeros when every share is 0.
@@ -12,12 +12,25 @@ pub fn largest_remainder(n: usize, shares: &[f64]) -> Vec<usize> {
     if total <= 0.0 || n == 0 {
         return vec![0; shares.len()];
     }
-    let exact: Vec<f64> = shares.iter().map(|s| if s.is_finite() && *s > 0.0 { s / total * n as f64 } else { 0.0 }).collect();
+    let exact: Vec<f64> = shares
+        .iter()
+        .map(|s| {
+            if s.is_finite() && *s > 0.0 {
+                s / total * n as f64
+            } else {
+                0.0
+            }
+        })
+        .collect();
     let mut counts: Vec<usize> = exact.iter().map(|x| x.floor() as usize).collect();
     let assigned: usize = counts.iter().sum();
     let mut order: Vec<usize> = (0..shares.len()).filter(|&i| exact[i] > 0.0).collect();
     // Largest remainder first; ties go to the earlier category, so the result is deterministic.
-    order.sort_by(|&a, &b| (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor())).then(a.cmp(&b)));
+    order.sort_by(|&a, &b| {
+        (exact[b] - exact[b].floor())
+            .total_cmp(&(exact[a] - exact[a].floor()))
+            .then(a.cmp(&b))
+    });
     for &i in order.iter().cycle().take(n.saturating_sub(assigned)) {
         counts[i] += 1;
     }
@@ -27,7 +40,11 @@ pub fn largest_remainder(n: usize, shares: &[f64]) -> Vec<usize> {
 /// `n` category indices with exact quotas, in a random order drawn from `rng`.
 pub fn allocate(n: usize, shares: &[f64], rng: &mut impl Rng) -> Vec<usize> {
     let counts = largest_remainder(n, shares);
-    let mut out: Vec<usize> = counts.iter().enumerate().flat_map(|(i, &c)| std::iter::repeat_n(i, c)).collect();
+    let mut out: Vec<usize> = counts
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &c)| std::iter::repeat_n(i, c))
+        .collect();
     out.shuffle(rng);
     out
 }
@@ -83,6 +100,12 @@ mod tests {
             heavy += usize::from(mask[0]);
         }
         assert!((1700..1900).contains(&heavy), "{heavy}");
-        assert_eq!(weighted_choice(2, &[0.0, 1.0, 0.0], &mut rng).iter().filter(|m| **m).count(), 2);
+        assert_eq!(
+            weighted_choice(2, &[0.0, 1.0, 0.0], &mut rng)
+                .iter()
+                .filter(|m| **m)
+                .count(),
+            2
+        );
     }
 }

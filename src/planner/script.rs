@@ -170,7 +170,13 @@ pub enum Behaviour {
 
 impl Behaviour {
     /// All behaviour types.
-    pub const ALL: [Behaviour; 5] = [Self::Normal, Self::Sudden, Self::Jaywalk, Self::MidroadJaywalker, Self::None];
+    pub const ALL: [Behaviour; 5] = [
+        Self::Normal,
+        Self::Sudden,
+        Self::Jaywalk,
+        Self::MidroadJaywalker,
+        Self::None,
+    ];
     /// The behaviour's name.
     pub fn name(self) -> &'static str {
         match self {

@@ -19,7 +19,9 @@ pub fn seed_bytes(dataset_seed: u64, identity: &str) -> [u8; 32] {
 /// A u64 seed for `identity` under `dataset_seed` (the clip seed recorded in scripts and tables).
 pub fn seed_u64(dataset_seed: u64, identity: &str) -> u64 {
     let bytes = seed_bytes(dataset_seed, identity);
-    u64::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3], bytes[4], bytes[5], bytes[6], bytes[7]])
+    u64::from_le_bytes([
+        bytes[0], bytes[1], bytes[2], bytes[3], bytes[4], bytes[5], bytes[6], bytes[7],
+    ])
 }
 
 /// The random stream of `identity` under `dataset_seed`.
