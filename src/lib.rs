@@ -3,5 +3,6 @@
 //! Pipeline: `dsl` (spec → validated, defaulted `Spec`) → `world` (road networks) → planner → executor.
 pub mod commands;
 pub mod dsl;
+pub mod exec;
 pub mod planner;
 pub mod world;

@@ -151,6 +151,7 @@ pub fn plan(
         seed: spec.dataset.seed,
         spec_hash: spec_hash.to_owned(),
         target_crossing_ratio: spec.crossing.target_ratio,
+        sim: SimParams::from_spec(spec),
         clips,
     })
 }

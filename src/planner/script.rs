@@ -7,7 +7,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::dsl::types::{Body, Split, WeatherParams};
+use crate::dsl::types::{Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Spec, Split, SpeedProfiles, WeatherParams};
 
 /// Version of the plan format.
 pub const PLAN_FORMAT_VERSION: u32 = 1;
@@ -27,8 +27,45 @@ pub struct Plan {
     pub spec_hash: String,
     /// Target sequence-level crossing ratio.
     pub target_crossing_ratio: f64,
+    /// Behaviour and traffic parameters shared by every clip.
+    pub sim: SimParams,
     /// The clips.
     pub clips: Vec<ClipScript>,
+}
+
+/// Behaviour and traffic parameters shared by every clip (from the spec), so that a plan file alone is
+/// enough to simulate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimParams {
+    /// Time-to-collision gap acceptance.
+    pub gap_acceptance: GapAcceptance,
+    /// In-road lookahead.
+    pub lookahead: Lookahead,
+    /// Mid-crossing retreat.
+    pub retreat: Retreat,
+    /// Patience expiry.
+    pub patience: Patience,
+    /// A potential crosser commits when the ego is this far away, metres.
+    pub decision_window_m: Range,
+    /// Intelligent Driver Model constants.
+    pub idm: Idm,
+    /// Situational speed profiles (multipliers, switching).
+    pub speed_profiles: SpeedProfiles,
+}
+
+impl SimParams {
+    /// The parameters of `spec`.
+    pub fn from_spec(spec: &Spec) -> Self {
+        SimParams {
+            gap_acceptance: spec.crossing.gap_acceptance.clone(),
+            lookahead: spec.crossing.lookahead.clone(),
+            retreat: spec.crossing.retreat.clone(),
+            patience: spec.crossing.patience.clone(),
+            decision_window_m: spec.crossing.decision_window_m,
+            idm: spec.traffic.idm.clone(),
+            speed_profiles: spec.pedestrians.speed_profiles.clone(),
+        }
+    }
 }
 
 /// One clip.

@@ -1,0 +1,194 @@
+//! The simulation's output: a per-frame trace of every agent and an event list. The dataset writer and the
+//! tests read it; the simulation is its only producer.
+//!
+//! Positions are world coordinates (right-handed, x east, y north, z up, metres); yaw is radians
+//! counter-clockwise from +x; frame `f` is at simulated time `f / fps` seconds.
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+use crate::world::LaneType;
+
+/// The paper's 12 behaviour states.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "SCREAMING_SNAKE_CASE")]
+pub enum PedState {
+    /// AI-controlled navigation along the sidewalk.
+    WalkingSidewalk,
+    /// Visual scanning (attention-driven).
+    LookingAround,
+    /// Assessing vehicle proximity (TTC).
+    CheckingTraffic,
+    /// Pausing at the road edge.
+    Hesitating,
+    /// Steady crossing at base speed.
+    CrossingRoad,
+    /// Abrupt entry without checking.
+    SuddenCrossing,
+    /// Mid-block crossing.
+    Jaywalking,
+    /// High-speed crossing when a vehicle approaches.
+    RunningAcross,
+    /// Stopped mid-road (lookahead conflict).
+    PausingMidCross,
+    /// Phone use / inattention.
+    DistractedBehavior,
+    /// Reached the opposite sidewalk.
+    FinishedCrossing,
+    /// Mid-crossing reversal.
+    Retreat,
+}
+
+impl PedState {
+    /// All states in the paper's order.
+    pub const ALL: [PedState; 12] = [
+        Self::WalkingSidewalk,
+        Self::LookingAround,
+        Self::CheckingTraffic,
+        Self::Hesitating,
+        Self::CrossingRoad,
+        Self::SuddenCrossing,
+        Self::Jaywalking,
+        Self::RunningAcross,
+        Self::PausingMidCross,
+        Self::DistractedBehavior,
+        Self::FinishedCrossing,
+        Self::Retreat,
+    ];
+
+    /// The state's name as written in tables (`WALKING_SIDEWALK`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::WalkingSidewalk => "WALKING_SIDEWALK",
+            Self::LookingAround => "LOOKING_AROUND",
+            Self::CheckingTraffic => "CHECKING_TRAFFIC",
+            Self::Hesitating => "HESITATING",
+            Self::CrossingRoad => "CROSSING_ROAD",
+            Self::SuddenCrossing => "SUDDEN_CROSSING",
+            Self::Jaywalking => "JAYWALKING",
+            Self::RunningAcross => "RUNNING_ACROSS",
+            Self::PausingMidCross => "PAUSING_MID_CROSS",
+            Self::DistractedBehavior => "DISTRACTED_BEHAVIOR",
+            Self::FinishedCrossing => "FINISHED_CROSSING",
+            Self::Retreat => "RETREAT",
+        }
+    }
+
+    /// Whether the state is crossing-type (the paper's label condition (i)).
+    pub fn is_crossing(self) -> bool {
+        matches!(self, Self::CrossingRoad | Self::SuddenCrossing | Self::Jaywalking | Self::RunningAcross | Self::PausingMidCross)
+    }
+}
+
+/// A vehicle (ego or traffic) in one frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct VehicleFrame {
+    /// Centre of the vehicle's ground footprint.
+    pub pos: DVec3,
+    /// Heading.
+    pub yaw_rad: f64,
+    /// Speed along the heading, m/s.
+    pub speed_mps: f64,
+    /// Longitudinal acceleration, m/s².
+    pub accel_mps2: f64,
+}
+
+/// A pedestrian in one frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PedFrame {
+    /// Ground point under the pedestrian's body centre.
+    pub pos: DVec3,
+    /// Body heading.
+    pub yaw_rad: f64,
+    /// Velocity in the ground plane, m/s.
+    pub velocity: DVec2,
+    /// Behaviour state.
+    pub state: PedState,
+    /// Lane type under the pedestrian (None off the road network).
+    pub lane_type: Option<LaneType>,
+    /// Head yaw relative to the body, radians (scanning and traffic checks turn the head).
+    pub head_yaw_rad: f64,
+    /// Gait phase in [0, 1): advances with distance walked.
+    pub gait_phase: f64,
+    /// Whether the pedestrian is using a phone.
+    pub on_phone: bool,
+}
+
+/// Something that happened in a clip.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Event {
+    /// A pedestrian changed state.
+    StateChange {
+        /// Frame of the change.
+        frame: u32,
+        /// Pedestrian id.
+        pedestrian: u32,
+        /// Previous state.
+        from: PedState,
+        /// New state.
+        to: PedState,
+    },
+    /// A pedestrian decided to cross (intention onset: gap accepted, sudden trigger, or injection).
+    CrossingDecision {
+        /// Frame of the decision.
+        frame: u32,
+        /// Pedestrian id.
+        pedestrian: u32,
+    },
+    /// An in-road conflict: a vehicle within the lookahead radius of a crossing pedestrian.
+    Conflict {
+        /// Frame.
+        frame: u32,
+        /// Pedestrian id.
+        pedestrian: u32,
+        /// Vehicle id (`u32::MAX` for the ego).
+        vehicle: u32,
+        /// Whether the conflict happened in the retreat window (the first part of the crossing).
+        in_retreat_window: bool,
+        /// Whether the once-per-conflict retreat draw said retreat.
+        retreated: bool,
+    },
+    /// A pedestrian's patience cap expired.
+    PatienceExpired {
+        /// Frame.
+        frame: u32,
+        /// Pedestrian id.
+        pedestrian: u32,
+        /// Whether it then crossed suddenly (otherwise it abandoned the attempt).
+        sudden_crossing: bool,
+    },
+    /// A vehicle touched a pedestrian or another vehicle (recorded, never hidden).
+    Contact {
+        /// Frame.
+        frame: u32,
+        /// Vehicle id (`u32::MAX` for the ego).
+        vehicle: u32,
+        /// Pedestrian id, if a pedestrian was touched.
+        pedestrian: Option<u32>,
+        /// Other vehicle id, if a vehicle was touched.
+        other_vehicle: Option<u32>,
+    },
+}
+
+/// Vehicle id used for the ego in events.
+pub const EGO_ID: u32 = u32::MAX;
+
+/// The trace of one simulated clip.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClipTrace {
+    /// Clip id.
+    pub clip_id: String,
+    /// Frames per second.
+    pub fps: u32,
+    /// Number of frames.
+    pub frame_count: u32,
+    /// The ego, per frame.
+    pub ego: Vec<VehicleFrame>,
+    /// Traffic vehicles, `[vehicle][frame]`.
+    pub vehicles: Vec<Vec<VehicleFrame>>,
+    /// Pedestrians, `[pedestrian][frame]`.
+    pub pedestrians: Vec<Vec<PedFrame>>,
+    /// Events in frame order.
+    pub events: Vec<Event>,
+}
