@@ -209,7 +209,13 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
     };
     let doc = Document::parse_with_options(xml, opts).map_err(|e| WorldError::XodrSyntax {
         path: path.into(),
-        line: e.pos().row,
+        // roxmltree reports the end of a truncated document at 1:1; the end is the last line.
+        line: match e {
+            roxmltree::Error::UnexpectedEndOfStream => {
+                1 + xml.bytes().filter(|&b| b == b'\n').count() as u32
+            }
+            _ => e.pos().row,
+        },
         message: e.to_string(),
     })?;
     let cx = Ctx { doc: &doc, path };
