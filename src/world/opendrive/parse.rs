@@ -214,6 +214,11 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
             roxmltree::Error::UnexpectedEndOfStream => {
                 1 + xml.bytes().filter(|&b| b == b'\n').count() as u32
             }
+            // DTDs are refused (entity expansion attacks); roxmltree gives no position for that.
+            roxmltree::Error::DtdDetected => {
+                let at = xml.find("<!DOCTYPE").unwrap_or(0);
+                1 + xml[..at].bytes().filter(|&b| b == b'\n').count() as u32
+            }
             _ => e.pos().row,
         },
         message: e.to_string(),
