@@ -94,7 +94,7 @@ impl ObstacleIndex {
         let bvh = self.bvh.as_ref()?;
         let d = to - from;
         let len = d.length();
-        if !(len > 1e-9) || !len.is_finite() {
+        if len.is_nan() || len <= 1e-9 || !len.is_finite() {
             return None;
         }
         let dir = d / len;

@@ -43,9 +43,9 @@ struct Canvas {
 impl Canvas {
     fn blend(&mut self, x: usize, y: usize, c: [u8; 3], alpha: f64) {
         let i = (y * self.w + x) * 3;
-        for k in 0..3 {
-            let old = self.px[i + k] as f64;
-            self.px[i + k] = (old + (c[k] as f64 - old) * alpha).round() as u8;
+        for (dst, &src) in self.px[i..i + 3].iter_mut().zip(c.iter()) {
+            let old = *dst as f64;
+            *dst = (old + (src as f64 - old) * alpha).round() as u8;
         }
     }
 

@@ -9,6 +9,9 @@ use glam::DVec2;
 use super::geometry::{Poly3At, eval_piecewise};
 use super::parse::{RawNetwork, RawRoad, RawSection};
 use super::{MAX_PIECES, MAX_WIDTH_M};
+/// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
+type Station = (DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>);
+
 use crate::world::{
     Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, Road, RoadNetwork, TownSource,
     TravelDirection, WorldError, index, obstacles, routes,
@@ -205,8 +208,7 @@ pub(crate) fn build_with(
             }
             let order = section_order(sec);
             // Per station: reference point, normal, z, per-lane borders.
-            let mut per_station: Vec<(DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>)> =
-                Vec::with_capacity(st.len());
+            let mut per_station: Vec<Station> = Vec::with_capacity(st.len());
             for &s in &st {
                 let (p, h) = ref_at(road, s);
                 borders_at(xml, road, sec, &order, s, path, &mut borders)?;
