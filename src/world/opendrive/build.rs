@@ -9,13 +9,13 @@ use glam::DVec2;
 use super::geometry::{Poly3At, eval_piecewise};
 use super::parse::{RawNetwork, RawRoad, RawSection};
 use super::{MAX_PIECES, MAX_WIDTH_M};
-/// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
-type Station = (DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>);
-
 use crate::world::{
     Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, Road, RoadNetwork, TownSource,
     TravelDirection, WorldError, index, obstacles, routes,
 };
+
+/// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
+type Station = (DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>);
 
 /// Default speed limit when a file gives none: 50 km/h.
 const DEFAULT_SPEED_MPS: f64 = 50.0 / 3.6;
