@@ -1,4 +1,8 @@
 //! The executor: simulates clip scripts and writes the dataset.
 //!
 //! - `trace` — the simulation's output (per-frame agent states and events).
+//! - `camera` — the ego's pinhole camera: mount, intrinsics, projection.
+//! - `body` — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
+pub mod body;
+pub mod camera;
 pub mod trace;

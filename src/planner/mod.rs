@@ -433,16 +433,31 @@ fn plan_clip(
     let mut last_error = String::new();
     let mut planned = None;
     for _ in 0..ROUTE_ATTEMPTS {
-        let route = net.random_route(&mut rng, needed_m).ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+        let route = net
+            .random_route(&mut rng, needed_m)
+            .ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
         let ego = EgoScript {
             route: route_script(&route, 0.0),
-            speed_below_limit_pct: rng.random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
+            speed_below_limit_pct: rng
+                .random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
             min_gap_m: ego_spec.min_gap_m,
             brake_ahead_m: ego_spec.brake_ahead_m,
             brake_lateral_m: ego_spec.brake_lateral_m,
         };
-        let placed = plan_pedestrians(spec, net, &route, peds, first_ped, archetype_names, duration_s, &mut rng)
-            .and_then(|pedestrians| plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng).map(|v| (pedestrians, v)));
+        let placed = plan_pedestrians(
+            spec,
+            net,
+            &route,
+            peds,
+            first_ped,
+            archetype_names,
+            duration_s,
+            &mut rng,
+        )
+        .and_then(|pedestrians| {
+            plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng)
+                .map(|v| (pedestrians, v))
+        });
         match placed {
             Ok((pedestrians, vehicles)) => {
                 planned = Some((ego, pedestrians, vehicles));
@@ -853,19 +868,18 @@ fn plan_vehicles(
             if taken.iter().any(|t| t.distance(sp.pos) < VEHICLE_SPACING_M) {
                 continue;
             }
-            let Some(route) = net.route_from(sp.lane, needed_m, rng) else {
+            // A lane walk, not a polyline: the executor builds the polyline (planning 10k clips stays fast).
+            let Some(lanes) = net.lane_walk(sp.lane, needed_m + sp.lane_s_m, rng) else {
                 continue;
             };
-            let start_s = route
-                .points
-                .iter()
-                .min_by(|a, b| {
-                    a.pos
-                        .distance_squared(sp.pos)
-                        .total_cmp(&b.pos.distance_squared(sp.pos))
-                })
-                .map_or(0.0, |q| q.s_m);
-            let script = route_script(&route, start_s);
+            let length_m = lanes.iter().map(|&l| net.lanes[l as usize].length_m).sum();
+            let script = RouteScript {
+                lanes,
+                length_m,
+                start_s_m: sp.lane_s_m,
+                start: sp.pos,
+                start_heading_rad: sp.heading_rad,
+            };
             if taken.iter().any(|t| t.distance(script.start) < VEHICLE_SPACING_M) {
                 continue;
             }

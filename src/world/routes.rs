@@ -224,6 +224,8 @@ pub struct SpawnPoint {
     pub pos: DVec2,
     pub heading_rad: f64,
     pub lane: u32,
+    /// Distance along the lane's centre line (in its direction of travel) from the lane's start.
+    pub lane_s_m: f64,
     pub speed_limit_mps: f64,
 }
 
@@ -486,16 +488,52 @@ impl RoadNetwork {
     /// A route of at least `min_length_m` from the start of driving lane `lane`, choosing randomly among
     /// successors (preferring lanes not yet on the route). None at a dead end.
     pub fn route_from(&self, lane: u32, min_length_m: f64, rng: &mut impl Rng) -> Option<Route> {
-        let mut points: Vec<RoutePoint> = Vec::new();
-        let mut visited: Vec<u32> = Vec::new();
+        // Lane lengths slightly exceed the polyline's length (joins are merged), hence the small margin.
+        let lanes = self.lane_walk(lane, min_length_m + 2.0 * JOIN_M, rng)?;
+        let route = self.route_through(&lanes)?;
+        (route.length_m() >= min_length_m).then_some(route)
+    }
+
+    /// The lanes of a random walk along the lane graph from driving lane `lane` whose lane lengths add up to
+    /// at least `min_length_m`, preferring successors not yet visited. Cheap: builds no polyline (the planner
+    /// stores walks; the executor turns them into routes with [`route_through`](Self::route_through)).
+    pub fn lane_walk(&self, lane: u32, min_length_m: f64, rng: &mut impl Rng) -> Option<Vec<u32>> {
+        let mut lanes: Vec<u32> = Vec::new();
         let mut cur = lane;
-        let mut s = 0.0;
+        let mut length = 0.0;
         for _ in 0..100_000 {
             let l = self.lanes.get(cur as usize)?;
             if l.lane_type != LaneType::Driving {
                 return None;
             }
-            let c = lane_centre_points(self, cur);
+            lanes.push(cur);
+            length += l.length_m;
+            if length >= min_length_m {
+                return Some(lanes);
+            }
+            let succ = self.lane_graph.successors(cur);
+            if succ.is_empty() {
+                return None;
+            }
+            let fresh = succ.iter().filter(|x| !lanes.contains(x)).count();
+            cur = if fresh == 0 {
+                succ[rng.random_range(0..succ.len())]
+            } else {
+                let k = rng.random_range(0..fresh);
+                *succ.iter().filter(|x| !lanes.contains(x)).nth(k)?
+            };
+        }
+        None
+    }
+
+    /// The route polyline along `lanes` (consecutive lanes should be successors), with cumulative arc length.
+    /// None if a lane index is out of range or the route has fewer than two points.
+    pub fn route_through(&self, lanes: &[u32]) -> Option<Route> {
+        let mut points: Vec<RoutePoint> = Vec::new();
+        let mut s = 0.0;
+        for &lane in lanes {
+            let l = self.lanes.get(lane as usize)?;
+            let c = lane_centre_points(self, lane);
             for (k, &(p, z)) in c.iter().enumerate() {
                 if let Some(last) = points.last() {
                     let d = (p - last.pos).length();
@@ -509,23 +547,12 @@ impl RoadNetwork {
                     heading_rad: 0.0,
                     s_m: s,
                     speed_limit_mps: l.speed_limit_mps,
-                    lane: cur,
+                    lane,
                     z_m: z,
                 });
             }
-            visited.push(cur);
-            if s >= min_length_m {
-                break;
-            }
-            let succ = self.lane_graph.successors(cur);
-            if succ.is_empty() {
-                return None;
-            }
-            let fresh: Vec<u32> = succ.iter().copied().filter(|x| !visited.contains(x)).collect();
-            let pool = if fresh.is_empty() { succ } else { &fresh[..] };
-            cur = pool[rng.random_range(0..pool.len())];
         }
-        if s < min_length_m || points.len() < 2 {
+        if points.len() < 2 {
             return None;
         }
         for i in 0..points.len() {
@@ -554,6 +581,7 @@ impl RoadNetwork {
                         pos: w[0].lerp(w[1], t),
                         heading_rad: heading(w[0], w[1]),
                         lane: i as u32,
+                        lane_s_m: next,
                         speed_limit_mps: l.speed_limit_mps,
                     });
                     next += spacing;
@@ -573,7 +601,9 @@ impl RoadNetwork {
 
     /// Like [`crossing_at`](Self::crossing_at) for a point at elevation `p.z` (on a bridge, say).
     pub fn crossing_at_3d(&self, p3: DVec3) -> Option<Crossing> {
-        const STEP: f64 = 0.2;
+        // Coarse steps with bisection at the curbs: lanes narrower than a step (curbs, borders) may be stepped
+        // over, which does not matter here; sidewalks and driving lanes are much wider.
+        const STEP: f64 = 0.4;
         let p = p3.truncate();
         let hit = if p3.z.is_nan() {
             self.lane_at(p)?
@@ -663,18 +693,35 @@ impl RoadNetwork {
         let (sn, cs) = pose.heading_rad.sin_cos();
         let left = DVec2::new(-sn, cs);
         let n = if side == Side::Left { left } else { -left };
+        // Step outwards to the first sidewalk, then bisect its near and far edges (a few `lane_at` calls
+        // instead of one per 10 cm: this is the planner's hottest query).
+        const STEP: f64 = 0.5;
+        let is_sw = |t: f64| self.class(pose.pos + n * t, pose.z_m) == Some(LaneType::Sidewalk);
+        let bisect = |mut inside: f64, mut outside: f64| {
+            for _ in 0..6 {
+                let mid = 0.5 * (inside + outside);
+                if is_sw(mid) {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            inside
+        };
         let mut t = 0.5;
-        while self.class(pose.pos + n * t, pose.z_m) != Some(LaneType::Sidewalk) {
-            t += 0.25;
+        while !is_sw(t) {
+            t += STEP;
             if t > 40.0 {
                 return None;
             }
         }
-        let t0 = t;
-        while self.class(pose.pos + n * (t + 0.1), pose.z_m) == Some(LaneType::Sidewalk) && t < t0 + 8.0 {
-            t += 0.1;
+        let t0 = if t > 0.5 { bisect(t, t - STEP) } else { t };
+        let mut t1 = t;
+        while is_sw(t1 + STEP) && t1 < t0 + 8.0 {
+            t1 += STEP;
         }
-        let mid = 0.5 * (t0 + t);
+        let t1 = bisect(t1, t1 + STEP);
+        let mid = 0.5 * (t0 + t1);
         Some(SidewalkSample {
             pos: pose.pos + n * mid,
             route_s_m: s_m,

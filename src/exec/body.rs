@@ -1,0 +1,249 @@
+//! Articulated pedestrian body: COCO-17 joints and a capsule silhouette, animated from the simulation trace
+//! (gait phase and speed for walking, running and standing; head yaw for scanning and traffic checks; a phone
+//! pose when distracted).
+//!
+//! Built in the body frame (x forward, y left, z up; origin on the ground under the body's centre) from
+//! anthropometric proportions of the body height, then placed in the world by the pedestrian's position and
+//! yaw. Allocation-free: everything is fixed-size arrays.
+
+use std::f64::consts::TAU;
+
+use glam::{DMat3, DVec3};
+
+use super::trace::PedFrame;
+use crate::dsl::types::Body;
+
+/// COCO-17 keypoint names, in COCO order.
+pub const COCO17: [&str; 17] = [
+    "nose",
+    "left_eye",
+    "right_eye",
+    "left_ear",
+    "right_ear",
+    "left_shoulder",
+    "right_shoulder",
+    "left_elbow",
+    "right_elbow",
+    "left_wrist",
+    "right_wrist",
+    "left_hip",
+    "right_hip",
+    "left_knee",
+    "right_knee",
+    "left_ankle",
+    "right_ankle",
+];
+
+/// Number of capsules in a body silhouette.
+pub const CAPSULES: usize = 14;
+
+/// A capsule: the set of points within `radius_m` of the segment `a`–`b`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    /// One end.
+    pub a: DVec3,
+    /// Other end.
+    pub b: DVec3,
+    /// Radius, metres.
+    pub radius_m: f64,
+}
+
+/// A posed body in world coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyPose {
+    /// COCO-17 joints.
+    pub joints: [DVec3; 17],
+    /// The silhouette: torso, head, limbs, feet.
+    pub capsules: [Capsule; CAPSULES],
+    /// Body height, metres.
+    pub height_m: f64,
+    /// Ground point under the body centre.
+    pub ground: DVec3,
+    /// Body yaw.
+    pub yaw_rad: f64,
+}
+
+impl BodyPose {
+    /// The 3D box around the silhouette, aligned with the body's yaw: its centre in the world and its extents
+    /// (length along the yaw, width, height), metres.
+    pub fn box3d(&self) -> (DVec3, DVec3) {
+        let to_body = DMat3::from_rotation_z(-self.yaw_rad);
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for c in &self.capsules {
+            for p in [c.a, c.b] {
+                let q = to_body * (p - self.ground);
+                lo = lo.min(q - DVec3::splat(c.radius_m));
+                hi = hi.max(q + DVec3::splat(c.radius_m));
+            }
+        }
+        (self.ground + DMat3::from_rotation_z(self.yaw_rad) * ((lo + hi) * 0.5), hi - lo)
+    }
+}
+
+/// Height of a pedestrian's main body and, for a parent with a child, the child's, metres. Drawn
+/// deterministically from the clip seed and the pedestrian id (adults 1.55–1.95 m, children 1.0–1.3 m).
+pub fn heights_m(body: Body, clip_seed: u64, pedestrian: u32) -> (f64, Option<f64>) {
+    let h = blake3::hash(&[clip_seed.to_le_bytes(), u64::from(pedestrian).to_le_bytes()].concat());
+    let b = h.as_bytes();
+    let u1 = f64::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0;
+    let u2 = f64::from(u16::from_le_bytes([b[2], b[3]])) / 65535.0;
+    let adult = 1.55 + 0.4 * u1;
+    let child = 1.0 + 0.3 * u2;
+    match body {
+        Body::Adult => (adult, None),
+        Body::Child => (child, None),
+        Body::AdultWithChild => (adult, Some(child)),
+    }
+}
+
+/// Where a parent's child walks, in the parent's body frame, metres (beside the parent, on its left).
+pub const CHILD_OFFSET_M: DVec3 = DVec3::new(0.0, 0.55, 0.0);
+
+/// Speed below which a pedestrian stands, m/s.
+const STAND_MPS: f64 = 0.15;
+/// Speed above which the gait is a run, m/s.
+const RUN_MPS: f64 = 2.4;
+
+/// Poses a body of height `height_m` for one trace frame; `offset_body` shifts it in the body frame (used for
+/// a parent's child).
+pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
+    let h = height_m;
+    let speed = frame.velocity.length();
+    let swing = if speed < STAND_MPS {
+        0.0
+    } else if speed > RUN_MPS {
+        0.75
+    } else {
+        0.3 + 0.2 * (speed / 1.4).min(1.5)
+    };
+    let phase = TAU * frame.gait_phase;
+    let theta = swing * phase.sin();
+    let knee = 0.6 * swing * (phase + 1.2).sin().max(0.0);
+
+    // Lower body: legs swing about the hips in the sagittal plane (x forward, z up).
+    let hip_z = 0.53 * h;
+    let thigh = 0.245 * h;
+    let shin = 0.246 * h;
+    let hip_y = 0.055 * h;
+    let leg = |side: f64, angle: f64, bend: f64| {
+        let hip = DVec3::new(0.0, side * hip_y, hip_z);
+        let knee_p = hip + DVec3::new(angle.sin(), 0.0, -angle.cos()) * thigh;
+        let shin_angle = angle - bend;
+        let ankle = knee_p + DVec3::new(shin_angle.sin(), 0.0, -shin_angle.cos()) * shin;
+        (hip, knee_p, ankle)
+    };
+    let (l_hip, l_knee, l_ankle) = leg(1.0, theta, knee);
+    let (r_hip, r_knee, r_ankle) = leg(-1.0, -theta, 0.6 * swing * (phase + 1.2 + std::f64::consts::PI).sin().max(0.0));
+
+    // Upper body: arms swing opposite to the legs; the right hand holds a phone in front of the chest.
+    let shoulder_z = 0.818 * h;
+    let shoulder_y = 0.11 * h;
+    let upper = 0.186 * h;
+    let fore = 0.146 * h;
+    let arm = |side: f64, angle: f64| {
+        let shoulder = DVec3::new(0.0, side * shoulder_y, shoulder_z);
+        let elbow = shoulder + DVec3::new(angle.sin(), 0.0, -angle.cos()) * upper;
+        let fore_angle = angle + 0.25;
+        let wrist = elbow + DVec3::new(fore_angle.sin(), 0.0, -fore_angle.cos()) * fore;
+        (shoulder, elbow, wrist)
+    };
+    let (l_shoulder, l_elbow, l_wrist) = arm(1.0, -0.8 * theta);
+    let (r_shoulder, r_elbow, mut r_wrist) = arm(-1.0, 0.8 * theta);
+    let mut head_pitch = 0.0;
+    if frame.on_phone {
+        r_wrist = DVec3::new(0.25 * h * 0.8, -0.02 * h, 0.72 * h);
+        head_pitch = 0.45;
+    }
+    let r_elbow = if frame.on_phone { DVec3::new(0.06 * h, -shoulder_y, 0.66 * h) } else { r_elbow };
+
+    // Head: turned by the head yaw about the neck, pitched down when reading a phone.
+    let neck = DVec3::new(0.0, 0.0, 0.87 * h);
+    let head_rot = DMat3::from_rotation_z(frame.head_yaw_rad) * DMat3::from_rotation_y(head_pitch);
+    let head_point = |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
+    let nose = head_point(0.06, 0.0, 0.92);
+    let l_eye = head_point(0.05, 0.018, 0.936);
+    let r_eye = head_point(0.05, -0.018, 0.936);
+    let l_ear = head_point(-0.005, 0.045, 0.93);
+    let r_ear = head_point(-0.005, -0.045, 0.93);
+    let head_centre = head_point(0.0, 0.0, 0.93);
+
+    let local = [
+        nose, l_eye, r_eye, l_ear, r_ear, l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist, l_hip, r_hip, l_knee, r_knee,
+        l_ankle, r_ankle,
+    ];
+    let rot = DMat3::from_rotation_z(frame.yaw_rad);
+    let to_world = |p: DVec3| frame.pos + rot * (p + offset_body);
+    let joints = local.map(to_world);
+    let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
+    let pelvis = DVec3::new(0.0, 0.0, hip_z);
+    let chest = DVec3::new(0.0, 0.0, 0.78 * h);
+    let cap = |a: DVec3, b: DVec3, r: f64| Capsule { a: to_world(a), b: to_world(b), radius_m: r * h };
+    let capsules = [
+        cap(pelvis, chest, 0.085),
+        cap(l_shoulder, r_shoulder, 0.04),
+        cap(head_centre, head_centre, 0.07),
+        cap(l_shoulder, l_elbow, 0.03),
+        cap(r_shoulder, r_elbow, 0.03),
+        cap(l_elbow, l_wrist, 0.025),
+        cap(r_elbow, r_wrist, 0.025),
+        cap(l_hip, l_knee, 0.045),
+        cap(r_hip, r_knee, 0.045),
+        cap(l_knee, l_ankle, 0.035),
+        cap(r_knee, r_ankle, 0.035),
+        cap(l_ankle, toe(l_ankle), 0.022),
+        cap(r_ankle, toe(r_ankle), 0.022),
+        cap(neck, head_centre, 0.035),
+    ];
+    BodyPose { joints, capsules, height_m, ground: to_world(DVec3::ZERO), yaw_rad: frame.yaw_rad }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exec::trace::PedState;
+    use glam::DVec2;
+
+    fn frame(speed: f64, phase: f64) -> PedFrame {
+        PedFrame {
+            pos: DVec3::new(5.0, 2.0, 0.0),
+            yaw_rad: 0.3,
+            velocity: DVec2::from_angle(0.3) * speed,
+            state: PedState::WalkingSidewalk,
+            lane_type: None,
+            head_yaw_rad: 0.0,
+            gait_phase: phase,
+            on_phone: false,
+        }
+    }
+
+    #[test]
+    fn standing_body_has_plausible_proportions() {
+        let p = pose(&frame(0.0, 0.0), 1.75, DVec3::ZERO);
+        let z = |i: usize| p.joints[i].z;
+        assert!(z(0) > z(5) && z(5) > z(11) && z(11) > z(13) && z(13) > z(15), "nose > shoulder > hip > knee > ankle");
+        assert!((z(15) - 0.039 * 1.75).abs() < 0.02, "ankle near the ground: {}", z(15));
+        let ext = p.box3d().1;
+        assert!((ext.z - 1.75).abs() < 0.05 && ext.y > 0.35 && ext.y < 0.7, "{ext}");
+        // Left joints are on the body's left (yaw 0.3: left is +y rotated).
+        let left = DVec2::from_angle(0.3).perp();
+        assert!((p.joints[5] - p.joints[6]).truncate().dot(left) > 0.0);
+    }
+
+    #[test]
+    fn walking_swings_the_legs_in_opposition() {
+        let p = pose(&frame(1.4, 0.25), 1.75, DVec3::ZERO);
+        let fwd = DVec2::from_angle(0.3);
+        let l = (p.joints[15] - p.joints[11]).truncate().dot(fwd);
+        let r = (p.joints[16] - p.joints[12]).truncate().dot(fwd);
+        assert!(l > 0.1 && r < -0.1, "left ankle forward, right back: {l} {r}");
+    }
+
+    #[test]
+    fn heights_are_deterministic_and_in_range() {
+        let (a, c) = heights_m(Body::AdultWithChild, 7, 3);
+        assert_eq!((a, c), heights_m(Body::AdultWithChild, 7, 3));
+        assert!((1.55..=1.95).contains(&a) && c.is_some_and(|c| (1.0..=1.3).contains(&c)));
+        assert!(heights_m(Body::Child, 7, 3).1.is_none());
+    }
+}
