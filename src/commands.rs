@@ -198,7 +198,7 @@ pub fn plan(
     if let Some(path) = &args.emit {
         let mut json = serde_json::to_string_pretty(&plan).unwrap_or_default();
         json.push('\n');
-        if let Err(e) = write_atomically(path, json.as_bytes()) {
+        if let Err(e) = crate::fsutil::write_atomically(path, json.as_bytes()) {
             let _ = writeln!(err, "cannot write plan to {}: {e}", path.display());
             return exit::FAILURE;
         }
@@ -215,30 +215,6 @@ pub fn plan(
         Ok(()) => exit::OK,
         Err(_) => exit::FAILURE,
     }
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory and a rename, so a complete file
-/// or nothing appears at `path`.
-pub fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }
 
 /// `pedsynth town list`.

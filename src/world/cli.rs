@@ -61,13 +61,5 @@ pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<S
 }
 
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WorldError> {
-    let io = |source| WorldError::Io {
-        path: path.display().to_string(),
-        source,
-    };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    crate::fsutil::write_atomically(path, bytes).map_err(|source| WorldError::Io { path: path.display().to_string(), source })
 }

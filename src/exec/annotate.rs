@@ -1,0 +1,403 @@
+//! Annotation of a simulated clip: the visibility gate, tight 2D boxes of the projected body, COCO-17
+//! keypoints with visibility flags, occlusion by vehicles, buildings and other pedestrians, per-frame crossing
+//! labels with temporal smoothing, sequence labels, time-to-event and intention onset.
+//!
+//! Crossing label (the paper's definition): C = 1 in a frame when the pedestrian is in a crossing-type state
+//! *and* stands on a driving lane; C stays 1 for up to `crossing_label_smoothing_frames` frames after it
+//! leaves the driving lane while still in a crossing-type state (shoulders, parking strips, lane seams).
+//! Sequence label (JAAD/PIE): a crosser has C = 1 in at least one annotated frame. TTE counts the frames until
+//! the first C = 1 (0 at that frame, null after it and for pedestrians that never cross).
+
+use glam::{DVec2, DVec3};
+
+use super::body::{self, BodyPose, CHILD_OFFSET_M};
+use super::camera::{Camera, CameraPose};
+use super::trace::{ClipTrace, Event, PedFrame, PedState};
+use crate::dsl::types::Annotations;
+use crate::planner::ClipScript;
+use crate::world::{LaneType, RoadNetwork};
+
+/// Vehicle footprint length, metres.
+pub const VEHICLE_LENGTH_M: f64 = 4.6;
+/// Vehicle width, metres.
+pub const VEHICLE_WIDTH_M: f64 = 1.9;
+/// Vehicle height, metres.
+pub const VEHICLE_HEIGHT_M: f64 = 1.5;
+/// Radius of the cylinder standing in for another pedestrian when testing occlusion, as a share of height.
+const PED_OCCLUDER_RADIUS_PER_M: f64 = 0.14;
+
+/// Why a pedestrian-frame is not annotated (the first gate it fails).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rejections {
+    /// Farther than the gate's distance.
+    pub too_far: u64,
+    /// Behind the camera.
+    pub behind: u64,
+    /// Box smaller than the gate's minimum.
+    pub too_small: u64,
+    /// Box not inside the image.
+    pub outside_image: u64,
+    /// Occluded beyond the threshold.
+    pub occluded: u64,
+}
+
+/// One annotated pedestrian-frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnnotationRow {
+    /// Frame index.
+    pub frame: u32,
+    /// Pedestrian id.
+    pub pedestrian: u32,
+    /// Tight 2D box `[x_min, y_min, x_max, y_max]`, pixels.
+    pub bbox_px: [f32; 4],
+    /// Crossing label C.
+    pub crossing: bool,
+    /// Behaviour state.
+    pub state: PedState,
+    /// Ground distance from the ego vehicle, metres.
+    pub distance_m: f32,
+    /// Frames until the first C = 1 (None after it and for non-crossers).
+    pub tte_frames: Option<i32>,
+    /// Share of the body's sample points hidden by other objects.
+    pub occlusion: f32,
+    /// COCO-17 keypoints: `x, y, v` per joint (v: 0 outside the image, 1 occluded, 2 visible).
+    pub keypoints: [f32; 51],
+    /// The 17 joints in the world, `x, y, z` per joint, metres.
+    pub keypoints_3d: [f32; 51],
+    /// Ground position, metres.
+    pub pos_m: [f32; 3],
+    /// Body yaw, radians.
+    pub yaw_rad: f32,
+    /// Ground velocity, m/s.
+    pub velocity_mps: [f32; 2],
+    /// Lane type under the pedestrian.
+    pub lane_type: Option<LaneType>,
+    /// Centre of the 3D box, metres.
+    pub box3d_centre_m: [f32; 3],
+    /// Extents of the 3D box (length, width, height), metres.
+    pub box3d_size_m: [f32; 3],
+}
+
+/// Per-pedestrian results over the whole clip.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PedestrianLabels {
+    /// Sequence label: C = 1 in at least one annotated frame.
+    pub crosser: bool,
+    /// First frame with C = 1 (in any frame, annotated or not).
+    pub first_crossing_frame: Option<u32>,
+    /// Frame of the decision to cross (intention onset).
+    pub intention_frame: Option<u32>,
+    /// Number of annotated frames.
+    pub annotated_frames: u32,
+}
+
+/// The annotations of one clip.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClipAnnotations {
+    /// Annotated pedestrian-frames, ordered by (frame, pedestrian).
+    pub rows: Vec<AnnotationRow>,
+    /// Per pedestrian, indexed by id.
+    pub pedestrians: Vec<PedestrianLabels>,
+    /// Counts of pedestrian-frames that failed the visibility gate, by reason.
+    pub rejections: Rejections,
+}
+
+/// Per-frame crossing labels of one pedestrian: raw (state ∧ driving lane), then smoothed.
+pub fn crossing_labels(frames: &[PedFrame], smoothing_frames: u32) -> Vec<bool> {
+    let mut out = Vec::with_capacity(frames.len());
+    let mut since_on_road: Option<u32> = None;
+    for f in frames {
+        let raw = f.state.is_crossing() && f.lane_type == Some(LaneType::Driving);
+        let label = if raw {
+            since_on_road = Some(0);
+            true
+        } else if f.state.is_crossing() {
+            let held = since_on_road.is_some_and(|n| n < smoothing_frames);
+            since_on_road = since_on_road.map(|n| n + 1);
+            held
+        } else {
+            since_on_road = None;
+            false
+        };
+        out.push(label);
+    }
+    out
+}
+
+/// An obstacle for occlusion rays in one frame.
+#[derive(Clone, Copy, Debug)]
+enum Occluder {
+    /// A vehicle: ground centre, yaw.
+    Vehicle { centre: DVec3, yaw_rad: f64 },
+    /// A pedestrian body as an upright cylinder: ground point, radius, height, owner id.
+    Person { ground: DVec3, radius_m: f64, height_m: f64, owner: u32 },
+}
+
+/// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
+fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
+    match *occ {
+        Occluder::Vehicle { centre, yaw_rad } => {
+            let (s, c) = yaw_rad.sin_cos();
+            let rel = from - centre - DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5);
+            let o = DVec3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
+            let v = DVec3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
+            let half = DVec3::new(VEHICLE_LENGTH_M * 0.5, VEHICLE_WIDTH_M * 0.5, VEHICLE_HEIGHT_M * 0.5);
+            let (mut t0, mut t1): (f64, f64) = (1e-6, t_max);
+            for k in 0..3 {
+                if v[k].abs() < 1e-12 {
+                    if o[k].abs() > half[k] {
+                        return false;
+                    }
+                } else {
+                    let a = (-half[k] - o[k]) / v[k];
+                    let b = (half[k] - o[k]) / v[k];
+                    t0 = t0.max(a.min(b));
+                    t1 = t1.min(a.max(b));
+                    if t0 > t1 {
+                        return false;
+                    }
+                }
+            }
+            true
+        }
+        Occluder::Person { ground, radius_m, height_m, .. } => {
+            let o = (from - ground).truncate();
+            let v = d.truncate();
+            let a = v.length_squared();
+            if a < 1e-12 {
+                return false;
+            }
+            let b = o.dot(v);
+            let c = o.length_squared() - radius_m * radius_m;
+            let disc = b * b - a * c;
+            if disc < 0.0 {
+                return false;
+            }
+            let sq = disc.sqrt();
+            let (ta, tb) = ((-b - sq) / a, (-b + sq) / a);
+            let (lo, hi) = (ta.max(1e-6), tb.min(t_max));
+            if lo > hi {
+                return false;
+            }
+            // Inside the cylinder's height anywhere on [lo, hi] (z is linear in t).
+            let z0 = from.z + d.z * lo - ground.z;
+            let z1 = from.z + d.z * hi - ground.z;
+            z0.min(z1) <= height_m && z0.max(z1) >= 0.0
+        }
+    }
+}
+
+/// Whether the line of sight from the camera to `target` is blocked (the pedestrian `owner` never blocks
+/// itself).
+fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: DVec3, owner: u32) -> bool {
+    let d = target - camera;
+    let t_max = 1.0 - 0.05 / d.length().max(0.05);
+    for occ in occluders {
+        if let Occluder::Person { owner: o, .. } = occ
+            && *o == owner
+        {
+            continue;
+        }
+        if blocks(occ, camera, d, t_max) {
+            return true;
+        }
+    }
+    town.first_obstacle_hit(camera, camera + d * t_max).is_some()
+}
+
+/// The tight 2D box of a posed body: the extremes of every capsule's end spheres as seen by the camera.
+/// Returns None if any part of the body is behind the camera.
+pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for c in &pose.capsules {
+        for centre in [c.a, c.b] {
+            for offset in [cam.right, -cam.right, cam.down, -cam.down] {
+                let p = cam.project(centre + offset * c.radius_m);
+                if p.depth_m <= 0.05 {
+                    return None;
+                }
+                lo = lo.min(p.px);
+                hi = hi.max(p.px);
+            }
+        }
+    }
+    Some([lo.x, lo.y, hi.x, hi.y])
+}
+
+/// Annotates a simulated clip.
+pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotations, camera: &Camera, town: &RoadNetwork) -> ClipAnnotations {
+    let gate = &annotations.visibility;
+    let n_peds = trace.pedestrians.len();
+    let heights: Vec<(f64, Option<f64>)> = script
+        .pedestrians
+        .iter()
+        .map(|p| body::heights_m(p.body, script.seed, p.id))
+        .chain(std::iter::repeat((1.75, None)))
+        .take(n_peds)
+        .collect();
+    let labels: Vec<Vec<bool>> = trace.pedestrians.iter().map(|f| crossing_labels(f, annotations.crossing_label_smoothing_frames)).collect();
+    let first_crossing: Vec<Option<u32>> = labels.iter().map(|l| l.iter().position(|c| *c).map(|f| f as u32)).collect();
+    let mut out = ClipAnnotations { rows: Vec::new(), pedestrians: vec![PedestrianLabels::default(); n_peds], rejections: Rejections::default() };
+    for (i, p) in out.pedestrians.iter_mut().enumerate() {
+        p.first_crossing_frame = first_crossing[i];
+    }
+    for e in &trace.events {
+        if let Event::CrossingDecision { frame, pedestrian } = e
+            && let Some(p) = out.pedestrians.get_mut(*pedestrian as usize)
+            && p.intention_frame.is_none()
+        {
+            p.intention_frame = Some(*frame);
+        }
+    }
+
+    let mut occluders: Vec<Occluder> = Vec::with_capacity(trace.vehicles.len() + 2 * n_peds);
+    let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
+    for frame in 0..trace.frame_count as usize {
+        let Some(ego) = trace.ego.get(frame) else { break };
+        let cam = camera.at(ego.pos, ego.yaw_rad);
+        occluders.clear();
+        for v in &trace.vehicles {
+            if let Some(f) = v.get(frame) {
+                occluders.push(Occluder::Vehicle { centre: f.pos, yaw_rad: f.yaw_rad });
+            }
+        }
+        for (id, ped) in trace.pedestrians.iter().enumerate() {
+            let f = &ped[frame];
+            let (h, child) = heights[id];
+            occluders.push(Occluder::Person { ground: f.pos, radius_m: PED_OCCLUDER_RADIUS_PER_M * h, height_m: h, owner: id as u32 });
+            if let Some(hc) = child {
+                let offset = glam::DMat3::from_rotation_z(f.yaw_rad) * CHILD_OFFSET_M;
+                occluders.push(Occluder::Person { ground: f.pos + offset, radius_m: PED_OCCLUDER_RADIUS_PER_M * hc, height_m: hc, owner: u32::MAX });
+            }
+        }
+        for (id, ped) in trace.pedestrians.iter().enumerate() {
+            let f = &ped[frame];
+            let distance = (f.pos - ego.pos).truncate().length();
+            if distance > gate.max_distance_m {
+                out.rejections.too_far += 1;
+                continue;
+            }
+            if gate.require_in_front && (f.pos - cam.centre).dot(cam.forward) <= 0.0 {
+                out.rejections.behind += 1;
+                continue;
+            }
+            let pose = body::pose(f, heights[id].0, DVec3::ZERO);
+            let Some(bbox) = project_box(&pose, &cam) else {
+                out.rejections.behind += 1;
+                continue;
+            };
+            let (w, hgt) = (bbox[2] - bbox[0], bbox[3] - bbox[1]);
+            let min = if distance > gate.far_distance_m { gate.min_box_far_px } else { gate.min_box_px };
+            if w < min.min() || hgt < min.max() {
+                out.rejections.too_small += 1;
+                continue;
+            }
+            if gate.require_inside_image && (bbox[0] < 0.0 || bbox[1] < 0.0 || bbox[2] > width || bbox[3] > height) {
+                out.rejections.outside_image += 1;
+                continue;
+            }
+            // Keypoints and occlusion: the 17 joints plus torso and head samples.
+            let mut keypoints = [0f32; 51];
+            let mut keypoints_3d = [0f32; 51];
+            let (mut seen, mut hidden) = (0u32, 0u32);
+            for (k, joint) in pose.joints.iter().enumerate() {
+                let p = cam.project(*joint);
+                let inside = p.depth_m > 0.05 && cam.in_image(p.px);
+                let flag = if !inside {
+                    0.0
+                } else if occluded(town, &occluders, cam.centre, *joint, id as u32) {
+                    hidden += 1;
+                    1.0
+                } else {
+                    2.0
+                };
+                seen += u32::from(inside);
+                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
+                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
+            }
+            for sample in [pose.capsules[0].a, pose.capsules[0].b, pose.capsules[2].a, (pose.capsules[7].a + pose.capsules[7].b) * 0.5, (pose.capsules[8].a + pose.capsules[8].b) * 0.5] {
+                seen += 1;
+                hidden += u32::from(occluded(town, &occluders, cam.centre, sample, id as u32));
+            }
+            let occlusion = if seen == 0 { 1.0 } else { f64::from(hidden) / f64::from(seen) };
+            if occlusion > gate.max_occlusion {
+                out.rejections.occluded += 1;
+                continue;
+            }
+            let crossing = labels[id][frame];
+            let tte = first_crossing[id].and_then(|fc| (frame as u32 <= fc).then(|| (fc - frame as u32) as i32));
+            let (box_centre, box_size) = pose.box3d();
+            out.pedestrians[id].annotated_frames += 1;
+            out.pedestrians[id].crosser |= crossing;
+            out.rows.push(AnnotationRow {
+                frame: frame as u32,
+                pedestrian: id as u32,
+                bbox_px: bbox.map(|x| x as f32),
+                crossing,
+                state: f.state,
+                distance_m: distance as f32,
+                tte_frames: tte,
+                occlusion: occlusion as f32,
+                keypoints,
+                keypoints_3d,
+                pos_m: [f.pos.x as f32, f.pos.y as f32, f.pos.z as f32],
+                yaw_rad: f.yaw_rad as f32,
+                velocity_mps: [f.velocity.x as f32, f.velocity.y as f32],
+                lane_type: f.lane_type,
+                box3d_centre_m: [box_centre.x as f32, box_centre.y as f32, box_centre.z as f32],
+                box3d_size_m: [box_size.x as f32, box_size.y as f32, box_size.z as f32],
+            });
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(state: PedState, lane: Option<LaneType>) -> PedFrame {
+        PedFrame {
+            pos: DVec3::ZERO,
+            yaw_rad: 0.0,
+            velocity: DVec2::ZERO,
+            state,
+            lane_type: lane,
+            head_yaw_rad: 0.0,
+            gait_phase: 0.0,
+            on_phone: false,
+        }
+    }
+
+    #[test]
+    fn crossing_label_needs_state_and_driving_lane_and_is_smoothed() {
+        use LaneType::*;
+        use PedState::*;
+        let frames = [
+            frame(CheckingTraffic, Some(Sidewalk)),
+            frame(CrossingRoad, Some(Sidewalk)),
+            frame(CrossingRoad, Some(Driving)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Driving)),
+            frame(FinishedCrossing, Some(Driving)),
+        ];
+        assert_eq!(crossing_labels(&frames, 2), vec![false, false, true, true, true, false, true, false]);
+        assert_eq!(crossing_labels(&frames, 0), vec![false, false, true, false, false, false, true, false]);
+    }
+
+    #[test]
+    fn occluders_block_only_what_they_cover() {
+        let car = Occluder::Vehicle { centre: DVec3::new(10.0, 0.0, 0.0), yaw_rad: 0.3 };
+        let from = DVec3::new(0.0, 0.0, 1.0);
+        assert!(blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 1.0));
+        assert!(!blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 0.3), "target in front of the car");
+        assert!(!blocks(&car, from, DVec3::new(20.0, 0.0, 3.0), 1.0), "the ray passes over the roof");
+        let person = Occluder::Person { ground: DVec3::new(5.0, 0.0, 0.0), radius_m: 0.25, height_m: 1.7, owner: 1 };
+        assert!(blocks(&person, from, DVec3::new(10.0, 0.0, 0.0), 1.0));
+        assert!(!blocks(&person, from, DVec3::new(10.0, 1.0, 0.0), 1.0));
+        assert!(!blocks(&person, from, DVec3::new(10.0, 0.0, 4.0), 1.0), "over the head");
+    }
+}

@@ -1,0 +1,443 @@
+//! The dataset's Parquet tables: schemas (keys first, Waymo-v2 style), Arrow record batches built from a
+//! clip's script, trace and annotations, and atomic writing (temporary file, then rename).
+//!
+//! Layout: `tables/<table>/<clip_id>.parquet`, one file per clip and table, so that pyarrow, polars and DuckDB
+//! read each table directory as one dataset. Every file carries `pedsynth.schema_version`, `pedsynth.version`,
+//! `pedsynth.spec_hash` and `pedsynth.clip_id` in its key-value metadata. DATASET.md documents every column.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use arrow_array::builder::{FixedSizeListBuilder, Float32Builder};
+use arrow_array::{
+    ArrayRef, BooleanArray, Float32Array, Float64Array, Int32Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+};
+use arrow_schema::{DataType, Field, Schema};
+use parquet::arrow::ArrowWriter;
+use parquet::basic::{Compression as ParquetCompression, ZstdLevel};
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterProperties;
+
+use super::annotate::ClipAnnotations;
+use super::trace::{ClipTrace, Event, EGO_ID};
+use crate::dsl::types::{Compression, Output};
+use crate::planner::ClipScript;
+use crate::world::LaneType;
+
+/// Version of the table schemas; bump on any change to a column.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// The tables, in the order they are written (`clips` last: its file marks the clip complete).
+pub const TABLES: [&str; 6] = ["frames", "pedestrians", "annotations", "vehicles", "events", "clips"];
+
+/// Metadata every file carries.
+#[derive(Clone, Debug)]
+pub struct FileMeta {
+    /// blake3 of the resolved spec.
+    pub spec_hash: String,
+}
+
+fn lane_name(l: LaneType) -> &'static str {
+    match l {
+        LaneType::Driving => "driving",
+        LaneType::Sidewalk => "sidewalk",
+        LaneType::Shoulder => "shoulder",
+        LaneType::Parking => "parking",
+        LaneType::Median => "median",
+        LaneType::Border => "border",
+        LaneType::Biking => "biking",
+        LaneType::Other => "other",
+    }
+}
+
+fn snake<T: serde::Serialize>(value: &T) -> String {
+    serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
+}
+
+fn field(name: &str, data_type: DataType, nullable: bool) -> Field {
+    Field::new(name, data_type, nullable)
+}
+
+fn utf8<'a>(n: usize, value: &'a str) -> ArrayRef {
+    Arc::new(StringArray::from_iter_values(std::iter::repeat_n(value, n)))
+}
+
+fn batch(fields: Vec<Field>, columns: Vec<ArrayRef>) -> RecordBatch {
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), columns).expect("columns match their schema")
+}
+
+/// The `clips` table: one row describing the clip.
+pub fn clips_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotations) -> RecordBatch {
+    let w = &script.weather_params;
+    let planned = script.pedestrians.iter().filter(|p| p.role == crate::planner::Role::Crosser).count() as u32;
+    let crossers = ann.pedestrians.iter().filter(|p| p.crosser).count() as u32;
+    let contacts = trace.events.iter().filter(|e| matches!(e, Event::Contact { .. })).count() as u32;
+    let r = &ann.rejections;
+    let f64s = [
+        ("duration_s", script.duration_s()),
+        ("sun_altitude_deg", w.sun_altitude_deg),
+        ("sun_azimuth_deg", w.sun_azimuth_deg),
+        ("cloudiness_pct", w.cloudiness_pct),
+        ("precipitation_pct", w.precipitation_pct),
+        ("fog_density_pct", w.fog_density_pct),
+        ("wetness_pct", w.wetness_pct),
+        ("wind_intensity_pct", w.wind_intensity_pct),
+    ];
+    let u32s = [
+        ("fps", script.fps),
+        ("frame_count", script.frame_count),
+        ("pedestrians", script.pedestrians.len() as u32),
+        ("planned_crossers", planned),
+        ("crossers", crossers),
+        ("vehicles", script.vehicles.len() as u32),
+        ("contacts", contacts),
+    ];
+    let u64s = [
+        ("seed", script.seed),
+        ("annotated_samples", ann.rows.len() as u64),
+        ("rejected_too_far", r.too_far),
+        ("rejected_behind", r.behind),
+        ("rejected_too_small", r.too_small),
+        ("rejected_outside_image", r.outside_image),
+        ("rejected_occluded", r.occluded),
+    ];
+    let mut fields = vec![
+        field("clip_id", DataType::Utf8, false),
+        field("town", DataType::Utf8, false),
+        field("weather", DataType::Utf8, false),
+        field("difficulty", DataType::Utf8, false),
+        field("split", DataType::Utf8, false),
+    ];
+    let mut columns: Vec<ArrayRef> = vec![
+        utf8(1, &script.clip_id),
+        utf8(1, &script.town),
+        utf8(1, &script.weather),
+        utf8(1, &snake(&w.difficulty)),
+        utf8(1, &snake(&script.split)),
+    ];
+    for (name, v) in u64s {
+        fields.push(field(name, DataType::UInt64, false));
+        columns.push(Arc::new(UInt64Array::from(vec![v])));
+    }
+    for (name, v) in u32s {
+        fields.push(field(name, DataType::UInt32, false));
+        columns.push(Arc::new(UInt32Array::from(vec![v])));
+    }
+    for (name, v) in f64s {
+        fields.push(field(name, DataType::Float64, false));
+        columns.push(Arc::new(Float64Array::from(vec![v])));
+    }
+    batch(fields, columns)
+}
+
+/// The `frames` table: one row per frame with the simulated time and the ego's state.
+pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
+    let n = trace.ego.len();
+    let ns_per_frame = 1_000_000_000i64 / i64::from(trace.fps.max(1));
+    let rem = 1_000_000_000i64 % i64::from(trace.fps.max(1));
+    let timestamps: Vec<i64> = (0..n as i64).map(|f| f * ns_per_frame + f * rem / i64::from(trace.fps.max(1))).collect();
+    let col = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef { Arc::new(Float64Array::from_iter_values(trace.ego.iter().map(get))) };
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("timestamp_ns", DataType::Int64, false),
+            field("ego_x_m", DataType::Float64, false),
+            field("ego_y_m", DataType::Float64, false),
+            field("ego_z_m", DataType::Float64, false),
+            field("ego_yaw_rad", DataType::Float64, false),
+            field("ego_speed_mps", DataType::Float64, false),
+            field("ego_accel_mps2", DataType::Float64, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(0..n as u32)),
+            Arc::new(Int64Array::from(timestamps)),
+            col(|f| f.pos.x),
+            col(|f| f.pos.y),
+            col(|f| f.pos.z),
+            col(|f| f.yaw_rad),
+            col(|f| f.speed_mps),
+            col(|f| f.accel_mps2),
+        ],
+    )
+}
+
+/// The `pedestrians` table: one row per pedestrian with its plan and its clip-level labels.
+pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
+    let peds = &script.pedestrians;
+    let n = peds.len();
+    let s = |f: &dyn Fn(&crate::planner::PedestrianScript) -> String| -> ArrayRef { Arc::new(StringArray::from_iter_values(peds.iter().map(f))) };
+    let f32c = |f: &dyn Fn(&crate::planner::PedestrianScript) -> f64| -> ArrayRef { Arc::new(Float32Array::from_iter_values(peds.iter().map(|p| f(p) as f32))) };
+    let label = |i: usize| ann.pedestrians.get(i).copied().unwrap_or_default();
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("pedestrian", DataType::UInt32, false),
+            field("archetype", DataType::Utf8, false),
+            field("body", DataType::Utf8, false),
+            field("role", DataType::Utf8, false),
+            field("crosser_source", DataType::Utf8, false),
+            field("behaviour", DataType::Utf8, false),
+            field("group_id", DataType::UInt32, true),
+            field("group_leader", DataType::UInt32, true),
+            field("speed_profile", DataType::Utf8, false),
+            field("base_speed_mps", DataType::Float32, false),
+            field("hesitation_s", DataType::Float32, false),
+            field("attention", DataType::Float32, false),
+            field("ttc_threshold_s", DataType::Float32, false),
+            field("safety_margin_s", DataType::Float32, false),
+            field("patience_s", DataType::Float32, false),
+            field("height_m", DataType::Float32, false),
+            field("crosser", DataType::Boolean, false),
+            field("first_crossing_frame", DataType::UInt32, true),
+            field("intention_frame", DataType::UInt32, true),
+            field("annotated_frames", DataType::UInt32, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(peds.iter().map(|p| p.id))),
+            s(&|p| p.archetype.clone()),
+            s(&|p| snake(&p.body)),
+            s(&|p| snake(&p.role)),
+            s(&|p| snake(&p.crosser_source)),
+            s(&|p| snake(&p.behaviour)),
+            Arc::new(UInt32Array::from_iter(peds.iter().map(|p| p.group.map(|g| g.group_id)))),
+            Arc::new(UInt32Array::from_iter(peds.iter().map(|p| p.group.map(|g| g.leader)))),
+            s(&|p| snake(&p.speed_profile)),
+            f32c(&|p| p.base_speed_mps),
+            f32c(&|p| p.hesitation_s),
+            f32c(&|p| p.attention),
+            f32c(&|p| p.ttc_threshold_s),
+            f32c(&|p| p.safety_margin_s),
+            f32c(&|p| p.patience_s),
+            f32c(&|p| super::body::heights_m(p.body, script.seed, p.id).0),
+            Arc::new(BooleanArray::from_iter((0..n).map(|i| Some(label(i).crosser)))),
+            Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).first_crossing_frame))),
+            Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).intention_frame))),
+            Arc::new(UInt32Array::from_iter_values((0..n).map(|i| label(i).annotated_frames))),
+        ],
+    )
+}
+
+fn fixed_list(rows: &[super::annotate::AnnotationRow], get: fn(&super::annotate::AnnotationRow) -> &[f32; 51]) -> ArrayRef {
+    let mut builder = FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(rows.len() * 51), 51, rows.len())
+        .with_field(Field::new("item", DataType::Float32, false));
+    for r in rows {
+        builder.values().append_slice(get(r));
+        builder.append(true);
+    }
+    Arc::new(builder.finish())
+}
+
+/// The `annotations` table: one row per annotated pedestrian-frame.
+pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
+    let rows = &ann.rows;
+    let n = rows.len();
+    let f32c = |get: fn(&super::annotate::AnnotationRow) -> f32| -> ArrayRef { Arc::new(Float32Array::from_iter_values(rows.iter().map(get))) };
+    let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), 51);
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("pedestrian", DataType::UInt32, false),
+            field("bbox_x_min", DataType::Float32, false),
+            field("bbox_y_min", DataType::Float32, false),
+            field("bbox_x_max", DataType::Float32, false),
+            field("bbox_y_max", DataType::Float32, false),
+            field("crossing", DataType::Boolean, false),
+            field("state", DataType::Utf8, false),
+            field("distance_to_ego_m", DataType::Float32, false),
+            field("tte_frames", DataType::Int32, true),
+            field("occlusion", DataType::Float32, false),
+            field("keypoints", list.clone(), false),
+            field("keypoints_3d", list, false),
+            field("x_m", DataType::Float32, false),
+            field("y_m", DataType::Float32, false),
+            field("z_m", DataType::Float32, false),
+            field("yaw_rad", DataType::Float32, false),
+            field("vx_mps", DataType::Float32, false),
+            field("vy_mps", DataType::Float32, false),
+            field("lane_type", DataType::Utf8, true),
+            field("box3d_x_m", DataType::Float32, false),
+            field("box3d_y_m", DataType::Float32, false),
+            field("box3d_z_m", DataType::Float32, false),
+            field("box3d_length_m", DataType::Float32, false),
+            field("box3d_width_m", DataType::Float32, false),
+            field("box3d_height_m", DataType::Float32, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.frame))),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.pedestrian))),
+            f32c(|r| r.bbox_px[0]),
+            f32c(|r| r.bbox_px[1]),
+            f32c(|r| r.bbox_px[2]),
+            f32c(|r| r.bbox_px[3]),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.crossing)))),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.state.name()))),
+            f32c(|r| r.distance_m),
+            Arc::new(Int32Array::from_iter(rows.iter().map(|r| r.tte_frames))),
+            f32c(|r| r.occlusion),
+            fixed_list(rows, |r| &r.keypoints),
+            fixed_list(rows, |r| &r.keypoints_3d),
+            f32c(|r| r.pos_m[0]),
+            f32c(|r| r.pos_m[1]),
+            f32c(|r| r.pos_m[2]),
+            f32c(|r| r.yaw_rad),
+            f32c(|r| r.velocity_mps[0]),
+            f32c(|r| r.velocity_mps[1]),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.lane_type.map(lane_name)))),
+            f32c(|r| r.box3d_centre_m[0]),
+            f32c(|r| r.box3d_centre_m[1]),
+            f32c(|r| r.box3d_centre_m[2]),
+            f32c(|r| r.box3d_size_m[0]),
+            f32c(|r| r.box3d_size_m[1]),
+            f32c(|r| r.box3d_size_m[2]),
+        ],
+    )
+}
+
+/// The `vehicles` table: one row per traffic vehicle and frame (the ego is in `frames`).
+pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
+    let rows: Vec<(u32, u32, &super::trace::VehicleFrame)> = (0..trace.ego.len())
+        .flat_map(|f| trace.vehicles.iter().enumerate().filter_map(move |(v, frames)| frames.get(f).map(|x| (f as u32, v as u32, x))))
+        .collect();
+    let n = rows.len();
+    let f32c = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef { Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32))) };
+    let profile = |v: u32| script.vehicles.get(v as usize).map_or_else(String::new, |s| snake(&s.profile));
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("vehicle", DataType::UInt32, false),
+            field("x_m", DataType::Float32, false),
+            field("y_m", DataType::Float32, false),
+            field("z_m", DataType::Float32, false),
+            field("yaw_rad", DataType::Float32, false),
+            field("speed_mps", DataType::Float32, false),
+            field("accel_mps2", DataType::Float32, false),
+            field("profile", DataType::Utf8, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.1))),
+            f32c(|f| f.pos.x),
+            f32c(|f| f.pos.y),
+            f32c(|f| f.pos.z),
+            f32c(|f| f.yaw_rad),
+            f32c(|f| f.speed_mps),
+            f32c(|f| f.accel_mps2),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| profile(r.1)))),
+        ],
+    )
+}
+
+/// The `events` table: state changes, crossing decisions, conflicts and retreats, patience expiry, contacts.
+pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
+    #[derive(Default)]
+    struct Row {
+        frame: u32,
+        kind: &'static str,
+        pedestrian: Option<u32>,
+        vehicle: Option<u32>,
+        from: Option<&'static str>,
+        to: Option<&'static str>,
+        in_window: Option<bool>,
+        retreated: Option<bool>,
+        sudden: Option<bool>,
+        other: Option<u32>,
+    }
+    let vehicle_id = |v: u32| if v == EGO_ID { None } else { Some(v) };
+    let rows: Vec<Row> = trace
+        .events
+        .iter()
+        .map(|e| match *e {
+            Event::StateChange { frame, pedestrian, from, to } => {
+                Row { frame, kind: "state_change", pedestrian: Some(pedestrian), from: Some(from.name()), to: Some(to.name()), ..Row::default() }
+            }
+            Event::CrossingDecision { frame, pedestrian } => Row { frame, kind: "crossing_decision", pedestrian: Some(pedestrian), ..Row::default() },
+            Event::Conflict { frame, pedestrian, vehicle, in_retreat_window, retreated } => Row {
+                frame,
+                kind: "conflict",
+                pedestrian: Some(pedestrian),
+                vehicle: vehicle_id(vehicle),
+                in_window: Some(in_retreat_window),
+                retreated: Some(retreated),
+                ..Row::default()
+            },
+            Event::PatienceExpired { frame, pedestrian, sudden_crossing } => {
+                Row { frame, kind: "patience_expired", pedestrian: Some(pedestrian), sudden: Some(sudden_crossing), ..Row::default() }
+            }
+            Event::Contact { frame, vehicle, pedestrian, other_vehicle } => {
+                Row { frame, kind: "contact", pedestrian, vehicle: vehicle_id(vehicle), other: other_vehicle, ..Row::default() }
+            }
+        })
+        .collect();
+    let n = rows.len();
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("kind", DataType::Utf8, false),
+            field("pedestrian", DataType::UInt32, true),
+            field("vehicle", DataType::UInt32, true),
+            field("ego_involved", DataType::Boolean, false),
+            field("from_state", DataType::Utf8, true),
+            field("to_state", DataType::Utf8, true),
+            field("in_retreat_window", DataType::Boolean, true),
+            field("retreated", DataType::Boolean, true),
+            field("sudden_crossing", DataType::Boolean, true),
+            field("other_vehicle", DataType::UInt32, true),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.frame))),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.kind))),
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.pedestrian))),
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.vehicle))),
+            Arc::new(BooleanArray::from_iter(trace.events.iter().map(|e| {
+                Some(matches!(e, Event::Conflict { vehicle: EGO_ID, .. } | Event::Contact { vehicle: EGO_ID, .. }))
+            }))),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.from))),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.to))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.in_window))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.retreated))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.sudden))),
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.other))),
+        ],
+    )
+}
+
+/// The path of a clip's file of a table.
+pub fn table_path(out_dir: &Path, table: &str, clip_id: &str) -> PathBuf {
+    out_dir.join("tables").join(table).join(format!("{clip_id}.parquet"))
+}
+
+/// Writes a record batch to `path` as Parquet, atomically (temporary file in the same directory, then
+/// rename). Returns the blake3 of the written bytes.
+pub fn write_parquet(path: &Path, batch: &RecordBatch, output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> std::io::Result<String> {
+    let compression = match output.compression {
+        Compression::Zstd => ParquetCompression::ZSTD(ZstdLevel::try_new(output.zstd_level as i32).unwrap_or_default()),
+        Compression::Snappy => ParquetCompression::SNAPPY,
+        Compression::None => ParquetCompression::UNCOMPRESSED,
+    };
+    let kv = |k: &str, v: String| KeyValue::new(k.to_owned(), v);
+    let props = WriterProperties::builder()
+        .set_compression(compression)
+        .set_created_by(format!("pedsynth {}", env!("CARGO_PKG_VERSION")))
+        .set_key_value_metadata(Some(vec![
+            kv("pedsynth.schema_version", SCHEMA_VERSION.to_string()),
+            kv("pedsynth.version", env!("CARGO_PKG_VERSION").to_owned()),
+            kv("pedsynth.spec_hash", meta.spec_hash.clone()),
+            kv("pedsynth.table", table.to_owned()),
+            kv("pedsynth.clip_id", clip_id.to_owned()),
+        ]))
+        .build();
+    let mut writer = ArrowWriter::try_new(Vec::new(), batch.schema(), Some(props)).map_err(std::io::Error::other)?;
+    writer.write(batch).map_err(std::io::Error::other)?;
+    let bytes = writer.into_inner().map_err(std::io::Error::other)?;
+    crate::fsutil::write_atomically(path, &bytes)?;
+    Ok(blake3::hash(&bytes).to_hex().to_string())
+}
