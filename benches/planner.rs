@@ -38,7 +38,7 @@ fn plan_10k_clips(bencher: divan::Bencher, town: &str) {
     let (loaded, towns) = spec(&format!("dataset.towns=[{town}]"), 834);
     let hash = loaded.hash();
     bencher.bench(|| {
-        let plan = planner::plan(divan::black_box(&loaded.spec), &hash, &towns, None).expect("feasible");
+        let plan = planner::plan(divan::black_box(&loaded.spec), &hash, "specs", &towns, None).expect("feasible");
         assert_eq!(plan.clips.len(), 10_008);
         plan
     });

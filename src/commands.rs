@@ -161,7 +161,13 @@ pub fn compile_plan(
             return Err(exit::INVALID);
         }
     };
-    match planner::plan(&loaded.spec, &loaded.hash(), &towns, only) {
+    match planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        only,
+    ) {
         Ok(plan) => Ok((loaded, plan)),
         Err(problems) => {
             let _ = writeln!(

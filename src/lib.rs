@@ -3,7 +3,7 @@
 //! Pipeline: `dsl` (spec → validated, defaulted `Spec`) → `world` (road networks) → planner → executor.
 pub mod commands;
 pub mod dsl;
-pub mod fsutil;
 pub mod exec;
+pub mod fsutil;
 pub mod planner;
 pub mod world;

@@ -21,9 +21,16 @@ fn compile(spec: &str, overrides: &[String]) -> (dsl::LoadedSpec, BTreeMap<Strin
         overrides: overrides.to_vec(),
         allow_large: true,
     };
-    let loaded = dsl::load_file(&root().join(spec), &options).unwrap_or_else(|e| panic!("{}", e.render_plain(100)));
+    let loaded = dsl::load_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{}", e.render_plain(100)));
     let towns = load_towns(&loaded).unwrap();
-    let plan = planner::plan(&loaded.spec, &loaded.hash(), &towns, None).unwrap_or_else(|p| panic!("{p:?}"));
+    let plan = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .unwrap_or_else(|p| panic!("{p:?}"));
     (loaded, towns, plan)
 }
 
@@ -193,7 +200,14 @@ fn carla_map_plan_has_exact_quotas_and_valid_spawns() {
     assert_eq!(plan.clips.len(), 6);
     assert_quotas(&loaded, &plan);
     assert_valid_spawns(&towns, &plan);
-    let again = planner::plan(&loaded.spec, &loaded.hash(), &towns, None).unwrap();
+    let again = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .unwrap();
     assert_eq!(
         serde_json::to_string(&plan).unwrap(),
         serde_json::to_string(&again).unwrap(),
@@ -220,14 +234,30 @@ fn adding_a_weather_leaves_existing_clips_identical_and_only_reproduces_a_clip()
         );
     }
     for clip in &more.clips {
-        let only = planner::plan(&loaded.spec, &loaded.hash(), &towns, Some(&clip.clip_id)).unwrap();
+        let only = planner::plan(
+            &loaded.spec,
+            &loaded.hash(),
+            &loaded.base_dir.display().to_string(),
+            &towns,
+            Some(&clip.clip_id),
+        )
+        .unwrap();
         assert_eq!(only.clips.len(), 1);
         assert_eq!(
             serde_json::to_string(&only.clips[0]).unwrap(),
             serde_json::to_string(clip).unwrap()
         );
     }
-    assert!(planner::plan(&loaded.spec, &loaded.hash(), &towns, Some("nope-clear_noon-0000")).is_err());
+    assert!(
+        planner::plan(
+            &loaded.spec,
+            &loaded.hash(),
+            &loaded.base_dir.display().to_string(),
+            &towns,
+            Some("nope-clear_noon-0000")
+        )
+        .is_err()
+    );
 }
 
 /// ChaCha20 and our seed derivation must never change silently (a dependency bump would change datasets).

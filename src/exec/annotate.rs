@@ -130,7 +130,12 @@ enum Occluder {
     /// A vehicle: ground centre, yaw.
     Vehicle { centre: DVec3, yaw_rad: f64 },
     /// A pedestrian body as an upright cylinder: ground point, radius, height, owner id.
-    Person { ground: DVec3, radius_m: f64, height_m: f64, owner: u32 },
+    Person {
+        ground: DVec3,
+        radius_m: f64,
+        height_m: f64,
+        owner: u32,
+    },
 }
 
 /// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
@@ -160,7 +165,12 @@ fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
             }
             true
         }
-        Occluder::Person { ground, radius_m, height_m, .. } => {
+        Occluder::Person {
+            ground,
+            radius_m,
+            height_m,
+            ..
+        } => {
             let o = (from - ground).truncate();
             let v = d.truncate();
             let a = v.length_squared();
@@ -226,7 +236,13 @@ pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
 }
 
 /// Annotates a simulated clip.
-pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotations, camera: &Camera, town: &RoadNetwork) -> ClipAnnotations {
+pub fn annotate(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    annotations: &Annotations,
+    camera: &Camera,
+    town: &RoadNetwork,
+) -> ClipAnnotations {
     let gate = &annotations.visibility;
     let n_peds = trace.pedestrians.len();
     let heights: Vec<(f64, Option<f64>)> = script
@@ -236,9 +252,20 @@ pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotation
         .chain(std::iter::repeat((1.75, None)))
         .take(n_peds)
         .collect();
-    let labels: Vec<Vec<bool>> = trace.pedestrians.iter().map(|f| crossing_labels(f, annotations.crossing_label_smoothing_frames)).collect();
-    let first_crossing: Vec<Option<u32>> = labels.iter().map(|l| l.iter().position(|c| *c).map(|f| f as u32)).collect();
-    let mut out = ClipAnnotations { rows: Vec::new(), pedestrians: vec![PedestrianLabels::default(); n_peds], rejections: Rejections::default() };
+    let labels: Vec<Vec<bool>> = trace
+        .pedestrians
+        .iter()
+        .map(|f| crossing_labels(f, annotations.crossing_label_smoothing_frames))
+        .collect();
+    let first_crossing: Vec<Option<u32>> = labels
+        .iter()
+        .map(|l| l.iter().position(|c| *c).map(|f| f as u32))
+        .collect();
+    let mut out = ClipAnnotations {
+        rows: Vec::new(),
+        pedestrians: vec![PedestrianLabels::default(); n_peds],
+        rejections: Rejections::default(),
+    };
     for (i, p) in out.pedestrians.iter_mut().enumerate() {
         p.first_crossing_frame = first_crossing[i];
     }
@@ -259,16 +286,29 @@ pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotation
         occluders.clear();
         for v in &trace.vehicles {
             if let Some(f) = v.get(frame) {
-                occluders.push(Occluder::Vehicle { centre: f.pos, yaw_rad: f.yaw_rad });
+                occluders.push(Occluder::Vehicle {
+                    centre: f.pos,
+                    yaw_rad: f.yaw_rad,
+                });
             }
         }
         for (id, ped) in trace.pedestrians.iter().enumerate() {
             let f = &ped[frame];
             let (h, child) = heights[id];
-            occluders.push(Occluder::Person { ground: f.pos, radius_m: PED_OCCLUDER_RADIUS_PER_M * h, height_m: h, owner: id as u32 });
+            occluders.push(Occluder::Person {
+                ground: f.pos,
+                radius_m: PED_OCCLUDER_RADIUS_PER_M * h,
+                height_m: h,
+                owner: id as u32,
+            });
             if let Some(hc) = child {
                 let offset = glam::DMat3::from_rotation_z(f.yaw_rad) * CHILD_OFFSET_M;
-                occluders.push(Occluder::Person { ground: f.pos + offset, radius_m: PED_OCCLUDER_RADIUS_PER_M * hc, height_m: hc, owner: u32::MAX });
+                occluders.push(Occluder::Person {
+                    ground: f.pos + offset,
+                    radius_m: PED_OCCLUDER_RADIUS_PER_M * hc,
+                    height_m: hc,
+                    owner: u32::MAX,
+                });
             }
         }
         for (id, ped) in trace.pedestrians.iter().enumerate() {
@@ -288,7 +328,11 @@ pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotation
                 continue;
             };
             let (w, hgt) = (bbox[2] - bbox[0], bbox[3] - bbox[1]);
-            let min = if distance > gate.far_distance_m { gate.min_box_far_px } else { gate.min_box_px };
+            let min = if distance > gate.far_distance_m {
+                gate.min_box_far_px
+            } else {
+                gate.min_box_px
+            };
             if w < min.min() || hgt < min.max() {
                 out.rejections.too_small += 1;
                 continue;
@@ -316,11 +360,21 @@ pub fn annotate(script: &ClipScript, trace: &ClipTrace, annotations: &Annotation
                 keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
                 keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
             }
-            for sample in [pose.capsules[0].a, pose.capsules[0].b, pose.capsules[2].a, (pose.capsules[7].a + pose.capsules[7].b) * 0.5, (pose.capsules[8].a + pose.capsules[8].b) * 0.5] {
+            for sample in [
+                pose.capsules[0].a,
+                pose.capsules[0].b,
+                pose.capsules[2].a,
+                (pose.capsules[7].a + pose.capsules[7].b) * 0.5,
+                (pose.capsules[8].a + pose.capsules[8].b) * 0.5,
+            ] {
                 seen += 1;
                 hidden += u32::from(occluded(town, &occluders, cam.centre, sample, id as u32));
             }
-            let occlusion = if seen == 0 { 1.0 } else { f64::from(hidden) / f64::from(seen) };
+            let occlusion = if seen == 0 {
+                1.0
+            } else {
+                f64::from(hidden) / f64::from(seen)
+            };
             if occlusion > gate.max_occlusion {
                 out.rejections.occluded += 1;
                 continue;
@@ -384,18 +438,38 @@ mod tests {
             frame(CrossingRoad, Some(Driving)),
             frame(FinishedCrossing, Some(Driving)),
         ];
-        assert_eq!(crossing_labels(&frames, 2), vec![false, false, true, true, true, false, true, false]);
-        assert_eq!(crossing_labels(&frames, 0), vec![false, false, true, false, false, false, true, false]);
+        assert_eq!(
+            crossing_labels(&frames, 2),
+            vec![false, false, true, true, true, false, true, false]
+        );
+        assert_eq!(
+            crossing_labels(&frames, 0),
+            vec![false, false, true, false, false, false, true, false]
+        );
     }
 
     #[test]
     fn occluders_block_only_what_they_cover() {
-        let car = Occluder::Vehicle { centre: DVec3::new(10.0, 0.0, 0.0), yaw_rad: 0.3 };
+        let car = Occluder::Vehicle {
+            centre: DVec3::new(10.0, 0.0, 0.0),
+            yaw_rad: 0.3,
+        };
         let from = DVec3::new(0.0, 0.0, 1.0);
         assert!(blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 1.0));
-        assert!(!blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 0.3), "target in front of the car");
-        assert!(!blocks(&car, from, DVec3::new(20.0, 0.0, 3.0), 1.0), "the ray passes over the roof");
-        let person = Occluder::Person { ground: DVec3::new(5.0, 0.0, 0.0), radius_m: 0.25, height_m: 1.7, owner: 1 };
+        assert!(
+            !blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 0.3),
+            "target in front of the car"
+        );
+        assert!(
+            !blocks(&car, from, DVec3::new(20.0, 0.0, 3.0), 1.0),
+            "the ray passes over the roof"
+        );
+        let person = Occluder::Person {
+            ground: DVec3::new(5.0, 0.0, 0.0),
+            radius_m: 0.25,
+            height_m: 1.7,
+            owner: 1,
+        };
         assert!(blocks(&person, from, DVec3::new(10.0, 0.0, 0.0), 1.0));
         assert!(!blocks(&person, from, DVec3::new(10.0, 1.0, 0.0), 1.0));
         assert!(!blocks(&person, from, DVec3::new(10.0, 0.0, 4.0), 1.0), "over the head");

@@ -77,7 +77,10 @@ impl BodyPose {
                 hi = hi.max(q + DVec3::splat(c.radius_m));
             }
         }
-        (self.ground + DMat3::from_rotation_z(self.yaw_rad) * ((lo + hi) * 0.5), hi - lo)
+        (
+            self.ground + DMat3::from_rotation_z(self.yaw_rad) * ((lo + hi) * 0.5),
+            hi - lo,
+        )
     }
 }
 
@@ -134,7 +137,11 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
         (hip, knee_p, ankle)
     };
     let (l_hip, l_knee, l_ankle) = leg(1.0, theta, knee);
-    let (r_hip, r_knee, r_ankle) = leg(-1.0, -theta, 0.6 * swing * (phase + 1.2 + std::f64::consts::PI).sin().max(0.0));
+    let (r_hip, r_knee, r_ankle) = leg(
+        -1.0,
+        -theta,
+        0.6 * swing * (phase + 1.2 + std::f64::consts::PI).sin().max(0.0),
+    );
 
     // Upper body: arms swing opposite to the legs; the right hand holds a phone in front of the chest.
     let shoulder_z = 0.818 * h;
@@ -155,12 +162,17 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
         r_wrist = DVec3::new(0.25 * h * 0.8, -0.02 * h, 0.72 * h);
         head_pitch = 0.45;
     }
-    let r_elbow = if frame.on_phone { DVec3::new(0.06 * h, -shoulder_y, 0.66 * h) } else { r_elbow };
+    let r_elbow = if frame.on_phone {
+        DVec3::new(0.06 * h, -shoulder_y, 0.66 * h)
+    } else {
+        r_elbow
+    };
 
     // Head: turned by the head yaw about the neck, pitched down when reading a phone.
     let neck = DVec3::new(0.0, 0.0, 0.87 * h);
     let head_rot = DMat3::from_rotation_z(frame.head_yaw_rad) * DMat3::from_rotation_y(head_pitch);
-    let head_point = |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
+    let head_point =
+        |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
     let nose = head_point(0.06, 0.0, 0.92);
     let l_eye = head_point(0.05, 0.018, 0.936);
     let r_eye = head_point(0.05, -0.018, 0.936);
@@ -169,8 +181,8 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     let head_centre = head_point(0.0, 0.0, 0.93);
 
     let local = [
-        nose, l_eye, r_eye, l_ear, r_ear, l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist, l_hip, r_hip, l_knee, r_knee,
-        l_ankle, r_ankle,
+        nose, l_eye, r_eye, l_ear, r_ear, l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist, l_hip, r_hip,
+        l_knee, r_knee, l_ankle, r_ankle,
     ];
     let rot = DMat3::from_rotation_z(frame.yaw_rad);
     let to_world = |p: DVec3| frame.pos + rot * (p + offset_body);
@@ -178,7 +190,11 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
     let pelvis = DVec3::new(0.0, 0.0, hip_z);
     let chest = DVec3::new(0.0, 0.0, 0.78 * h);
-    let cap = |a: DVec3, b: DVec3, r: f64| Capsule { a: to_world(a), b: to_world(b), radius_m: r * h };
+    let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
+        a: to_world(a),
+        b: to_world(b),
+        radius_m: r * h,
+    };
     let capsules = [
         cap(pelvis, chest, 0.085),
         cap(l_shoulder, r_shoulder, 0.04),
@@ -195,7 +211,13 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
         cap(r_ankle, toe(r_ankle), 0.022),
         cap(neck, head_centre, 0.035),
     ];
-    BodyPose { joints, capsules, height_m, ground: to_world(DVec3::ZERO), yaw_rad: frame.yaw_rad }
+    BodyPose {
+        joints,
+        capsules,
+        height_m,
+        ground: to_world(DVec3::ZERO),
+        yaw_rad: frame.yaw_rad,
+    }
 }
 
 #[cfg(test)]
@@ -221,7 +243,10 @@ mod tests {
     fn standing_body_has_plausible_proportions() {
         let p = pose(&frame(0.0, 0.0), 1.75, DVec3::ZERO);
         let z = |i: usize| p.joints[i].z;
-        assert!(z(0) > z(5) && z(5) > z(11) && z(11) > z(13) && z(13) > z(15), "nose > shoulder > hip > knee > ankle");
+        assert!(
+            z(0) > z(5) && z(5) > z(11) && z(11) > z(13) && z(13) > z(15),
+            "nose > shoulder > hip > knee > ankle"
+        );
         assert!((z(15) - 0.039 * 1.75).abs() < 0.02, "ankle near the ground: {}", z(15));
         let ext = p.box3d().1;
         assert!((ext.z - 1.75).abs() < 0.05 && ext.y > 0.35 && ext.y < 0.7, "{ext}");

@@ -35,7 +35,10 @@ pub fn vehicle_from_mount(mount: &Mount) -> DAffine3 {
     let yaw = DMat3::from_rotation_z(mount.yaw_deg.to_radians());
     let pitch = DMat3::from_rotation_y(-mount.pitch_deg.to_radians());
     let roll = DMat3::from_rotation_x(mount.roll_deg.to_radians());
-    DAffine3::from_mat3_translation(yaw * pitch * roll, DVec3::new(mount.forward_m, mount.left_m, mount.up_m))
+    DAffine3::from_mat3_translation(
+        yaw * pitch * roll,
+        DVec3::new(mount.forward_m, mount.left_m, mount.up_m),
+    )
 }
 
 /// The pose of a vehicle in the world: on the ground at `pos` (z is the ground height), heading `yaw_rad`.
@@ -73,7 +76,12 @@ impl Camera {
     /// The RGB camera of a spec.
     pub fn from_spec(rgb: &Rgb) -> Self {
         let focal_px = f64::from(rgb.width_px) / (2.0 * (rgb.fov_deg.to_radians() / 2.0).tan());
-        Camera { width_px: rgb.width_px, height_px: rgb.height_px, focal_px, vehicle_from_sensor: vehicle_from_mount(&rgb.mount) }
+        Camera {
+            width_px: rgb.width_px,
+            height_px: rgb.height_px,
+            focal_px,
+            vehicle_from_sensor: vehicle_from_mount(&rgb.mount),
+        }
     }
 
     /// The camera on a vehicle at `pos` heading `yaw_rad`.
@@ -101,14 +109,20 @@ impl CameraPose {
         let depth = p.z;
         let inv = if depth.abs() > 1e-9 { 1.0 / depth } else { 1e9 };
         Projection {
-            px: DVec2::new(c.focal_px * p.x * inv + f64::from(c.width_px) * 0.5, c.focal_px * p.y * inv + f64::from(c.height_px) * 0.5),
+            px: DVec2::new(
+                c.focal_px * p.x * inv + f64::from(c.width_px) * 0.5,
+                c.focal_px * p.y * inv + f64::from(c.height_px) * 0.5,
+            ),
             depth_m: depth,
         }
     }
 
     /// Whether a pixel lies inside the image.
     pub fn in_image(&self, px: DVec2) -> bool {
-        px.x >= 0.0 && px.y >= 0.0 && px.x <= f64::from(self.camera.width_px) && px.y <= f64::from(self.camera.height_px)
+        px.x >= 0.0
+            && px.y >= 0.0
+            && px.x <= f64::from(self.camera.width_px)
+            && px.y <= f64::from(self.camera.height_px)
     }
 }
 
@@ -140,7 +154,13 @@ mod tests {
     fn the_camera_turns_with_the_vehicle() {
         let cam = Camera::from_spec(&Rgb::default());
         let pose = cam.at(DVec3::new(10.0, 5.0, 0.0), std::f64::consts::FRAC_PI_2);
-        assert!((pose.forward.truncate().normalize() - DVec2::Y).length() < 1e-9, "heading north looks north");
-        assert!((pose.right - DVec3::X).length() < 1e-9 || pose.right.x > 0.99, "north-facing: right is east");
+        assert!(
+            (pose.forward.truncate().normalize() - DVec2::Y).length() < 1e-9,
+            "heading north looks north"
+        );
+        assert!(
+            (pose.right - DVec3::X).length() < 1e-9 || pose.right.x > 0.99,
+            "north-facing: right is east"
+        );
     }
 }

@@ -10,7 +10,8 @@ use std::sync::Arc;
 
 use arrow_array::builder::{FixedSizeListBuilder, Float32Builder};
 use arrow_array::{
-    ArrayRef, BooleanArray, Float32Array, Float64Array, Int32Array, Int64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+    ArrayRef, BooleanArray, Float32Array, Float64Array, Int32Array, Int64Array, RecordBatch, StringArray, UInt32Array,
+    UInt64Array,
 };
 use arrow_schema::{DataType, Field, Schema};
 use parquet::arrow::ArrowWriter;
@@ -19,7 +20,7 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
 use super::annotate::ClipAnnotations;
-use super::trace::{ClipTrace, Event, EGO_ID};
+use super::trace::{ClipTrace, EGO_ID, Event};
 use crate::dsl::types::{Compression, Output};
 use crate::planner::ClipScript;
 use crate::world::LaneType;
@@ -51,7 +52,10 @@ fn lane_name(l: LaneType) -> &'static str {
 }
 
 fn snake<T: serde::Serialize>(value: &T) -> String {
-    serde_json::to_value(value).ok().and_then(|v| v.as_str().map(str::to_owned)).unwrap_or_default()
+    serde_json::to_value(value)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_owned))
+        .unwrap_or_default()
 }
 
 fn field(name: &str, data_type: DataType, nullable: bool) -> Field {
@@ -69,9 +73,17 @@ fn batch(fields: Vec<Field>, columns: Vec<ArrayRef>) -> RecordBatch {
 /// The `clips` table: one row describing the clip.
 pub fn clips_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotations) -> RecordBatch {
     let w = &script.weather_params;
-    let planned = script.pedestrians.iter().filter(|p| p.role == crate::planner::Role::Crosser).count() as u32;
+    let planned = script
+        .pedestrians
+        .iter()
+        .filter(|p| p.role == crate::planner::Role::Crosser)
+        .count() as u32;
     let crossers = ann.pedestrians.iter().filter(|p| p.crosser).count() as u32;
-    let contacts = trace.events.iter().filter(|e| matches!(e, Event::Contact { .. })).count() as u32;
+    let contacts = trace
+        .events
+        .iter()
+        .filter(|e| matches!(e, Event::Contact { .. }))
+        .count() as u32;
     let r = &ann.rejections;
     let f64s = [
         ("duration_s", script.duration_s()),
@@ -135,8 +147,12 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     let n = trace.ego.len();
     let ns_per_frame = 1_000_000_000i64 / i64::from(trace.fps.max(1));
     let rem = 1_000_000_000i64 % i64::from(trace.fps.max(1));
-    let timestamps: Vec<i64> = (0..n as i64).map(|f| f * ns_per_frame + f * rem / i64::from(trace.fps.max(1))).collect();
-    let col = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef { Arc::new(Float64Array::from_iter_values(trace.ego.iter().map(get))) };
+    let timestamps: Vec<i64> = (0..n as i64)
+        .map(|f| f * ns_per_frame + f * rem / i64::from(trace.fps.max(1)))
+        .collect();
+    let col = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef {
+        Arc::new(Float64Array::from_iter_values(trace.ego.iter().map(get)))
+    };
     batch(
         vec![
             field("clip_id", DataType::Utf8, false),
@@ -167,8 +183,12 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
 pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
     let peds = &script.pedestrians;
     let n = peds.len();
-    let s = |f: &dyn Fn(&crate::planner::PedestrianScript) -> String| -> ArrayRef { Arc::new(StringArray::from_iter_values(peds.iter().map(f))) };
-    let f32c = |f: &dyn Fn(&crate::planner::PedestrianScript) -> f64| -> ArrayRef { Arc::new(Float32Array::from_iter_values(peds.iter().map(|p| f(p) as f32))) };
+    let s = |f: &dyn Fn(&crate::planner::PedestrianScript) -> String| -> ArrayRef {
+        Arc::new(StringArray::from_iter_values(peds.iter().map(f)))
+    };
+    let f32c = |f: &dyn Fn(&crate::planner::PedestrianScript) -> f64| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(peds.iter().map(|p| f(p) as f32)))
+    };
     let label = |i: usize| ann.pedestrians.get(i).copied().unwrap_or_default();
     batch(
         vec![
@@ -220,9 +240,13 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
     )
 }
 
-fn fixed_list(rows: &[super::annotate::AnnotationRow], get: fn(&super::annotate::AnnotationRow) -> &[f32; 51]) -> ArrayRef {
-    let mut builder = FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(rows.len() * 51), 51, rows.len())
-        .with_field(Field::new("item", DataType::Float32, false));
+fn fixed_list(
+    rows: &[super::annotate::AnnotationRow],
+    get: fn(&super::annotate::AnnotationRow) -> &[f32; 51],
+) -> ArrayRef {
+    let mut builder =
+        FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(rows.len() * 51), 51, rows.len())
+            .with_field(Field::new("item", DataType::Float32, false));
     for r in rows {
         builder.values().append_slice(get(r));
         builder.append(true);
@@ -234,7 +258,9 @@ fn fixed_list(rows: &[super::annotate::AnnotationRow], get: fn(&super::annotate:
 pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
     let rows = &ann.rows;
     let n = rows.len();
-    let f32c = |get: fn(&super::annotate::AnnotationRow) -> f32| -> ArrayRef { Arc::new(Float32Array::from_iter_values(rows.iter().map(get))) };
+    let f32c = |get: fn(&super::annotate::AnnotationRow) -> f32| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(rows.iter().map(get)))
+    };
     let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), 51);
     batch(
         vec![
@@ -301,11 +327,24 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
 /// The `vehicles` table: one row per traffic vehicle and frame (the ego is in `frames`).
 pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     let rows: Vec<(u32, u32, &super::trace::VehicleFrame)> = (0..trace.ego.len())
-        .flat_map(|f| trace.vehicles.iter().enumerate().filter_map(move |(v, frames)| frames.get(f).map(|x| (f as u32, v as u32, x))))
+        .flat_map(|f| {
+            trace
+                .vehicles
+                .iter()
+                .enumerate()
+                .filter_map(move |(v, frames)| frames.get(f).map(|x| (f as u32, v as u32, x)))
+        })
         .collect();
     let n = rows.len();
-    let f32c = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef { Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32))) };
-    let profile = |v: u32| script.vehicles.get(v as usize).map_or_else(String::new, |s| snake(&s.profile));
+    let f32c = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32)))
+    };
+    let profile = |v: u32| {
+        script
+            .vehicles
+            .get(v as usize)
+            .map_or_else(String::new, |s| snake(&s.profile))
+    };
     batch(
         vec![
             field("clip_id", DataType::Utf8, false),
@@ -354,11 +393,32 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         .events
         .iter()
         .map(|e| match *e {
-            Event::StateChange { frame, pedestrian, from, to } => {
-                Row { frame, kind: "state_change", pedestrian: Some(pedestrian), from: Some(from.name()), to: Some(to.name()), ..Row::default() }
-            }
-            Event::CrossingDecision { frame, pedestrian } => Row { frame, kind: "crossing_decision", pedestrian: Some(pedestrian), ..Row::default() },
-            Event::Conflict { frame, pedestrian, vehicle, in_retreat_window, retreated } => Row {
+            Event::StateChange {
+                frame,
+                pedestrian,
+                from,
+                to,
+            } => Row {
+                frame,
+                kind: "state_change",
+                pedestrian: Some(pedestrian),
+                from: Some(from.name()),
+                to: Some(to.name()),
+                ..Row::default()
+            },
+            Event::CrossingDecision { frame, pedestrian } => Row {
+                frame,
+                kind: "crossing_decision",
+                pedestrian: Some(pedestrian),
+                ..Row::default()
+            },
+            Event::Conflict {
+                frame,
+                pedestrian,
+                vehicle,
+                in_retreat_window,
+                retreated,
+            } => Row {
                 frame,
                 kind: "conflict",
                 pedestrian: Some(pedestrian),
@@ -367,12 +427,30 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 retreated: Some(retreated),
                 ..Row::default()
             },
-            Event::PatienceExpired { frame, pedestrian, sudden_crossing } => {
-                Row { frame, kind: "patience_expired", pedestrian: Some(pedestrian), sudden: Some(sudden_crossing), ..Row::default() }
-            }
-            Event::Contact { frame, vehicle, pedestrian, other_vehicle } => {
-                Row { frame, kind: "contact", pedestrian, vehicle: vehicle_id(vehicle), other: other_vehicle, ..Row::default() }
-            }
+            Event::PatienceExpired {
+                frame,
+                pedestrian,
+                sudden_crossing,
+            } => Row {
+                frame,
+                kind: "patience_expired",
+                pedestrian: Some(pedestrian),
+                sudden: Some(sudden_crossing),
+                ..Row::default()
+            },
+            Event::Contact {
+                frame,
+                vehicle,
+                pedestrian,
+                other_vehicle,
+            } => Row {
+                frame,
+                kind: "contact",
+                pedestrian,
+                vehicle: vehicle_id(vehicle),
+                other: other_vehicle,
+                ..Row::default()
+            },
         })
         .collect();
     let n = rows.len();
@@ -398,7 +476,10 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.pedestrian))),
             Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.vehicle))),
             Arc::new(BooleanArray::from_iter(trace.events.iter().map(|e| {
-                Some(matches!(e, Event::Conflict { vehicle: EGO_ID, .. } | Event::Contact { vehicle: EGO_ID, .. }))
+                Some(matches!(
+                    e,
+                    Event::Conflict { vehicle: EGO_ID, .. } | Event::Contact { vehicle: EGO_ID, .. }
+                ))
             }))),
             Arc::new(StringArray::from_iter(rows.iter().map(|r| r.from))),
             Arc::new(StringArray::from_iter(rows.iter().map(|r| r.to))),
@@ -417,7 +498,14 @@ pub fn table_path(out_dir: &Path, table: &str, clip_id: &str) -> PathBuf {
 
 /// Writes a record batch to `path` as Parquet, atomically (temporary file in the same directory, then
 /// rename). Returns the blake3 of the written bytes.
-pub fn write_parquet(path: &Path, batch: &RecordBatch, output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> std::io::Result<String> {
+pub fn write_parquet(
+    path: &Path,
+    batch: &RecordBatch,
+    output: &Output,
+    meta: &FileMeta,
+    table: &str,
+    clip_id: &str,
+) -> std::io::Result<String> {
     let compression = match output.compression {
         Compression::Zstd => ParquetCompression::ZSTD(ZstdLevel::try_new(output.zstd_level as i32).unwrap_or_default()),
         Compression::Snappy => ParquetCompression::SNAPPY,

@@ -106,11 +106,12 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
         .collect()
 }
 
-/// Compiles `spec` into a plan. `towns` maps each town name of the spec to its prepared road network.
+/// Compiles `spec` into a plan; `spec_dir` is recorded for resolving the spec's relative paths. `towns` maps each town name of the spec to its prepared road network.
 /// With `only`, plans just that clip (its stratum is allocated in full, so the script is identical).
 pub fn plan(
     spec: &Spec,
     spec_hash: &str,
+    spec_dir: &str,
     towns: &BTreeMap<String, TownContext>,
     only: Option<&str>,
 ) -> Result<Plan, Vec<PlanProblem>> {
@@ -152,6 +153,8 @@ pub fn plan(
         spec_hash: spec_hash.to_owned(),
         target_crossing_ratio: spec.crossing.target_ratio,
         sim: SimParams::from_spec(spec),
+        spec: spec.clone(),
+        spec_dir: spec_dir.to_owned(),
         clips,
     })
 }

@@ -31,6 +31,11 @@ pub struct Plan {
     pub target_crossing_ratio: f64,
     /// Behaviour and traffic parameters shared by every clip.
     pub sim: SimParams,
+    /// The resolved spec the plan was compiled from (sensors, annotation rules, output encodings), so that a
+    /// plan file alone is enough to generate the dataset.
+    pub spec: Spec,
+    /// Directory the spec's relative paths (OpenDRIVE maps) resolve against, as it was given.
+    pub spec_dir: String,
     /// The clips.
     pub clips: Vec<ClipScript>,
 }

@@ -61,5 +61,8 @@ pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<S
 }
 
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WorldError> {
-    crate::fsutil::write_atomically(path, bytes).map_err(|source| WorldError::Io { path: path.display().to_string(), source })
+    crate::fsutil::write_atomically(path, bytes).map_err(|source| WorldError::Io {
+        path: path.display().to_string(),
+        source,
+    })
 }

@@ -603,7 +603,7 @@ impl RoadNetwork {
     pub fn crossing_at_3d(&self, p3: DVec3) -> Option<Crossing> {
         // Coarse steps with bisection at the curbs: lanes narrower than a step (curbs, borders) may be stepped
         // over, which does not matter here; sidewalks and driving lanes are much wider.
-        const STEP: f64 = 0.4;
+        const STEP: f64 = 0.8;
         let p = p3.truncate();
         let hit = if p3.z.is_nan() {
             self.lane_at(p)?
@@ -622,7 +622,7 @@ impl RoadNetwork {
         let is_sw = |t: f64| self.class(p + dir * t, z) == Some(LaneType::Sidewalk);
         // Bisect the boundary between `lo` (state a) and `hi` (state b).
         let bisect = |mut lo: f64, mut hi: f64, want_sidewalk_at_hi: bool| {
-            for _ in 0..8 {
+            for _ in 0..7 {
                 let mid = 0.5 * (lo + hi);
                 if is_sw(mid) == want_sidewalk_at_hi {
                     hi = mid;
@@ -695,7 +695,7 @@ impl RoadNetwork {
         let n = if side == Side::Left { left } else { -left };
         // Step outwards to the first sidewalk, then bisect its near and far edges (a few `lane_at` calls
         // instead of one per 10 cm: this is the planner's hottest query).
-        const STEP: f64 = 0.5;
+        const STEP: f64 = 1.0;
         let is_sw = |t: f64| self.class(pose.pos + n * t, pose.z_m) == Some(LaneType::Sidewalk);
         let bisect = |mut inside: f64, mut outside: f64| {
             for _ in 0..6 {
