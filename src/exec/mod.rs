@@ -9,4 +9,5 @@ pub mod annotate;
 pub mod body;
 pub mod camera;
 pub mod tables;
+pub mod stats;
 pub mod trace;

@@ -1,0 +1,261 @@
+//! `pedsynth stats DIR`: dataset statistics computed from the written tables only (the paper's Table 5 plus
+//! target vs achieved crossing ratio, state shares, per-archetype crossing rates and speeds, per-split counts).
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+use arrow_array::cast::AsArray;
+use arrow_array::types::{Float32Type, UInt32Type, UInt64Type};
+use arrow_array::{Array, RecordBatch};
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use serde::Serialize;
+
+/// Counts of one split.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SplitCounts {
+    /// Clips.
+    pub clips: u64,
+    /// Frames.
+    pub frames: u64,
+    /// Pedestrians.
+    pub pedestrians: u64,
+    /// Sequence-level crossers.
+    pub crossers: u64,
+    /// Annotated samples.
+    pub samples: u64,
+}
+
+/// Per-archetype figures.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ArchetypeStats {
+    /// Pedestrians.
+    pub pedestrians: u64,
+    /// Sequence-level crossers.
+    pub crossers: u64,
+    /// crossers / pedestrians.
+    pub crossing_rate: f64,
+    /// Mean speed over annotated samples where the pedestrian moves (> 0.2 m/s), m/s.
+    pub mean_moving_speed_mps: f64,
+}
+
+/// Dataset statistics.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct DatasetStats {
+    /// Clips.
+    pub clips: u64,
+    /// Frames.
+    pub frames: u64,
+    /// Mean frames per clip.
+    pub mean_frames_per_clip: f64,
+    /// Mean clip duration, seconds.
+    pub mean_duration_s: f64,
+    /// Unique pedestrians.
+    pub pedestrians: u64,
+    /// Sequence-level crossers (C = 1 in at least one annotated frame).
+    pub crossing: u64,
+    /// The others.
+    pub non_crossing: u64,
+    /// crossing / pedestrians.
+    pub crossing_share: f64,
+    /// non_crossing / pedestrians.
+    pub non_crossing_share: f64,
+    /// crossing / non_crossing.
+    pub c_nc_ratio: f64,
+    /// Annotated samples (pedestrian-frames).
+    pub annotated_samples: u64,
+    /// Mean annotated samples per clip.
+    pub samples_per_clip: f64,
+    /// Weathers.
+    pub weathers: Vec<String>,
+    /// Towns.
+    pub towns: Vec<String>,
+    /// Target crossing ratio (from the manifest).
+    pub target_crossing_ratio: Option<f64>,
+    /// Achieved sequence-level crossing ratio (= crossing_share).
+    pub achieved_crossing_ratio: f64,
+    /// Share of annotated samples in each behaviour state.
+    pub state_shares: BTreeMap<String, f64>,
+    /// Annotated samples with C = 1.
+    pub crossing_samples: u64,
+    /// Per archetype.
+    pub archetypes: BTreeMap<String, ArchetypeStats>,
+    /// Per split.
+    pub splits: BTreeMap<String, SplitCounts>,
+    /// Pedestrian-frames rejected by the visibility gate, by reason.
+    pub rejected: BTreeMap<String, u64>,
+    /// Vehicle contacts recorded.
+    pub contacts: u64,
+}
+
+fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, String> {
+    let file = File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format!("{}: {e}", path.display()))?;
+    let schema = builder.parquet_schema();
+    let indices: Vec<usize> = columns
+        .iter()
+        .map(|c| schema.columns().iter().position(|col| col.path().parts()[0] == *c).ok_or_else(|| format!("{}: no column `{c}`", path.display())))
+        .collect::<Result<_, _>>()?;
+    let mask = parquet::arrow::ProjectionMask::roots(schema, indices);
+    let reader = builder.with_projection(mask).build().map_err(|e| format!("{}: {e}", path.display()))?;
+    reader.collect::<Result<Vec<_>, _>>().map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn files(dir: &Path, table: &str) -> Result<Vec<PathBuf>, String> {
+    let d = dir.join("tables").join(table);
+    let mut out: Vec<PathBuf> = std::fs::read_dir(&d)
+        .map_err(|e| format!("{}: {e} (is this a pedsynth dataset?)", d.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+fn col<'a>(batch: &'a RecordBatch, name: &str) -> &'a dyn Array {
+    batch.column_by_name(name).map(|c| c.as_ref()).expect("projected column")
+}
+
+/// Computes the statistics of the dataset in `dir` from its tables.
+pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
+    let mut s = DatasetStats::default();
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json")).ok().and_then(|t| serde_json::from_str(&t).ok());
+    s.target_crossing_ratio = manifest.as_ref().and_then(|m| m["target_crossing_ratio"].as_f64());
+    let mut towns = std::collections::BTreeSet::new();
+    let mut weathers = std::collections::BTreeSet::new();
+    let mut duration_s = 0.0;
+    let mut states: BTreeMap<String, u64> = BTreeMap::new();
+    let mut speed_sums: BTreeMap<String, (f64, u64)> = BTreeMap::new();
+    for path in files(dir, "clips")? {
+        let mut split = String::new();
+        for b in read_table(&path, &["town", "weather", "split", "frame_count", "duration_s", "annotated_samples", "rejected_too_far", "rejected_behind", "rejected_too_small", "rejected_outside_image", "rejected_occluded", "contacts"])? {
+            for i in 0..b.num_rows() {
+                let town = col(&b, "town").as_string::<i32>().value(i).to_owned();
+                let weather = col(&b, "weather").as_string::<i32>().value(i).to_owned();
+                split = col(&b, "split").as_string::<i32>().value(i).to_owned();
+                let frames = u64::from(col(&b, "frame_count").as_primitive::<UInt32Type>().value(i));
+                let samples = col(&b, "annotated_samples").as_primitive::<UInt64Type>().value(i);
+                s.clips += 1;
+                s.frames += frames;
+                s.annotated_samples += samples;
+                duration_s += col(&b, "duration_s").as_primitive::<arrow_array::types::Float64Type>().value(i);
+                s.contacts += u64::from(col(&b, "contacts").as_primitive::<UInt32Type>().value(i));
+                for reason in ["too_far", "behind", "too_small", "outside_image", "occluded"] {
+                    *s.rejected.entry(reason.to_owned()).or_default() += col(&b, &format!("rejected_{reason}")).as_primitive::<UInt64Type>().value(i);
+                }
+                let sp = s.splits.entry(split.clone()).or_default();
+                sp.clips += 1;
+                sp.frames += frames;
+                sp.samples += samples;
+                towns.insert(town);
+                weathers.insert(weather);
+            }
+        }
+        let clip_id = path.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_default();
+        // Pedestrians of this clip: sequence labels and archetypes.
+        let mut archetype_of: Vec<String> = Vec::new();
+        for b in read_table(&dir.join("tables/pedestrians").join(format!("{clip_id}.parquet")), &["pedestrian", "archetype", "crosser"])? {
+            for i in 0..b.num_rows() {
+                let id = col(&b, "pedestrian").as_primitive::<UInt32Type>().value(i) as usize;
+                let archetype = col(&b, "archetype").as_string::<i32>().value(i).to_owned();
+                let crosser = col(&b, "crosser").as_boolean().value(i);
+                if archetype_of.len() <= id {
+                    archetype_of.resize(id + 1, String::new());
+                }
+                archetype_of[id] = archetype.clone();
+                s.pedestrians += 1;
+                s.crossing += u64::from(crosser);
+                let a = s.archetypes.entry(archetype).or_default();
+                a.pedestrians += 1;
+                a.crossers += u64::from(crosser);
+                let sp = s.splits.entry(split.clone()).or_default();
+                sp.pedestrians += 1;
+                sp.crossers += u64::from(crosser);
+            }
+        }
+        for b in read_table(&dir.join("tables/annotations").join(format!("{clip_id}.parquet")), &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"])? {
+            let ped = col(&b, "pedestrian").as_primitive::<UInt32Type>();
+            let state = col(&b, "state").as_string::<i32>();
+            let crossing = col(&b, "crossing").as_boolean();
+            let vx = col(&b, "vx_mps").as_primitive::<Float32Type>();
+            let vy = col(&b, "vy_mps").as_primitive::<Float32Type>();
+            for i in 0..b.num_rows() {
+                *states.entry(state.value(i).to_owned()).or_default() += 1;
+                s.crossing_samples += u64::from(crossing.value(i));
+                let speed = f64::from(vx.value(i)).hypot(f64::from(vy.value(i)));
+                if speed > 0.2
+                    && let Some(a) = archetype_of.get(ped.value(i) as usize)
+                {
+                    let e = speed_sums.entry(a.clone()).or_default();
+                    e.0 += speed;
+                    e.1 += 1;
+                }
+            }
+        }
+    }
+    s.non_crossing = s.pedestrians - s.crossing;
+    let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+    s.crossing_share = ratio(s.crossing, s.pedestrians);
+    s.non_crossing_share = ratio(s.non_crossing, s.pedestrians);
+    s.c_nc_ratio = ratio(s.crossing, s.non_crossing);
+    s.achieved_crossing_ratio = s.crossing_share;
+    s.mean_frames_per_clip = ratio(s.frames, s.clips);
+    s.mean_duration_s = if s.clips == 0 { 0.0 } else { duration_s / s.clips as f64 };
+    s.samples_per_clip = ratio(s.annotated_samples, s.clips);
+    let total: u64 = states.values().sum();
+    s.state_shares = states.into_iter().map(|(k, v)| (k, ratio(v, total))).collect();
+    for (name, a) in &mut s.archetypes {
+        a.crossing_rate = ratio(a.crossers, a.pedestrians);
+        if let Some((sum, n)) = speed_sums.get(name) {
+            a.mean_moving_speed_mps = sum / *n as f64;
+        }
+    }
+    s.towns = towns.into_iter().collect();
+    s.weathers = weathers.into_iter().collect();
+    Ok(s)
+}
+
+/// Renders the statistics as text (the paper's Table 5 first).
+pub fn render_text(s: &DatasetStats) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "Dataset statistics (from the tables)");
+    let _ = writeln!(o, "  clips                      {}", s.clips);
+    let _ = writeln!(o, "  frames                     {}", s.frames);
+    let _ = writeln!(o, "  avg frames per clip        {:.1}", s.mean_frames_per_clip);
+    let _ = writeln!(o, "  avg clip duration          {:.1} s", s.mean_duration_s);
+    let _ = writeln!(o, "  unique pedestrians         {}", s.pedestrians);
+    let _ = writeln!(o, "    crossing (C)             {} ({:.1}%)", s.crossing, 100.0 * s.crossing_share);
+    let _ = writeln!(o, "    non-crossing (NC)        {} ({:.1}%)", s.non_crossing, 100.0 * s.non_crossing_share);
+    let _ = writeln!(o, "  C/NC ratio                 {:.2}:1", s.c_nc_ratio);
+    let _ = writeln!(o, "  annotated samples          {}", s.annotated_samples);
+    let _ = writeln!(o, "  avg samples per clip       {:.0}", s.samples_per_clip);
+    let _ = writeln!(o, "  weathers                   {} ({})", s.weathers.len(), s.weathers.join(", "));
+    let _ = writeln!(o, "  towns                      {} ({})", s.towns.len(), s.towns.join(", "));
+    match s.target_crossing_ratio {
+        Some(t) => {
+            let _ = writeln!(o, "\ncrossing ratio: target {:.3}, achieved {:.3} ({:+.1} pp)", t, s.achieved_crossing_ratio, 100.0 * (s.achieved_crossing_ratio - t));
+        }
+        None => {
+            let _ = writeln!(o, "\ncrossing ratio: achieved {:.3}", s.achieved_crossing_ratio);
+        }
+    }
+    let _ = writeln!(o, "\nshare of annotated samples per state");
+    for (k, v) in &s.state_shares {
+        let _ = writeln!(o, "  {k:<20} {:6.2}%", 100.0 * v);
+    }
+    let _ = writeln!(o, "\nper archetype                pedestrians crossers  rate   moving speed");
+    for (k, a) in &s.archetypes {
+        let _ = writeln!(o, "  {k:<26} {:>9} {:>8} {:5.1}%  {:.2} m/s", a.pedestrians, a.crossers, 100.0 * a.crossing_rate, a.mean_moving_speed_mps);
+    }
+    let _ = writeln!(o, "\nper split");
+    for (k, sp) in &s.splits {
+        let _ = writeln!(o, "  {k:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers {:>9} samples", sp.clips, sp.frames, sp.pedestrians, sp.crossers, sp.samples);
+    }
+    let _ = writeln!(o, "\nvisibility gate rejections (pedestrian-frames)");
+    for (k, v) in &s.rejected {
+        let _ = writeln!(o, "  {k:<14} {v}");
+    }
+    let _ = writeln!(o, "vehicle contacts             {}", s.contacts);
+    o
+}
