@@ -266,3 +266,40 @@ proptest! {
         assert_valid_spawns(&towns, &plan);
     }
 }
+
+/// Golden statistics (text and JSON) for every shipped spec, and the full plan of the quickstart.
+/// Update with `INSTA_UPDATE=always cargo test`; read the diff before committing.
+#[test]
+fn golden_plan_statistics_for_every_shipped_spec() {
+    let mut specs: Vec<_> = std::fs::read_dir(root().join("specs")).unwrap().map(|e| e.unwrap().path()).collect();
+    specs.sort();
+    for path in specs {
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let (loaded, towns, plan) = compile(&format!("specs/{name}.yaml"), &[]);
+        assert_valid_spawns(&towns, &plan);
+        assert_quotas(&loaded, &plan);
+        let stats = planner::stats::compute(&plan, &loaded.spec);
+        insta::with_settings!({snapshot_path => "golden/plan", prepend_module_to_snapshot => false, omit_expression => true}, {
+            insta::assert_snapshot!(format!("{name}.stats.txt"), planner::stats::render_text(&stats));
+            insta::assert_json_snapshot!(format!("{name}.stats.json"), stats);
+            if name == "quickstart" {
+                insta::assert_json_snapshot!("quickstart.plan.json", plan);
+            }
+        });
+    }
+}
+
+#[test]
+fn pedsynth_pp_plans_600_clips_at_the_target_ratio() {
+    let (loaded, _, plan) = compile("specs/pedsynth_pp.yaml", &[]);
+    assert_eq!(plan.clips.len(), 600);
+    let stats = planner::stats::compute(&plan, &loaded.spec);
+    assert_eq!(stats.cells.len(), 48);
+    assert!((stats.planned_crossing_ratio - 0.6).abs() < 0.005, "{}", stats.planned_crossing_ratio);
+    for weather in pedsynth::dsl::types::WeatherPreset::ALL {
+        let n = plan.clips.iter().filter(|c| c.weather == weather.name()).count();
+        assert_eq!(n, 50, "{}", weather.name());
+    }
+    let test_split = plan.clips.iter().filter(|c| c.town == "town05_like").all(|c| c.split == pedsynth::dsl::types::Split::Test);
+    assert!(test_split);
+}

@@ -10,8 +10,7 @@ use world_common::*;
 fn load(town: &str) -> RoadNetwork {
     let path = carla_dir().join(format!("{town}.xodr"));
     let t = std::time::Instant::now();
-    let net =
-        RoadNetwork::from_xodr_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let net = RoadNetwork::from_xodr_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     eprintln!("{town}: loaded in {:?}", t.elapsed());
     net
 }

@@ -76,7 +76,10 @@ impl PedState {
 
     /// Whether the state is crossing-type (the paper's label condition (i)).
     pub fn is_crossing(self) -> bool {
-        matches!(self, Self::CrossingRoad | Self::SuddenCrossing | Self::Jaywalking | Self::RunningAcross | Self::PausingMidCross)
+        matches!(
+            self,
+            Self::CrossingRoad | Self::SuddenCrossing | Self::Jaywalking | Self::RunningAcross | Self::PausingMidCross
+        )
     }
 }
 

@@ -427,31 +427,33 @@ fn plan_clip(
     let ahead_max = l1.spawn_ahead_m.max().max(spec.annotations.visibility.max_distance_m);
     let needed_m = ahead_max + MAX_URBAN_SPEED_MPS * duration_s + spec.traffic.ego.route_margin_m;
 
-    // The ego route, with room ahead for every pedestrian.
-    let route = net
-        .random_route(&mut rng, needed_m)
-        .ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+    // The ego route, with room ahead for every pedestrian; a route along which the clip's pedestrians or
+    // vehicles cannot be placed is replaced by another (a few tries), then the clip is infeasible.
     let ego_spec = &spec.traffic.ego;
-    let ego = EgoScript {
-        route: route_script(&route, 0.0),
-        speed_below_limit_pct: rng
-            .random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
-        min_gap_m: ego_spec.min_gap_m,
-        brake_ahead_m: ego_spec.brake_ahead_m,
-        brake_lateral_m: ego_spec.brake_lateral_m,
+    let mut last_error = String::new();
+    let mut planned = None;
+    for _ in 0..ROUTE_ATTEMPTS {
+        let route = net.random_route(&mut rng, needed_m).ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+        let ego = EgoScript {
+            route: route_script(&route, 0.0),
+            speed_below_limit_pct: rng.random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
+            min_gap_m: ego_spec.min_gap_m,
+            brake_ahead_m: ego_spec.brake_ahead_m,
+            brake_lateral_m: ego_spec.brake_lateral_m,
+        };
+        let placed = plan_pedestrians(spec, net, &route, peds, first_ped, archetype_names, duration_s, &mut rng)
+            .and_then(|pedestrians| plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng).map(|v| (pedestrians, v)));
+        match placed {
+            Ok((pedestrians, vehicles)) => {
+                planned = Some((ego, pedestrians, vehicles));
+                break;
+            }
+            Err(e) => last_error = e,
+        }
+    }
+    let Some((ego, pedestrians, vehicles)) = planned else {
+        return Err(format!("{last_error} (tried {ROUTE_ATTEMPTS} ego routes)"));
     };
-
-    let pedestrians = plan_pedestrians(
-        spec,
-        net,
-        &route,
-        peds,
-        first_ped,
-        archetype_names,
-        duration_s,
-        &mut rng,
-    )?;
-    let vehicles = plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng)?;
 
     Ok(ClipScript {
         clip_id: basics.clip_id.clone(),
@@ -490,6 +492,8 @@ fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
     }
 }
 
+/// Ego routes tried before a clip is declared infeasible.
+const ROUTE_ATTEMPTS: usize = 8;
 /// Minimum distance between two pedestrians' spawn points, metres.
 const PED_SPACING_M: f64 = 1.0;
 /// Attempts to place one pedestrian before the clip is declared infeasible.

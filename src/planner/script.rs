@@ -7,7 +7,9 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::dsl::types::{Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Spec, Split, SpeedProfiles, WeatherParams};
+use crate::dsl::types::{
+    Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Spec, SpeedProfiles, Split, WeatherParams,
+};
 
 /// Version of the plan format.
 pub const PLAN_FORMAT_VERSION: u32 = 1;

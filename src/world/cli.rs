@@ -7,9 +7,7 @@ use crate::world::{BUILTIN_TOWN_NAMES, RoadNetwork, WorldError, builtin};
 
 /// The text `pedsynth town list` prints: one line per built-in town with its character and size.
 pub fn town_list_text() -> String {
-    let mut out = String::from(
-        "Built-in towns (procedural, modelled on the paper's CARLA towns; not CARLA's maps):\n",
-    );
+    let mut out = String::from("Built-in towns (procedural, modelled on the paper's CARLA towns; not CARLA's maps):\n");
     for name in BUILTIN_TOWN_NAMES {
         let desc = builtin::description(name).unwrap_or("");
         match RoadNetwork::builtin(name) {
@@ -23,7 +21,9 @@ pub fn town_list_text() -> String {
             None => out.push_str(&format!("  {name:<12} {desc}\n")),
         }
     }
-    out.push_str("Any OpenDRIVE file (.xodr 1.4-1.7) can be given by path instead, e.g. ../shared/maps/carla/Town01.xodr\n");
+    out.push_str(
+        "Any OpenDRIVE file (.xodr 1.4-1.7) can be given by path instead, e.g. ../shared/maps/carla/Town01.xodr\n",
+    );
     out
 }
 

@@ -244,8 +244,7 @@ impl LaneIndex {
                 continue;
             }
             let (t, lat, _) = project(&piece.corners, p);
-            let w =
-                piece.width_m[0] as f64 + (piece.width_m[1] as f64 - piece.width_m[0] as f64) * t;
+            let w = piece.width_m[0] as f64 + (piece.width_m[1] as f64 - piece.width_m[0] as f64) * t;
             let mut score = lat.abs() / (0.5 * w).max(1e-3);
             // Lanes of no particular type (OpenDRIVE `none`, ...) lose against any typed lane they overlap.
             if net.lanes[piece.lane as usize].lane_type == LaneType::Other {
@@ -340,9 +339,6 @@ mod tests {
         assert!(!in_quad(&c, DVec2::new(3.0, 0.5)));
         assert!((quad_dist(&c, DVec2::new(3.0, 0.5)) - 1.0).abs() < 1e-12);
         let (t, lat, _) = project(&c, DVec2::new(1.0, 0.75));
-        assert!(
-            (t - 0.5).abs() < 1e-12 && (lat - 0.25).abs() < 1e-12,
-            "{t} {lat}"
-        );
+        assert!((t - 0.5).abs() < 1e-12 && (lat - 0.25).abs() < 1e-12, "{t} {lat}");
     }
 }

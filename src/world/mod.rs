@@ -42,8 +42,7 @@ pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSampl
 
 /// Names of the built-in procedural towns, in the order `pedsynth town list` shows them. They are modelled on
 /// the paper's CARLA towns but are not CARLA's maps, hence the `_like` suffix.
-pub const BUILTIN_TOWN_NAMES: [&str; 4] =
-    ["town01_like", "town02_like", "town03_like", "town05_like"];
+pub const BUILTIN_TOWN_NAMES: [&str; 4] = ["town01_like", "town02_like", "town03_like", "town05_like"];
 
 /// Converts a point from this crate's right-handed frame to CARLA's left-handed world frame.
 pub fn to_carla(p: DVec3) -> DVec3 {
@@ -65,27 +64,15 @@ pub enum WorldError {
         code(pedsynth::world::xodr_syntax),
         help("the file must be a well-formed OpenDRIVE 1.4-1.7 document")
     )]
-    XodrSyntax {
-        path: String,
-        line: u32,
-        message: String,
-    },
+    XodrSyntax { path: String, line: u32, message: String },
     /// The XML is well-formed but its content is unusable (missing geometry, NaN, absurd values, ...).
     #[error("{path}:{line}: invalid OpenDRIVE: {message}")]
     #[diagnostic(code(pedsynth::world::xodr_invalid))]
-    XodrInvalid {
-        path: String,
-        line: u32,
-        message: String,
-    },
+    XodrInvalid { path: String, line: u32, message: String },
     /// The file (or the network it describes) exceeds the size caps that protect us from hostile input.
     #[error("{path}:{line}: OpenDRIVE input too large: {message}")]
     #[diagnostic(code(pedsynth::world::xodr_too_large))]
-    XodrTooLarge {
-        path: String,
-        line: u32,
-        message: String,
-    },
+    XodrTooLarge { path: String, line: u32, message: String },
     /// The file could not be read.
     #[error("cannot read {path}: {source}")]
     #[diagnostic(code(pedsynth::world::io))]
@@ -98,18 +85,14 @@ pub enum WorldError {
     #[error("unknown town {name:?}")]
     #[diagnostic(
         code(pedsynth::world::unknown_town),
-        help(
-            "built-in towns: town01_like, town02_like, town03_like, town05_like; or give a path to an .xodr file"
-        )
+        help("built-in towns: town01_like, town02_like, town03_like, town05_like; or give a path to an .xodr file")
     )]
     UnknownTown { name: String },
 }
 
 /// What a lane is for. Unknown OpenDRIVE types map to `Other`; `curb` maps to `Border`; the driving-like types
 /// (`entry`, `exit`, `onRamp`, `offRamp`, `connectingRamp`, `bidirectional`, `stop`) map to `Driving`.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, serde::Deserialize,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LaneType {
     Driving,
@@ -126,8 +109,9 @@ impl LaneType {
     /// Parses an OpenDRIVE lane type attribute (case-insensitive, lenient).
     pub fn from_xodr(s: &str) -> LaneType {
         match s.to_ascii_lowercase().as_str() {
-            "driving" | "entry" | "exit" | "onramp" | "offramp" | "connectingramp"
-            | "bidirectional" | "stop" => LaneType::Driving,
+            "driving" | "entry" | "exit" | "onramp" | "offramp" | "connectingramp" | "bidirectional" | "stop" => {
+                LaneType::Driving
+            }
             "sidewalk" | "walking" => LaneType::Sidewalk,
             "shoulder" => LaneType::Shoulder,
             "parking" => LaneType::Parking,
@@ -388,11 +372,7 @@ impl RoadNetwork {
             return Err(WorldError::XodrTooLarge {
                 path: shown,
                 line: 1,
-                message: format!(
-                    "file is {} bytes, the cap is {}",
-                    meta.len(),
-                    opendrive::MAX_FILE_BYTES
-                ),
+                message: format!("file is {} bytes, the cap is {}", meta.len(), opendrive::MAX_FILE_BYTES),
             });
         }
         let bytes = std::fs::read(path).map_err(|source| WorldError::Io {
@@ -454,11 +434,7 @@ impl RoadNetwork {
     /// The nearest driving lane with a travel direction within `max_distance_m` of `p`.
     pub fn nearest_driving_lane(&self, p: DVec2, max_distance_m: f64) -> Option<LaneHit> {
         self.index.nearest(self, p, max_distance_m, |l| {
-            l.lane_type == LaneType::Driving
-                && matches!(
-                    l.travel,
-                    TravelDirection::Forward | TravelDirection::Backward
-                )
+            l.lane_type == LaneType::Driving && matches!(l.travel, TravelDirection::Forward | TravelDirection::Backward)
         })
     }
 
@@ -470,12 +446,7 @@ impl RoadNetwork {
     /// Summary figures for `town show --json` and golden tests.
     pub fn summary(&self) -> TownSummary {
         let km = |t: LaneType| {
-            let m: f64 = self
-                .lanes
-                .iter()
-                .filter(|l| l.lane_type == t)
-                .map(|l| l.length_m)
-                .sum();
+            let m: f64 = self.lanes.iter().filter(|l| l.lane_type == t).map(|l| l.length_m).sum();
             (m / 10.0).round() / 100.0
         };
         let r1 = |v: f64| (v * 10.0).round() / 10.0;

@@ -31,11 +31,7 @@ fn aabb(o: &Obstacle) -> Aabb {
         hi = hi.max(c);
     }
     Aabb::new(
-        Vec3::new(
-            lo.x as f32 - 0.01,
-            lo.y as f32 - 0.01,
-            o.base_z_m as f32 - 0.01,
-        ),
+        Vec3::new(lo.x as f32 - 0.01, lo.y as f32 - 0.01, o.base_z_m as f32 - 0.01),
         Vec3::new(
             hi.x as f32 + 0.01,
             hi.y as f32 + 0.01,
@@ -50,11 +46,7 @@ fn ray_obb(o: &Obstacle, from: DVec3, dir: DVec3, max_t: f64) -> Option<f64> {
     let ax = DVec2::new(c, s);
     let ay = DVec2::new(-s, c);
     let rel = from.truncate() - o.centre;
-    let o3 = [
-        rel.dot(ax),
-        rel.dot(ay),
-        from.z - (o.base_z_m + 0.5 * o.height_m),
-    ];
+    let o3 = [rel.dot(ax), rel.dot(ay), from.z - (o.base_z_m + 0.5 * o.height_m)];
     let d3 = [dir.truncate().dot(ax), dir.truncate().dot(ay), dir.z];
     let h3 = [o.half_extents_m.x, o.half_extents_m.y, 0.5 * o.height_m];
     let (mut t0, mut t1) = (0.0f64, max_t);
@@ -94,7 +86,7 @@ impl ObstacleIndex {
         let bvh = self.bvh.as_ref()?;
         let d = to - from;
         let len = d.length();
-        if !(len > 1e-9) || !len.is_finite() {
+        if len.is_nan() || len <= 1e-9 || !len.is_finite() {
             return None;
         }
         let dir = d / len;
@@ -220,12 +212,8 @@ mod tests {
             .unwrap();
         assert!(hit > 7.0 && hit < 8.5, "{hit}");
         assert!(
-            idx.first_hit(
-                &[o],
-                DVec3::new(0.0, 0.0, 11.0),
-                DVec3::new(20.0, 0.0, 11.0)
-            )
-            .is_none()
+            idx.first_hit(&[o], DVec3::new(0.0, 0.0, 11.0), DVec3::new(20.0, 0.0, 11.0))
+                .is_none()
         );
         assert!(
             idx.first_hit(&[o], DVec3::new(0.0, 5.0, 1.0), DVec3::new(20.0, 5.0, 1.0))

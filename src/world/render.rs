@@ -43,9 +43,9 @@ struct Canvas {
 impl Canvas {
     fn blend(&mut self, x: usize, y: usize, c: [u8; 3], alpha: f64) {
         let i = (y * self.w + x) * 3;
-        for k in 0..3 {
-            let old = self.px[i + k] as f64;
-            self.px[i + k] = (old + (c[k] as f64 - old) * alpha).round() as u8;
+        for (dst, &src) in self.px[i..i + 3].iter_mut().zip(c.iter()) {
+            let old = *dst as f64;
+            *dst = (old + (src as f64 - old) * alpha).round() as u8;
         }
     }
 
@@ -208,10 +208,7 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
     }
     // Travel-direction ticks on driving lanes: a short light stroke every ~20 m pointing along travel.
     for (i, lane) in net.lanes.iter().enumerate() {
-        if lane.lane_type != LaneType::Driving
-            || lane.in_junction
-            || lane.travel == TravelDirection::Undirected
-        {
+        if lane.lane_type != LaneType::Driving || lane.in_junction || lane.travel == TravelDirection::Undirected {
             continue;
         }
         let c = net.lane_centre_line(i as u32);
@@ -225,12 +222,7 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
                 let tip = w[1];
                 let tail = tip - dir * 2.5;
                 let side = DVec2::new(-dir.y, dir.x) * 0.8;
-                cv.line(
-                    to_px(tail),
-                    to_px(tip),
-                    (0.25 * scale).max(1.0),
-                    [230, 230, 120],
-                );
+                cv.line(to_px(tail), to_px(tip), (0.25 * scale).max(1.0), [230, 230, 120]);
                 cv.line(
                     to_px(tip),
                     to_px(tip - dir * 1.0 + side),
@@ -255,25 +247,17 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
     }
     // Scale bar, bottom left.
     let target = 0.2 * w as f64 / scale;
-    let bar_m = [
-        5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
-    ]
-    .into_iter()
-    .rev()
-    .find(|&m| m <= target)
-    .unwrap_or(5.0);
+    let bar_m = [5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0]
+        .into_iter()
+        .rev()
+        .find(|&m| m <= target)
+        .unwrap_or(5.0);
     let bar_px = (bar_m * scale).round() as i64;
     let (x0, y0) = (12i64, h as i64 - 30);
     let label = format!("{}m", bar_m as i64);
     let s = 2;
     let text_w = label.len() as i64 * 4 * s;
-    cv.rect(
-        x0 - 6,
-        y0 - 16,
-        x0 + bar_px.max(text_w) + 6,
-        y0 + 16,
-        [255, 255, 255],
-    );
+    cv.rect(x0 - 6, y0 - 16, x0 + bar_px.max(text_w) + 6, y0 + 16, [255, 255, 255]);
     cv.rect(x0, y0 + 2, x0 + bar_px, y0 + 8, [0, 0, 0]);
     cv.rect(x0, y0 - 2, x0 + 2, y0 + 12, [0, 0, 0]);
     cv.rect(x0 + bar_px - 2, y0 - 2, x0 + bar_px, y0 + 12, [0, 0, 0]);

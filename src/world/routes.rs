@@ -20,10 +20,7 @@ const JOIN_HEADING_RAD: f64 = 0.6;
 
 /// Centre-line points of a lane, in its direction of travel (reference direction if undirected).
 pub(crate) fn lane_centre_line(net: &RoadNetwork, lane: u32) -> Vec<DVec2> {
-    lane_centre_points(net, lane)
-        .into_iter()
-        .map(|(p, _)| p)
-        .collect()
+    lane_centre_points(net, lane).into_iter().map(|(p, _)| p).collect()
 }
 
 /// Centre-line points with the elevation of their piece.
@@ -71,10 +68,7 @@ impl LaneGraph {
         let mut entries: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
         for (i, l) in net.lanes.iter().enumerate() {
             if l.lane_type != LaneType::Driving
-                || !matches!(
-                    l.travel,
-                    TravelDirection::Forward | TravelDirection::Backward
-                )
+                || !matches!(l.travel, TravelDirection::Forward | TravelDirection::Backward)
             {
                 continue;
             }
@@ -108,11 +102,8 @@ impl LaneGraph {
                             if j as usize == i {
                                 continue;
                             }
-                            let (entry, entry_h, _, _) =
-                                ends[j as usize].expect("indexed lanes have ends");
-                            if (entry - exit).length() <= JOIN_M
-                                && angle_diff(entry_h, exit_h) <= JOIN_HEADING_RAD
-                            {
+                            let (entry, entry_h, _, _) = ends[j as usize].expect("indexed lanes have ends");
+                            if (entry - exit).length() <= JOIN_M && angle_diff(entry_h, exit_h) <= JOIN_HEADING_RAD {
                                 found.push(j);
                             }
                         }
@@ -169,9 +160,7 @@ impl Route {
     /// Interpolated pose at arc length `s_m` (clamped to the route).
     pub fn pose_at(&self, s_m: f64) -> RoutePoint {
         let pts = &self.points;
-        let i = pts
-            .partition_point(|p| p.s_m <= s_m)
-            .clamp(1, pts.len().max(2) - 1);
+        let i = pts.partition_point(|p| p.s_m <= s_m).clamp(1, pts.len().max(2) - 1);
         if pts.len() < 2 {
             return pts[0];
         }
@@ -383,11 +372,7 @@ impl SidewalkGraph {
         self.nodes
             .iter()
             .enumerate()
-            .min_by(|a, b| {
-                (*a.1 - p)
-                    .length_squared()
-                    .total_cmp(&(*b.1 - p).length_squared())
-            })
+            .min_by(|a, b| (*a.1 - p).length_squared().total_cmp(&(*b.1 - p).length_squared()))
             .map(|(i, _)| i as u32)
     }
 
@@ -484,9 +469,7 @@ impl RoadNetwork {
     /// A route of at least `min_length_m` starting at a random lane outside junctions; tries up to 200 starts.
     pub fn random_route(&self, rng: &mut impl Rng, min_length_m: f64) -> Option<Route> {
         let starts: Vec<u32> = (0..self.lanes.len() as u32)
-            .filter(|&l| {
-                !self.lanes[l as usize].in_junction && !self.lane_graph.successors(l).is_empty()
-            })
+            .filter(|&l| !self.lanes[l as usize].in_junction && !self.lane_graph.successors(l).is_empty())
             .collect();
         if starts.is_empty() {
             return None;
@@ -538,11 +521,7 @@ impl RoadNetwork {
             if succ.is_empty() {
                 return None;
             }
-            let fresh: Vec<u32> = succ
-                .iter()
-                .copied()
-                .filter(|x| !visited.contains(x))
-                .collect();
+            let fresh: Vec<u32> = succ.iter().copied().filter(|x| !visited.contains(x)).collect();
             let pool = if fresh.is_empty() { succ } else { &fresh[..] };
             cur = pool[rng.random_range(0..pool.len())];
         }
@@ -550,11 +529,7 @@ impl RoadNetwork {
             return None;
         }
         for i in 0..points.len() {
-            let (a, b) = if i + 1 < points.len() {
-                (i, i + 1)
-            } else {
-                (i - 1, i)
-            };
+            let (a, b) = if i + 1 < points.len() { (i, i + 1) } else { (i - 1, i) };
             points[i].heading_rad = heading(points[a].pos, points[b].pos);
         }
         Some(Route { points })
@@ -696,9 +671,7 @@ impl RoadNetwork {
             }
         }
         let t0 = t;
-        while self.class(pose.pos + n * (t + 0.1), pose.z_m) == Some(LaneType::Sidewalk)
-            && t < t0 + 8.0
-        {
+        while self.class(pose.pos + n * (t + 0.1), pose.z_m) == Some(LaneType::Sidewalk) && t < t0 + 8.0 {
             t += 0.1;
         }
         let mid = 0.5 * (t0 + t);

@@ -35,12 +35,7 @@ pub fn classification(net: &RoadNetwork, t: LaneType, n: usize, seed: u64) -> (u
     let mut misses = Vec::new();
     for _ in 0..n {
         let pi = pieces[rng.random_range(0..pieces.len())];
-        let p = point_in_piece(
-            net,
-            pi,
-            rng.random_range(0.05..0.95),
-            rng.random_range(0.2..0.8),
-        );
+        let p = point_in_piece(net, pi, rng.random_range(0.05..0.95), rng.random_range(0.2..0.8));
         let z = net.pieces[pi].z_m as f64;
         match net.lane_at_3d(p.extend(z)) {
             Some(h) if h.lane_type == t => ok += 1,
@@ -80,12 +75,7 @@ pub fn assert_route(net: &RoadNetwork, min_m: f64) {
         let mut on_driving = 0;
         for w in r.points.windows(2) {
             let gap = (w[1].pos - w[0].pos).length();
-            assert!(
-                gap < 3.0,
-                "{}: route jumps {gap:.2} m at s={:.1}",
-                net.name,
-                w[0].s_m
-            );
+            assert!(gap < 3.0, "{}: route jumps {gap:.2} m at s={:.1}", net.name, w[0].s_m);
             assert!(w[1].s_m > w[0].s_m);
         }
         for p in &r.points {
@@ -119,9 +109,7 @@ pub fn assert_crossings(net: &RoadNetwork, min_found: f64) {
         .filter(|&i| {
             let p = &net.pieces[i];
             let l = &net.lanes[p.lane as usize];
-            l.lane_type == LaneType::Sidewalk
-                && !l.in_junction
-                && p.width_m[0].min(p.width_m[1]) > 1.0
+            l.lane_type == LaneType::Sidewalk && !l.in_junction && p.width_m[0].min(p.width_m[1]) > 1.0
         })
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -167,10 +155,7 @@ pub fn assert_crossings(net: &RoadNetwork, min_found: f64) {
         );
     }
     let frac = found as f64 / n as f64;
-    eprintln!(
-        "{}: crossings found for {found}/{n} sidewalk points",
-        net.name
-    );
+    eprintln!("{}: crossings found for {found}/{n} sidewalk points", net.name);
     assert!(
         frac >= min_found,
         "{}: crossings found for only {frac:.2} of sidewalk points",

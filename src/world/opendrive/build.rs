@@ -10,9 +10,12 @@ use super::geometry::{Poly3At, eval_piecewise};
 use super::parse::{RawNetwork, RawRoad, RawSection};
 use super::{MAX_PIECES, MAX_WIDTH_M};
 use crate::world::{
-    Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, Road, RoadNetwork, TownSource,
-    TravelDirection, WorldError, index, obstacles, routes,
+    Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, Road, RoadNetwork, TownSource, TravelDirection,
+    WorldError, index, obstacles, routes,
 };
+
+/// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
+type Station = (DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>);
 
 /// Default speed limit when a file gives none: 50 km/h.
 const DEFAULT_SPEED_MPS: f64 = 50.0 / 3.6;
@@ -20,18 +23,12 @@ const DEFAULT_SPEED_MPS: f64 = 50.0 / 3.6;
 /// 1-based line of byte offset `pos` in `xml` (1 when `xml` is empty, as for built-in towns).
 pub(crate) fn line_of(xml: &str, pos: u32) -> u32 {
     let end = (pos as usize).min(xml.len());
-    1 + xml.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count() as u32
+    1 + xml.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() as u32
 }
 
 /// Reference-line position and heading at `s`.
 pub(crate) fn ref_at(road: &RawRoad, s: f64) -> (DVec2, f64) {
-    let gi = road
-        .geometries
-        .partition_point(|g| g.s <= s + 1e-9)
-        .saturating_sub(1);
+    let gi = road.geometries.partition_point(|g| g.s <= s + 1e-9).saturating_sub(1);
     let g = &road.geometries[gi];
     g.eval(s - g.s)
 }
@@ -50,12 +47,8 @@ struct Borders {
 
 /// Order of lanes inside a section: left lanes by increasing id, then right lanes by decreasing id.
 fn section_order(sec: &RawSection) -> Vec<usize> {
-    let mut left: Vec<usize> = (0..sec.lanes.len())
-        .filter(|&i| sec.lanes[i].id > 0)
-        .collect();
-    let mut right: Vec<usize> = (0..sec.lanes.len())
-        .filter(|&i| sec.lanes[i].id < 0)
-        .collect();
+    let mut left: Vec<usize> = (0..sec.lanes.len()).filter(|&i| sec.lanes[i].id > 0).collect();
+    let mut right: Vec<usize> = (0..sec.lanes.len()).filter(|&i| sec.lanes[i].id < 0).collect();
     left.sort_by_key(|&i| sec.lanes[i].id);
     right.sort_by_key(|&i| -sec.lanes[i].id);
     left.extend(right);
@@ -137,10 +130,7 @@ fn stations(road: &RawRoad, a: f64, b: f64, out: &mut Vec<f64>) {
     for w in cuts.windows(2) {
         let (s0, s1) = (w[0], w[1]);
         let mid = 0.5 * (s0 + s1);
-        let gi = road
-            .geometries
-            .partition_point(|g| g.s <= mid)
-            .saturating_sub(1);
+        let gi = road.geometries.partition_point(|g| g.s <= mid).saturating_sub(1);
         let k = road.geometries[gi].max_curvature();
         let step = if k > 1e-9 {
             (0.16 / k).sqrt().clamp(0.25, 2.0)
@@ -188,10 +178,7 @@ pub(crate) fn build_with(
         let lane_start = lanes.len() as u32;
         for (si, sec) in road.sections.iter().enumerate() {
             let a = sec.s.min(road.length);
-            let b = road
-                .sections
-                .get(si + 1)
-                .map_or(road.length, |n| n.s.min(road.length));
+            let b = road.sections.get(si + 1).map_or(road.length, |n| n.s.min(road.length));
             if b - a < 1e-3 {
                 continue;
             }
@@ -205,19 +192,12 @@ pub(crate) fn build_with(
             }
             let order = section_order(sec);
             // Per station: reference point, normal, z, per-lane borders.
-            let mut per_station: Vec<(DVec2, DVec2, f64, f64, Vec<(f64, f64, f64)>)> =
-                Vec::with_capacity(st.len());
+            let mut per_station: Vec<Station> = Vec::with_capacity(st.len());
             for &s in &st {
                 let (p, h) = ref_at(road, s);
                 borders_at(xml, road, sec, &order, s, path, &mut borders)?;
                 let z = eval_piecewise(&road.elevations, s);
-                per_station.push((
-                    p,
-                    left_normal(h),
-                    z,
-                    borders.carriageway_m,
-                    borders.lanes.clone(),
-                ));
+                per_station.push((p, left_normal(h), z, borders.carriageway_m, borders.lanes.clone()));
             }
             let speed_road = road
                 .speeds
@@ -231,11 +211,7 @@ pub(crate) fn build_with(
                 let travel = match (rl.lane_type, rl.travel) {
                     (
                         LaneType::Driving,
-                        Some(
-                            t @ (TravelDirection::Forward
-                            | TravelDirection::Backward
-                            | TravelDirection::Both),
-                        ),
+                        Some(t @ (TravelDirection::Forward | TravelDirection::Backward | TravelDirection::Both)),
                     ) => t,
                     (LaneType::Driving, _) => {
                         if (rl.id < 0) != road.lht {
@@ -294,9 +270,7 @@ pub(crate) fn build_with(
             successor: road.successor.clone(),
         });
     }
-    let live = pieces
-        .iter()
-        .filter(|p| p.width_m[0].max(p.width_m[1]) > 0.01);
+    let live = pieces.iter().filter(|p| p.width_m[0].max(p.width_m[1]) > 0.01);
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
     for p in live {
@@ -396,11 +370,7 @@ fn object_polygon(road: &RawRoad, ri: u32, o: &super::parse::RawObject) -> Cross
 
 /// Crosswalks across every non-junction road end that meets a junction and has sidewalks on both sides:
 /// 3 m deep, starting 0.5 m from the road end, spanning between the inner sidewalk borders.
-fn synthesize_crosswalks(
-    raw: &RawNetwork,
-    path: &str,
-    xml: &str,
-) -> Result<Vec<Crosswalk>, WorldError> {
+fn synthesize_crosswalks(raw: &RawNetwork, path: &str, xml: &str) -> Result<Vec<Crosswalk>, WorldError> {
     let mut out = Vec::new();
     let mut b = Borders {
         lanes: Vec::new(),
@@ -410,9 +380,7 @@ fn synthesize_crosswalks(
         if road.junction.is_some() || road.length < 10.0 || road.sections.is_empty() {
             continue;
         }
-        let at_junction = |l: &Option<crate::world::RoadLink>| {
-            l.as_ref().is_some_and(|l| l.element_type == "junction")
-        };
+        let at_junction = |l: &Option<crate::world::RoadLink>| l.as_ref().is_some_and(|l| l.element_type == "junction");
         for (is_start, linked) in [
             (true, at_junction(&road.predecessor)),
             (false, at_junction(&road.successor)),
@@ -428,10 +396,7 @@ fn synthesize_crosswalks(
             let mut ts = [(0.0, 0.0); 2];
             let mut ok = true;
             for (k, s) in [s0, s1].into_iter().enumerate() {
-                let si = road
-                    .sections
-                    .partition_point(|x| x.s <= s)
-                    .saturating_sub(1);
+                let si = road.sections.partition_point(|x| x.s <= s).saturating_sub(1);
                 let sec = &road.sections[si];
                 let order = section_order(sec);
                 borders_at(xml, road, sec, &order, s, path, &mut b)?;
@@ -439,9 +404,7 @@ fn synthesize_crosswalks(
                     order
                         .iter()
                         .filter(|&&i| (sec.lanes[i].id > 0) == left)
-                        .find(|&&i| {
-                            sec.lanes[i].lane_type == LaneType::Sidewalk && b.lanes[i].2 > 0.5
-                        })
+                        .find(|&&i| sec.lanes[i].lane_type == LaneType::Sidewalk && b.lanes[i].2 > 0.5)
                         .map(|&i| b.lanes[i].0)
                 };
                 match (inner(false), inner(true)) {
@@ -457,12 +420,7 @@ fn synthesize_crosswalks(
                 p + left_normal(h) * t
             };
             out.push(Crosswalk {
-                polygon: vec![
-                    pt(s0, ts[0].0),
-                    pt(s1, ts[1].0),
-                    pt(s1, ts[1].1),
-                    pt(s0, ts[0].1),
-                ],
+                polygon: vec![pt(s0, ts[0].0), pt(s1, ts[1].0), pt(s1, ts[1].1), pt(s0, ts[0].1)],
                 road: ri as u32,
                 synthesized: true,
             });

@@ -115,17 +115,11 @@ impl<'a, 'i> Ctx<'a, 'i> {
             Ok(x) if x.is_finite() => Ok(Some(x)),
             Ok(_) => Err(self.invalid(
                 n,
-                format!(
-                    "<{}> attribute {attr}=\"{v}\" is not finite",
-                    n.tag_name().name()
-                ),
+                format!("<{}> attribute {attr}=\"{v}\" is not finite", n.tag_name().name()),
             )),
             Err(_) => Err(self.invalid(
                 n,
-                format!(
-                    "<{}> attribute {attr}=\"{v}\" is not a number",
-                    n.tag_name().name()
-                ),
+                format!("<{}> attribute {attr}=\"{v}\" is not a number", n.tag_name().name()),
             )),
         }
     }
@@ -138,10 +132,7 @@ impl<'a, 'i> Ctx<'a, 'i> {
         self.num(n, attr)?.ok_or_else(|| {
             self.invalid(
                 n,
-                format!(
-                    "<{}> is missing the required attribute {attr}",
-                    n.tag_name().name()
-                ),
+                format!("<{}> is missing the required attribute {attr}", n.tag_name().name()),
             )
         })
     }
@@ -150,10 +141,7 @@ impl<'a, 'i> Ctx<'a, 'i> {
         if v < lo || v > hi {
             return Err(self.invalid(
                 n,
-                format!(
-                    "<{}> {attr}={v} is outside [{lo}, {hi}]",
-                    n.tag_name().name()
-                ),
+                format!("<{}> {attr}={v} is outside [{lo}, {hi}]", n.tag_name().name()),
             ));
         }
         Ok(v)
@@ -209,7 +197,16 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
     };
     let doc = Document::parse_with_options(xml, opts).map_err(|e| WorldError::XodrSyntax {
         path: path.into(),
-        line: e.pos().row,
+        // roxmltree reports the end of a truncated document at 1:1; the end is the last line.
+        line: match e {
+            roxmltree::Error::UnexpectedEndOfStream => 1 + xml.bytes().filter(|&b| b == b'\n').count() as u32,
+            // DTDs are refused (entity expansion attacks); roxmltree gives no position for that.
+            roxmltree::Error::DtdDetected => {
+                let at = xml.find("<!DOCTYPE").unwrap_or(0);
+                1 + xml[..at].bytes().filter(|&b| b == b'\n').count() as u32
+            }
+            _ => e.pos().row,
+        },
         message: e.to_string(),
     })?;
     let cx = Ctx { doc: &doc, path };
@@ -217,10 +214,7 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
     if !root.tag_name().name().eq_ignore_ascii_case("OpenDRIVE") {
         return Err(cx.invalid(
             root,
-            format!(
-                "root element is <{}>, expected <OpenDRIVE>",
-                root.tag_name().name()
-            ),
+            format!("root element is <{}>, expected <OpenDRIVE>", root.tag_name().name()),
         ));
     }
     let mut net = RawNetwork::default();
@@ -260,9 +254,7 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
         name: n.attribute("name").unwrap_or("").to_string(),
         length: 0.0,
         junction,
-        lht: n
-            .attribute("rule")
-            .is_some_and(|r| r.eq_ignore_ascii_case("LHT")),
+        lht: n.attribute("rule").is_some_and(|r| r.eq_ignore_ascii_case("LHT")),
         pos,
         predecessor: None,
         successor: None,
@@ -296,17 +288,10 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
         road.geometries.push(geom);
     }
     if road.geometries.is_empty() {
-        return Err(cx.invalid(
-            pv,
-            format!("road {:?} has no <geometry> in its <planView>", road.id),
-        ));
+        return Err(cx.invalid(pv, format!("road {:?} has no <geometry> in its <planView>", road.id)));
     }
     road.geometries.sort_by(|a, b| a.s.total_cmp(&b.s));
-    let geom_end = road
-        .geometries
-        .iter()
-        .map(|g| g.s + g.length)
-        .fold(0.0, f64::max);
+    let geom_end = road.geometries.iter().map(|g| g.s + g.length).fold(0.0, f64::max);
     road.length = match cx.num(n, "length")? {
         Some(l) => cx.bounded(n, "length", l, 0.0, MAX_LENGTH_M)?,
         None => geom_end,
@@ -353,10 +338,7 @@ fn parse_geometry(cx: &Ctx, g: Node, running_s: f64) -> Result<Geometry, WorldEr
     let length = cx.req(g, "length")?;
     cx.bounded(g, "length", length, 0.0, MAX_LENGTH_M)?;
     let Some(shape) = g.children().find(|c| c.is_element()) else {
-        return Err(cx.invalid(
-            g,
-            "<geometry> has no shape (line, arc, spiral, poly3 or paramPoly3)",
-        ));
+        return Err(cx.invalid(g, "<geometry> has no shape (line, arc, spiral, poly3 or paramPoly3)"));
     };
     let curv = |attr: &str| -> Result<f64, WorldError> {
         let k = cx.num_or(shape, attr, 0.0)?;
@@ -426,10 +408,7 @@ fn parse_section(cx: &Ctx, sec: Node, lht: bool) -> Result<RawSection, WorldErro
             for w in children(l, "width") {
                 let p = cx.poly(w, "sOffset")?;
                 if p.c[0] > MAX_WIDTH_M || p.c[0] < -MAX_WIDTH_M {
-                    return Err(cx.invalid(
-                        w,
-                        format!("lane width a={} is absurd (cap {MAX_WIDTH_M} m)", p.c[0]),
-                    ));
+                    return Err(cx.invalid(w, format!("lane width a={} is absurd (cap {MAX_WIDTH_M} m)", p.c[0])));
                 }
                 widths.push(p);
             }
@@ -438,10 +417,7 @@ fn parse_section(cx: &Ctx, sec: Node, lht: bool) -> Result<RawSection, WorldErro
             if let Some(sp) = child(l, "speed")
                 && let Some(v) = cx.num(sp, "max")?
             {
-                speed = Some(speed_mps(
-                    cx.bounded(sp, "max", v, 0.0, 1000.0)?,
-                    sp.attribute("unit"),
-                ));
+                speed = Some(speed_mps(cx.bounded(sp, "max", v, 0.0, 1000.0)?, sp.attribute("unit")));
             }
             // Travel direction: OpenDRIVE 1.7 `direction`, RoadRunner's `vectorLane travelDir`, else the rule.
             let mut travel = match l.attribute("direction") {
@@ -492,12 +468,8 @@ fn parse_junction(cx: &Ctx, n: Node) -> Result<RawJunction, WorldError> {
     for c in children(n, "connection") {
         let mut lane_links = Vec::new();
         for ll in children(c, "laneLink") {
-            let from = ll
-                .attribute("from")
-                .and_then(|v| v.trim().parse::<i32>().ok());
-            let to = ll
-                .attribute("to")
-                .and_then(|v| v.trim().parse::<i32>().ok());
+            let from = ll.attribute("from").and_then(|v| v.trim().parse::<i32>().ok());
+            let to = ll.attribute("to").and_then(|v| v.trim().parse::<i32>().ok());
             match (from, to) {
                 (Some(f), Some(t)) => lane_links.push((f, t)),
                 _ => return Err(cx.invalid(ll, "<laneLink> needs integer from and to attributes")),
@@ -530,8 +502,7 @@ fn parse_object(cx: &Ctx, o: Node) -> Result<RawObject, WorldError> {
     cx.bounded(o, "width", width, 0.0, 1e4)?;
     let mut outline = Vec::new();
     let mut road_coords = false;
-    let outline_node =
-        child(o, "outline").or_else(|| child(o, "outlines").and_then(|os| child(os, "outline")));
+    let outline_node = child(o, "outline").or_else(|| child(o, "outlines").and_then(|os| child(os, "outline")));
     if let Some(ol) = outline_node {
         for c in ol.children().filter(|c| c.is_element()) {
             match c.tag_name().name() {
