@@ -109,6 +109,8 @@ struct Sim<'a> {
     views: Vec<PedView>,
     accels: Vec<f64>,
     leader_facts: Vec<Option<LeaderFacts>>,
+    /// Where each vehicle's path crosses another's (found once at set-up).
+    zones: Vec<Vec<vehicle::ConflictZone>>,
     ped_contact: Vec<bool>,
     vehicle_contact: Vec<bool>,
 }
@@ -136,9 +138,13 @@ impl<'a> Sim<'a> {
                 peds[i].leader = Some(l);
                 peds[l].followers.push(i);
                 // A follower sharing its leader's crossing line walks a parallel one through its own spawn.
+                // So does one whose own line is not parallel to its leader's or much wider or narrower.
                 if let (Some(fl), Some(ll)) = (peds[i].line, peds[l].line)
-                    && fl.near_curb.distance(ll.near_curb) < 1e-6
+                    && (fl.near_curb.distance(ll.near_curb) < 1e-6
+                        || fl.dir.dot(ll.dir) < 0.95
+                        || (fl.width_m - ll.width_m).abs() > 0.15 * ll.width_m)
                 {
+                    peds[i].line = Some(ll);
                     let d = s.spawn - ll.near_curb;
                     let shift = d - ll.dir * d.dot(ll.dir);
                     let line = peds[i].line.as_mut().expect("checked");
@@ -163,6 +169,7 @@ impl<'a> Sim<'a> {
         for p in peds.iter_mut() {
             p.update_head(0.0, &vehicles);
         }
+        let zones = vehicle::conflict_zones(&vehicles);
         let trace = ClipTrace {
             clip_id: script.clip_id.clone(),
             fps,
@@ -185,6 +192,7 @@ impl<'a> Sim<'a> {
             views: Vec::with_capacity(np),
             accels: Vec::with_capacity(nv),
             leader_facts: vec![None; np],
+            zones,
             ped_contact: vec![false; nv * np],
             vehicle_contact: vec![false; nv * nv],
         }
@@ -305,7 +313,7 @@ impl<'a> Sim<'a> {
         }));
         self.accels.clear();
         for i in 0..self.vehicles.len() {
-            self.accels.push(vehicle::accel_for(i, &self.vehicles, &self.views, &self.params.idm));
+            self.accels.push(vehicle::accel_for(i, &self.vehicles, &self.zones[i], &self.views, &self.params.idm));
         }
         // 6. Integrate.
         for (v, &a) in self.vehicles.iter_mut().zip(&self.accels) {

@@ -34,6 +34,8 @@ const CONFLICT_CLEAR_S: f64 = 0.5;
 /// A vehicle slower than this is not a lookahead conflict (it has stopped for the pedestrian; counting it would
 /// make both wait forever), m/s.
 const CONFLICT_MIN_VEHICLE_SPEED_MPS: f64 = 0.5;
+/// A pedestrian blocked this long by a standing vehicle steps back to the curb (not a retreat draw), seconds.
+const BLOCKED_RETREAT_S: f64 = 3.0;
 /// How long a distraction (phone) pause mid-road lasts, seconds.
 const DISTRACTION_PAUSE_S: f64 = 1.0;
 /// Range of a phone-use episode, seconds.
@@ -44,6 +46,8 @@ const FINISH_BEYOND_CURB_M: f64 = 0.3;
 const STRIDE_M: f64 = 1.4;
 /// Pedestrians closer than this push each other apart in AI mode, metres.
 const AVOID_RADIUS_M: f64 = 1.0;
+/// A crosser on the road runs when a vehicle would arrive within this fraction of its own TTC threshold.
+const RUN_TTC_FRACTION: f64 = 0.5;
 /// Share of non-crossers that stand still (waiting, chatting) rather than walk.
 const STANDING_SHARE: f64 = 0.2;
 
@@ -255,6 +259,8 @@ pub(crate) struct Ped {
     pub ego_ahead: bool,
     /// Vehicle id of a lookahead conflict this step (own probes).
     pub conflict_vehicle: Option<u32>,
+    /// The conflict is a standing vehicle blocking the way.
+    pub blocked_by_standing: bool,
     /// Speed of the group crossing (leaders), m/s.
     pub group_speed_mps: f64,
 }
@@ -331,6 +337,7 @@ impl Ped {
             ego_dist_m: f64::INFINITY,
             ego_ahead: true,
             conflict_vehicle: None,
+            blocked_by_standing: false,
             group_speed_mps: 0.0,
         };
         if let Some(h) = net.lane_at(p.pos) {
@@ -408,8 +415,18 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
         probes,
     );
     let r = params.lookahead.radius_m;
+    p.blocked_by_standing = false;
     for v in vehicles {
         if v.speed_mps < CONFLICT_MIN_VEHICLE_SPEED_MPS {
+            // A standing vehicle only matters when it physically blocks the next step.
+            let next = p.pos + dir * params.lookahead.points_m.first().copied().unwrap_or(0.5);
+            if ttc::distance_to_box_m(next, v.pose.pos, v.pose.heading_rad, HALF_LENGTH_M, HALF_WIDTH_M)
+                < super::PED_RADIUS_M + 0.2
+            {
+                p.conflict_vehicle = Some(v.id);
+                p.blocked_by_standing = true;
+                break;
+            }
             continue;
         }
         if v.pose.pos.distance_squared(p.pos) > (r + 2.5 + HALF_LENGTH_M + 2.0).powi(2) {
@@ -623,7 +640,7 @@ pub(crate) fn transition(
                 p.resume = p.state;
                 p.pause_is_distraction = false;
                 set_state(p, PedState::PausingMidCross, frame, events);
-            } else if along > 0.0 && p.state != PedState::RunningAcross && p.min_ttc_s < p.ttc_threshold_s {
+            } else if along > 0.0 && p.state != PedState::RunningAcross && p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s {
                 // A vehicle is approaching while on the road: run.
                 switch_profile(p, params, SpeedProfile::Rushed);
                 set_state(p, PedState::RunningAcross, frame, events);
@@ -640,11 +657,15 @@ pub(crate) fn transition(
             }
             if group_conflict.is_some() {
                 p.conflict_clear_s = 0.0;
+                if p.blocked_by_standing && t >= BLOCKED_RETREAT_S {
+                    // Blocked by a vehicle that waits for us: step back to the curb and let it go.
+                    set_state(p, PedState::Retreat, frame, events);
+                }
             } else {
                 p.conflict_clear_s += ctx.dt_s;
                 if p.conflict_clear_s >= CONFLICT_CLEAR_S {
                     p.conflict_active = false;
-                    let next = if p.min_ttc_s < p.ttc_threshold_s { PedState::RunningAcross } else { p.resume };
+                    let next = if p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s { PedState::RunningAcross } else { p.resume };
                     if next == PedState::RunningAcross {
                         switch_profile(p, params, SpeedProfile::Rushed);
                     }
@@ -771,29 +792,36 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     let dt = ctx.dt_s;
     let old = p.pos;
     let manual = p.is_crossing_motion() || p.state == PedState::FinishedCrossing;
-    let mut new_pos = old;
+    let mut new_pos;
     if manual && let Some(line) = p.line {
         let along = line.along_m(old);
-        let target_along = match (leader, p.state) {
-            (Some(l), s) if s != PedState::FinishedCrossing => l.fraction * line.width_m,
-            _ => {
-                let speed = match p.state {
-                    PedState::PausingMidCross => 0.0,
-                    PedState::Retreat => p.retreat_speed_mps,
-                    _ if p.group_speed_mps > 0.0 && p.state != PedState::FinishedCrossing => p.group_speed_mps,
-                    _ => p.own_speed_mps(m),
-                };
-                if p.state == PedState::Retreat {
-                    (along - speed * dt).max(-CURB_STANDOFF_M)
-                } else {
-                    (along + speed * dt).min(line.end_along_m())
-                }
-            }
-        };
-        // Manual control: along the crossing vector, pulled back onto the line if off it.
         let on_line = line.near_curb + line.dir * along;
         let off = old - on_line;
-        new_pos = line.near_curb + line.dir * target_along + off * 0.8;
+        if let (Some(l), false) = (leader, p.state == PedState::FinishedCrossing) {
+            // Followers keep their leader's progress along their own line.
+            let step = line.near_curb + line.dir * (l.fraction * line.width_m) + off * 0.8 - old;
+            let max_step = p.base_speed_mps * m.rushed.max(profile_multiplier(m, p.profile)) * dt;
+            let len = step.length();
+            new_pos = if len > max_step && len > 0.0 { old + step * (max_step / len) } else { old + step };
+        } else {
+            let speed = match p.state {
+                PedState::PausingMidCross => 0.0,
+                PedState::Retreat => p.retreat_speed_mps,
+                _ if p.group_speed_mps > 0.0 && p.state != PedState::FinishedCrossing => p.group_speed_mps,
+                _ => p.own_speed_mps(m),
+            };
+            let target_along = if p.state == PedState::Retreat {
+                (along - speed * dt).max(-CURB_STANDOFF_M)
+            } else {
+                (along + speed * dt).min(line.end_along_m())
+            };
+            // Manual control: along the crossing vector, pulled back onto the line if off it, never faster
+            // than the state's speed.
+            let step = line.near_curb + line.dir * target_along + off * 0.8 - old;
+            let max_step = speed * dt;
+            let len = step.length();
+            new_pos = if len > max_step && len > 0.0 { old + step * (max_step / len) } else { old + step };
+        }
     } else {
         let speed = match p.state {
             PedState::DistractedBehavior => {

@@ -347,7 +347,13 @@ fn lookahead_m(v: f64, idm: &Idm) -> f64 {
 /// The longitudinal acceleration of vehicle `i` this step: IDM towards the most constraining leader among the
 /// other vehicles, the pedestrians in its path (walkers are ignored by vehicles that ignore them until an
 /// emergency stop is needed), the ego's braking rule and the end of its route.
-pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], peds: &[PedView], idm: &Idm) -> f64 {
+pub(crate) fn accel_for(
+    i: usize,
+    vehicles: &[Vehicle],
+    zones: &[ConflictZone],
+    peds: &[PedView],
+    idm: &Idm,
+) -> f64 {
     let me = &vehicles[i];
     let v = me.speed_mps;
     let look = lookahead_m(v, idm);
@@ -380,6 +386,12 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], peds: &[PedView], idm: &
             continue;
         }
         accel = accel.min(idm_to(gap, lead_speed));
+    }
+
+    for zone in zones {
+        if let Some(gap) = zone_yield_gap_m(me, vehicles, zone, look) {
+            accel = accel.min(idm_to(gap, 0.0));
+        }
     }
 
     let emergency_gap = v * v / (2.0 * idm.max_decel_mps2.max(0.5)) + me.min_gap_m;
@@ -416,6 +428,137 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], peds: &[PedView], idm: &
         }
     }
     accel
+}
+
+/// Where two vehicles' paths cross or merge: the stretch of each path whose centre line comes within
+/// [`ZONE_DISTANCE_M`] of the other's at a heading difference above [`ZONE_MIN_ANGLE_RAD`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ConflictZone {
+    /// Index of the other vehicle.
+    pub other: usize,
+    /// The zone on this vehicle's path, arc lengths `[start, end]`.
+    pub me_m: (f64, f64),
+    /// The zone on the other's path.
+    pub other_m: (f64, f64),
+}
+
+/// Centre lines closer than this belong to a conflict zone, metres.
+const ZONE_DISTANCE_M: f64 = 2.5;
+/// Paths meeting at less than this angle are following, not crossing, radians.
+const ZONE_MIN_ANGLE_RAD: f64 = 0.35;
+/// How far ahead of its start a vehicle's path is searched for conflict zones, metres.
+const ZONE_HORIZON_M: f64 = 260.0;
+/// Samples of one path closer than this along it belong to the same zone, metres.
+const ZONE_GAP_M: f64 = 10.0;
+
+/// The conflict zones of every vehicle with every other, found once at set-up with a 2 m grid over the path
+/// samples (1 m apart). Sorted by zone start; lookups only, so no hash order leaks out.
+pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
+    const CELL_M: f64 = 2.5;
+    let cell = |p: DVec2| ((p.x / CELL_M).floor() as i64, (p.y / CELL_M).floor() as i64);
+    // (vehicle, s, pos, heading)
+    let mut samples: Vec<(usize, f64, DVec2, f64)> = Vec::new();
+    for (i, v) in vehicles.iter().enumerate() {
+        let end = (v.s_m + ZONE_HORIZON_M).min(v.path.length_m());
+        let mut s = (v.s_m - VEHICLE_LENGTH_M).max(0.0);
+        while s <= end {
+            let pose = v.path.pose_at(s);
+            samples.push((i, s, pose.pos, pose.heading_rad));
+            s += 1.0;
+        }
+    }
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = std::collections::HashMap::new();
+    for (k, smp) in samples.iter().enumerate() {
+        grid.entry(cell(smp.2)).or_default().push(k as u32);
+    }
+    // Close pairs per ordered (i, j): (s_i, s_j).
+    let n = vehicles.len();
+    let mut pairs: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n * n];
+    for a in &samples {
+        let (cx, cy) = cell(a.2);
+        for y in cy - 1..=cy + 1 {
+            for x in cx - 1..=cx + 1 {
+                let Some(bucket) = grid.get(&(x, y)) else {
+                    continue;
+                };
+                for &kb in bucket {
+                    let b = &samples[kb as usize];
+                    if b.0 == a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
+                        continue;
+                    }
+                    let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
+                    if d > std::f64::consts::PI {
+                        d = std::f64::consts::TAU - d;
+                    }
+                    if d > ZONE_MIN_ANGLE_RAD {
+                        pairs[a.0 * n + b.0].push((a.1, b.1));
+                    }
+                }
+            }
+        }
+    }
+    let mut out = vec![Vec::new(); n];
+    for i in 0..n {
+        for j in 0..n {
+            let list = &mut pairs[i * n + j];
+            if list.is_empty() {
+                continue;
+            }
+            list.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+            let mut zone: Option<ConflictZone> = None;
+            for &(si, sj) in list.iter() {
+                match zone.as_mut() {
+                    Some(z) if si - z.me_m.1 <= ZONE_GAP_M => {
+                        z.me_m.1 = si;
+                        z.other_m.0 = z.other_m.0.min(sj);
+                        z.other_m.1 = z.other_m.1.max(sj);
+                    }
+                    _ => {
+                        if let Some(z) = zone.take() {
+                            out[i].push(z);
+                        }
+                        zone = Some(ConflictZone {
+                            other: j,
+                            me_m: (si, si),
+                            other_m: (sj, sj),
+                        });
+                    }
+                }
+            }
+            out[i].extend(zone);
+        }
+        out[i].sort_by(|a, b| a.me_m.0.total_cmp(&b.me_m.0).then(a.other.cmp(&b.other)));
+    }
+    out
+}
+
+/// The standing obstacle (gap from the front bumper, metres) at which vehicle `i` must yield in a conflict zone,
+/// if it must: a vehicle already in the zone goes first; otherwise the one that would reach it first (ties:
+/// the ego, then lower ids). Both vehicles evaluate the same rule, so exactly one of them yields.
+fn zone_yield_gap_m(me: &Vehicle, vehicles: &[Vehicle], zone: &ConflictZone, look: f64) -> Option<f64> {
+    let other = &vehicles[zone.other];
+    let my_front = me.s_m + HALF_LENGTH_M;
+    let other_front = other.s_m + HALF_LENGTH_M;
+    if me.s_m - HALF_LENGTH_M > zone.me_m.1 || other.s_m - HALF_LENGTH_M > zone.other_m.1 {
+        return None; // one of us has passed
+    }
+    let dist_me = zone.me_m.0 - my_front;
+    if dist_me > look {
+        return None;
+    }
+    let dist_other = zone.other_m.0 - other_front;
+    let (in_me, in_other) = (dist_me <= 0.0, dist_other <= 0.0);
+    let yield_now = match (in_me, in_other) {
+        (true, false) => false,
+        (false, true) => true,
+        (true, true) => priority(me.id) > priority(other.id),
+        (false, false) => {
+            let t_me = dist_me / me.speed_mps.max(0.5);
+            let t_other = dist_other / other.speed_mps.max(0.5);
+            t_other < t_me || (t_other == t_me && priority(other.id) < priority(me.id))
+        }
+    };
+    yield_now.then_some(dist_me - 1.0)
 }
 
 fn priority(id: u32) -> u64 {
