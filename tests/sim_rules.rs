@@ -204,12 +204,12 @@ fn assert_events_match_trace(trace: &ClipTrace) {
 #[test]
 fn a_closing_vehicle_below_the_threshold_makes_the_pedestrian_wait() {
     let net = road();
-    // Ego far behind (out of range); a traffic vehicle 45 m away closing at ~8.3 m/s: TTC ≈ 5.4 s, below the
-    // threshold 4 + 0.5 + 7 / 1.2 ≈ 10.3 s.
+    // The ego has passed (so only the gap matters); a traffic vehicle 45 m away closing at ~8.3 m/s: TTC ≈ 5.4 s,
+    // below the threshold 4 + 0.5 + 7 / 1.2 ≈ 10.3 s.
     let script = clip(
-        ego_at(&net, -45.0, 0.0),
+        ego_at(&net, 160.0, 0.0),
         vec![vehicle(&net, 0, false, 195.0, 0.0, false)],
-        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         5,
     );
     let trace = sim::simulate(&script, &params(), &net);
@@ -224,9 +224,9 @@ fn a_gap_above_the_threshold_is_accepted() {
     let net = road();
     // The same vehicle crawling at ~1 m/s: TTC ≈ 45 s.
     let script = clip(
-        ego_at(&net, -45.0, 0.0),
+        ego_at(&net, 160.0, 0.0),
         vec![vehicle(&net, 0, false, 195.0, 88.0, false)],
-        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         14,
     );
     let trace = sim::simulate(&script, &params(), &net);
@@ -261,11 +261,11 @@ fn a_gap_above_the_threshold_is_accepted() {
 #[test]
 fn a_vehicle_that_is_not_closing_does_not_block() {
     let net = road();
-    // A vehicle 10 m past the pedestrian, driving away at 8.3 m/s.
+    // A vehicle 10 m past the pedestrian, driving away at 8.3 m/s (the ego too).
     let script = clip(
-        ego_at(&net, -45.0, 0.0),
+        ego_at(&net, 170.0, 0.0),
         vec![vehicle(&net, 0, true, 160.0, 0.0, false)],
-        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         8,
     );
     let trace = sim::simulate(&script, &params(), &net);
@@ -374,11 +374,11 @@ fn groups_cross_together() {
 }
 
 fn patience_clip(net: &RoadNetwork, sudden_probability: f64) -> (ClipTrace, ClipScript) {
-    let mut p = crosser(net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline);
+    let mut p = crosser(net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated);
     p.patience_s = 2.0;
     p.ttc_threshold_s = 100.0;
     // A vehicle crawling towards the pedestrian keeps the TTC finite but below 100 s.
-    let script = clip(ego_at(net, -45.0, 0.0), vec![vehicle(net, 0, false, 200.0, 88.0, false)], vec![p], 10);
+    let script = clip(ego_at(net, 160.0, 0.0), vec![vehicle(net, 0, false, 200.0, 88.0, false)], vec![p], 10);
     let mut params = params();
     params.patience.sudden_crossing_probability = sudden_probability;
     (sim::simulate(&script, &params, net), script)
@@ -408,6 +408,23 @@ fn patience_expiry_can_abandon_the_attempt() {
     assert_eq!(first_in_road(&trace, 0), None);
     assert!(trace.pedestrians[0].iter().all(|f| f.lane_type != Some(LaneType::Driving)));
     assert_eq!(trace.pedestrians[0].last().expect("frames").state, PedState::WalkingSidewalk);
+}
+
+#[test]
+fn a_baseline_crosser_stops_and_checks_like_carla() {
+    let net = road();
+    // No decision window and no TTC threshold: it crosses once nothing is within 6 m or about to arrive, even
+    // with the ego approaching 50 m away.
+    let script = clip(
+        ego_at(&net, 100.0, 50.0),
+        vec![],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
+        10,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    let entered = first_in_road(&trace, 0).expect("crosses");
+    assert!(trace.ego[entered].pos.x < 150.0, "crossed in front of the ego");
+    assert_no_interpenetration(&trace);
 }
 
 #[test]

@@ -29,6 +29,8 @@ const CURB_STANDOFF_M: f64 = 0.3;
 const CHECK_MIN_S: f64 = 0.5;
 /// A jaywalker's brief check only waits while a vehicle would arrive within this time, seconds.
 const JAYWALK_MIN_TTC_S: f64 = 2.0;
+/// A baseline (CARLA-like) crosser waits until no vehicle is this close, metres (CARLA's stop-and-check).
+const BASELINE_CLEAR_M: f64 = 6.0;
 /// A conflict ends after the lookahead has been clear this long, seconds.
 const CONFLICT_CLEAR_S: f64 = 0.5;
 /// A vehicle slower than this is not a lookahead conflict (it has stopped for the pedestrian; counting it would
@@ -256,6 +258,8 @@ pub(crate) struct Ped {
     // Perception (from the state at the start of the step).
     pub min_ttc_s: f64,
     pub ego_dist_m: f64,
+    /// Distance to the nearest vehicle centre, metres.
+    pub nearest_vehicle_m: f64,
     pub ego_ahead: bool,
     /// Vehicle id of a lookahead conflict this step (own probes).
     pub conflict_vehicle: Option<u32>,
@@ -335,6 +339,7 @@ impl Ped {
             rng,
             min_ttc_s: f64::INFINITY,
             ego_dist_m: f64::INFINITY,
+            nearest_vehicle_m: f64::INFINITY,
             ego_ahead: true,
             conflict_vehicle: None,
             blocked_by_standing: false,
@@ -392,6 +397,7 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
         vehicles.iter().map(|v| (v.pose.pos, v.velocity())),
         params.gap_acceptance.vehicle_range_m,
     );
+    p.nearest_vehicle_m = vehicles.iter().map(|v| v.pose.pos.distance(p.pos)).fold(f64::INFINITY, f64::min);
     let ego = &vehicles[0];
     p.ego_dist_m = ego.pose.pos.distance(p.pos);
     p.ego_ahead = (p.pos - ego.pose.pos).dot(DVec2::from_angle(ego.pose.heading_rad)) > 0.0;
@@ -593,15 +599,25 @@ pub(crate) fn transition(
             if t < CHECK_MIN_S {
                 return;
             }
-            let window_ok = p.source == CrosserSource::Baseline || ego_in_window_or_past(p, params);
-            if window_ok && ttc::gap_accepted(p.min_ttc_s, gap_threshold_s(p, params)) {
+            let go = if p.source == CrosserSource::Baseline {
+                // CARLA's walkers stop and check: no vehicle within a few metres, none about to arrive.
+                p.nearest_vehicle_m > BASELINE_CLEAR_M && p.min_ttc_s > JAYWALK_MIN_TTC_S
+            } else {
+                ego_in_window_or_past(p, params) && ttc::gap_accepted(p.min_ttc_s, gap_threshold_s(p, params))
+            };
+            if go {
                 decide_to_cross(p, frame, events);
                 set_state(p, PedState::Hesitating, frame, events);
             }
         }
         PedState::Hesitating => {
             let threshold = gap_threshold_s(p, params);
-            if !ttc::gap_accepted(p.min_ttc_s, threshold) {
+            let lost = if p.source == CrosserSource::Baseline {
+                p.nearest_vehicle_m <= BASELINE_CLEAR_M || p.min_ttc_s <= JAYWALK_MIN_TTC_S
+            } else {
+                !ttc::gap_accepted(p.min_ttc_s, threshold)
+            };
+            if lost {
                 set_state(p, PedState::CheckingTraffic, frame, events);
             } else if t >= p.hesitation_s {
                 // Closing a tight gap: rushed.
@@ -800,7 +816,8 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
         if let (Some(l), false) = (leader, p.state == PedState::FinishedCrossing) {
             // Followers keep their leader's progress along their own line.
             let step = line.near_curb + line.dir * (l.fraction * line.width_m) + off * 0.8 - old;
-            let max_step = p.base_speed_mps * m.rushed.max(profile_multiplier(m, p.profile)) * dt;
+            // Never faster than its own speed in this state (with slack for a wider line than the leader's).
+            let max_step = 1.3 * p.own_speed_mps(m) * dt;
             let len = step.length();
             new_pos = if len > max_step && len > 0.0 { old + step * (max_step / len) } else { old + step };
         } else {
