@@ -271,7 +271,10 @@ proptest! {
 /// Update with `INSTA_UPDATE=always cargo test`; read the diff before committing.
 #[test]
 fn golden_plan_statistics_for_every_shipped_spec() {
-    let mut specs: Vec<_> = std::fs::read_dir(root().join("specs")).unwrap().map(|e| e.unwrap().path()).collect();
+    let mut specs: Vec<_> = std::fs::read_dir(root().join("specs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     specs.sort();
     for path in specs {
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
@@ -295,11 +298,19 @@ fn pedsynth_pp_plans_600_clips_at_the_target_ratio() {
     assert_eq!(plan.clips.len(), 600);
     let stats = planner::stats::compute(&plan, &loaded.spec);
     assert_eq!(stats.cells.len(), 48);
-    assert!((stats.planned_crossing_ratio - 0.6).abs() < 0.005, "{}", stats.planned_crossing_ratio);
+    assert!(
+        (stats.planned_crossing_ratio - 0.6).abs() < 0.005,
+        "{}",
+        stats.planned_crossing_ratio
+    );
     for weather in pedsynth::dsl::types::WeatherPreset::ALL {
         let n = plan.clips.iter().filter(|c| c.weather == weather.name()).count();
         assert_eq!(n, 50, "{}", weather.name());
     }
-    let test_split = plan.clips.iter().filter(|c| c.town == "town05_like").all(|c| c.split == pedsynth::dsl::types::Split::Test);
+    let test_split = plan
+        .clips
+        .iter()
+        .filter(|c| c.town == "town05_like")
+        .all(|c| c.split == pedsynth::dsl::types::Split::Test);
     assert!(test_split);
 }

@@ -11,7 +11,10 @@ use pedsynth::planner;
 fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn std::error::Error>> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/pedsynth_pp.yaml");
     let options = LoadOptions {
-        overrides: vec!["dataset.clips.count=4".to_owned(), "dataset.weathers=[clear_noon, night_rainy]".to_owned()],
+        overrides: vec![
+            "dataset.clips.count=4".to_owned(),
+            "dataset.weathers=[clear_noon, night_rainy]".to_owned(),
+        ],
         allow_large: true,
     };
     let loaded = dsl::load_file(&path, &options).map_err(|e| format!("{e:?}"))?;
@@ -29,7 +32,11 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     assert!(one == two, "1 vs 2 threads differ");
     assert!(two == again, "two runs differ");
     // A single clip alone gives the same trace as within the batch.
-    let alone = serde_json::to_string(&sim::simulate(&plan.clips[3], &plan.sim, &towns[&plan.clips[3].town].network))?;
+    let alone = serde_json::to_string(&sim::simulate(
+        &plan.clips[3],
+        &plan.sim,
+        &towns[&plan.clips[3].town].network,
+    ))?;
     assert!(one.1 == alone, "a clip alone differs from the same clip in a batch");
     Ok(())
 }

@@ -8,8 +8,8 @@ use pedsynth::dsl::types::{Body, Spec, WeatherParams};
 use pedsynth::exec::sim::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
 use pedsynth::exec::trace::{ClipTrace, EGO_ID, Event, PedState};
 use pedsynth::planner::{
-    Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef,
-    PedestrianScript, Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
+    Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef, PedestrianScript,
+    Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
 };
 use pedsynth::world::{LaneType, RoadNetwork};
 
@@ -173,14 +173,21 @@ fn assert_no_interpenetration(trace: &ClipTrace) {
                     VEHICLE_LENGTH_M / 2.0,
                     VEHICLE_WIDTH_M / 2.0,
                 );
-                assert!(d >= PED_RADIUS_M - 1e-9, "pedestrian {k} overlaps a vehicle at frame {f}");
+                assert!(
+                    d >= PED_RADIUS_M - 1e-9,
+                    "pedestrian {k} overlaps a vehicle at frame {f}"
+                );
             }
         }
     }
     assert!(
         !trace.events.iter().any(|e| matches!(e, Event::Contact { .. })),
         "contacts: {:?}",
-        trace.events.iter().filter(|e| matches!(e, Event::Contact { .. })).collect::<Vec<_>>()
+        trace
+            .events
+            .iter()
+            .filter(|e| matches!(e, Event::Contact { .. }))
+            .collect::<Vec<_>>()
     );
 }
 
@@ -215,7 +222,11 @@ fn a_closing_vehicle_below_the_threshold_makes_the_pedestrian_wait() {
     let trace = sim::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     assert_eq!(first_in_road(&trace, 0), None, "states: {:?}", states(&trace, 0));
-    assert!(trace.pedestrians[0].iter().any(|f| f.state == PedState::CheckingTraffic));
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .any(|f| f.state == PedState::CheckingTraffic)
+    );
     assert!(!trace.events.iter().any(|e| matches!(e, Event::CrossingDecision { .. })));
 }
 
@@ -301,7 +312,12 @@ fn the_lookahead_stops_a_crosser_before_a_vehicle_in_its_path() {
     let c = p.crossing.clone().expect("crossing");
     p.spawn = c.near_curb + c.direction * 2.0;
     p.spawn_place = SpawnPlace::DrivingLane;
-    let script = clip(ego_at(&net, -45.0, 0.0), vec![vehicle(&net, 0, false, 170.0, 0.0, true)], vec![p], 8);
+    let script = clip(
+        ego_at(&net, -45.0, 0.0),
+        vec![vehicle(&net, 0, false, 170.0, 0.0, true)],
+        vec![p],
+        8,
+    );
     let trace = sim::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     let s = states(&trace, 0);
@@ -310,8 +326,19 @@ fn the_lookahead_stops_a_crosser_before_a_vehicle_in_its_path() {
         s.contains(&PedState::PausingMidCross) || s.contains(&PedState::Retreat),
         "states: {s:?}"
     );
-    assert!(trace.events.iter().any(|e| matches!(e, Event::Conflict { vehicle: 0, .. })));
-    assert!(matches!(trace.events[0], Event::CrossingDecision { frame: 0, pedestrian: 0 }));
+    assert!(
+        trace
+            .events
+            .iter()
+            .any(|e| matches!(e, Event::Conflict { vehicle: 0, .. }))
+    );
+    assert!(matches!(
+        trace.events[0],
+        Event::CrossingDecision {
+            frame: 0,
+            pedestrian: 0
+        }
+    ));
     assert_no_interpenetration(&trace);
 }
 
@@ -351,7 +378,10 @@ fn groups_cross_together() {
             "states differ at frame {f}"
         );
     }
-    let (a, b) = (first_in_road(&trace, 0).expect("leader crosses"), first_in_road(&trace, 1).expect("follower crosses"));
+    let (a, b) = (
+        first_in_road(&trace, 0).expect("leader crosses"),
+        first_in_road(&trace, 1).expect("follower crosses"),
+    );
     assert!(a.abs_diff(b) <= 3, "entered the road at frames {a} and {b}");
     // Same decision frame.
     let decisions: Vec<_> = trace
@@ -378,7 +408,12 @@ fn patience_clip(net: &RoadNetwork, sudden_probability: f64) -> (ClipTrace, Clip
     p.patience_s = 2.0;
     p.ttc_threshold_s = 100.0;
     // A vehicle crawling towards the pedestrian keeps the TTC finite but below 100 s.
-    let script = clip(ego_at(net, 160.0, 0.0), vec![vehicle(net, 0, false, 200.0, 88.0, false)], vec![p], 10);
+    let script = clip(
+        ego_at(net, 160.0, 0.0),
+        vec![vehicle(net, 0, false, 200.0, 88.0, false)],
+        vec![p],
+        10,
+    );
     let mut params = params();
     params.patience.sudden_crossing_probability = sudden_probability;
     (sim::simulate(&script, &params, net), script)
@@ -390,7 +425,13 @@ fn patience_expiry_leads_to_a_sudden_crossing() {
     let (trace, _) = patience_clip(&net, 1.0);
     assert_events_match_trace(&trace);
     assert!(
-        trace.events.iter().any(|e| matches!(e, Event::PatienceExpired { sudden_crossing: true, .. })),
+        trace.events.iter().any(|e| matches!(
+            e,
+            Event::PatienceExpired {
+                sudden_crossing: true,
+                ..
+            }
+        )),
         "{:?}",
         states(&trace, 0)
     );
@@ -402,12 +443,23 @@ fn patience_expiry_leads_to_a_sudden_crossing() {
 fn patience_expiry_can_abandon_the_attempt() {
     let net = road();
     let (trace, _) = patience_clip(&net, 0.0);
-    assert!(
-        trace.events.iter().any(|e| matches!(e, Event::PatienceExpired { sudden_crossing: false, .. }))
-    );
+    assert!(trace.events.iter().any(|e| matches!(
+        e,
+        Event::PatienceExpired {
+            sudden_crossing: false,
+            ..
+        }
+    )));
     assert_eq!(first_in_road(&trace, 0), None);
-    assert!(trace.pedestrians[0].iter().all(|f| f.lane_type != Some(LaneType::Driving)));
-    assert_eq!(trace.pedestrians[0].last().expect("frames").state, PedState::WalkingSidewalk);
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .all(|f| f.lane_type != Some(LaneType::Driving))
+    );
+    assert_eq!(
+        trace.pedestrians[0].last().expect("frames").state,
+        PedState::WalkingSidewalk
+    );
 }
 
 #[test]
@@ -437,8 +489,15 @@ fn non_crossers_stay_on_the_sidewalk_and_sudden_crossers_go_without_checking() {
     let sudden = crosser(&net, 1, 150.0, Behaviour::Sudden, CrosserSource::Allocated);
     let script = clip(ego_at(&net, 80.0, 0.0), vec![], vec![walker, sudden], 10);
     let trace = sim::simulate(&script, &params(), &net);
-    assert!(trace.pedestrians[0].iter().all(|f| f.lane_type == Some(LaneType::Sidewalk)));
-    assert!(trace.pedestrians[0].last().expect("frames").pos.x > 105.0, "the walker walks");
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .all(|f| f.lane_type == Some(LaneType::Sidewalk))
+    );
+    assert!(
+        trace.pedestrians[0].last().expect("frames").pos.x > 105.0,
+        "the walker walks"
+    );
     let s = states(&trace, 1);
     assert_eq!(&s[..2], &[PedState::WalkingSidewalk, PedState::SuddenCrossing], "{s:?}");
     // Triggered by the ego entering the 40 m window.
@@ -459,13 +518,23 @@ fn non_crossers_stay_on_the_sidewalk_and_sudden_crossers_go_without_checking() {
 fn vehicles_follow_without_passing_through_each_other() {
     let net = road();
     // A slow vehicle ahead of the ego in the same lane.
-    let script = clip(ego_at(&net, 0.0, 0.0), vec![vehicle(&net, 0, true, 25.0, 70.0, false)], vec![], 15);
+    let script = clip(
+        ego_at(&net, 0.0, 0.0),
+        vec![vehicle(&net, 0, true, 25.0, 70.0, false)],
+        vec![],
+        15,
+    );
     let trace = sim::simulate(&script, &params(), &net);
     for f in 0..trace.frame_count as usize {
         let gap = trace.vehicles[0][f].pos.x - trace.ego[f].pos.x - VEHICLE_LENGTH_M;
         assert!(gap > 1.0, "gap {gap} at frame {f}");
     }
-    assert!(!trace.events.iter().any(|e| matches!(e, Event::Contact { vehicle: EGO_ID, .. })));
+    assert!(
+        !trace
+            .events
+            .iter()
+            .any(|e| matches!(e, Event::Contact { vehicle: EGO_ID, .. }))
+    );
     // It ends up following at about the leader's speed.
     let last = trace.ego.last().expect("frames");
     assert!((last.speed_mps - trace.vehicles[0].last().expect("frames").speed_mps).abs() < 0.5);

@@ -102,8 +102,10 @@ fn measure(plan: &Plan, traces: &[ClipTrace]) -> Stats {
                     ));
                 }
                 // Steady crossing (mid-road, same state as before): at least the slowest allowed speed.
-                let steady = matches!(f.state, PedState::CrossingRoad | PedState::Jaywalking | PedState::RunningAcross)
-                    && prev == f.state
+                let steady = matches!(
+                    f.state,
+                    PedState::CrossingRoad | PedState::Jaywalking | PedState::RunningAcross
+                ) && prev == f.state
                     && f.lane_type == Some(LaneType::Driving)
                     && frames.get(k + 1).is_some_and(|n| n.state == f.state);
                 if steady && !follower && ps.group.is_none() && v < lo * (1.0 - 1e-6) {
@@ -143,7 +145,9 @@ fn measure(plan: &Plan, traces: &[ClipTrace]) -> Stats {
                         s.retreats += usize::from(*retreated);
                     }
                 }
-                Event::Contact { pedestrian: Some(_), .. } => s.contacts_ped += 1,
+                Event::Contact {
+                    pedestrian: Some(_), ..
+                } => s.contacts_ped += 1,
                 Event::Contact { .. } => s.contacts_vehicle += 1,
                 Event::PatienceExpired { sudden_crossing, .. } => {
                     s.patience_expired += 1;
@@ -195,15 +199,27 @@ fn pedsynth_pp_behaviour_statistics() {
     report("pedsynth_pp", &s);
     assert!(s.pedestrians >= 2000, "{} pedestrians", s.pedestrians);
     let retreat = s.retreats as f64 / s.eligible_conflicts as f64;
-    assert!(s.eligible_conflicts >= 300, "only {} eligible conflicts", s.eligible_conflicts);
+    assert!(
+        s.eligible_conflicts >= 300,
+        "only {} eligible conflicts",
+        s.eligible_conflicts
+    );
     assert!((retreat - 0.15).abs() <= 0.03, "retreat share {retreat:.3}");
     // Planned crossers cross (see the report for the figure; abandoning after patience expiry is legitimate).
     let realised = s.realised as f64 / s.planned_crossers as f64;
     assert!(realised >= 0.75, "realisation {realised:.3}");
     for state in PedState::ALL {
-        assert!(s.frames_per_state.contains_key(state.name()), "{} never occurs", state.name());
+        assert!(
+            s.frames_per_state.contains_key(state.name()),
+            "{} never occurs",
+            state.name()
+        );
     }
-    assert!(s.speed_violations.is_empty(), "{} speed violations", s.speed_violations.len());
+    assert!(
+        s.speed_violations.is_empty(),
+        "{} speed violations",
+        s.speed_violations.len()
+    );
     assert_eq!(s.overlaps, 0);
     assert_eq!(s.non_crossers_on_road, 0);
 }

@@ -2,5 +2,5 @@
 //!
 //! - `trace` — the simulation's output (per-frame agent states and events).
 //! - `sim` — the simulation engine (vehicles, pedestrians and their 12-state behaviour machine).
-pub mod trace;
 pub mod sim;
+pub mod trace;

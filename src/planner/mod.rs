@@ -433,16 +433,31 @@ fn plan_clip(
     let mut last_error = String::new();
     let mut planned = None;
     for _ in 0..ROUTE_ATTEMPTS {
-        let route = net.random_route(&mut rng, needed_m).ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
+        let route = net
+            .random_route(&mut rng, needed_m)
+            .ok_or_else(|| format!("no route of {needed_m:.0} m in town `{}`", net.name))?;
         let ego = EgoScript {
             route: route_script(&route, 0.0),
-            speed_below_limit_pct: rng.random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
+            speed_below_limit_pct: rng
+                .random_range(ego_spec.speed_below_limit_pct.min()..=ego_spec.speed_below_limit_pct.max()),
             min_gap_m: ego_spec.min_gap_m,
             brake_ahead_m: ego_spec.brake_ahead_m,
             brake_lateral_m: ego_spec.brake_lateral_m,
         };
-        let placed = plan_pedestrians(spec, net, &route, peds, first_ped, archetype_names, duration_s, &mut rng)
-            .and_then(|pedestrians| plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng).map(|v| (pedestrians, v)));
+        let placed = plan_pedestrians(
+            spec,
+            net,
+            &route,
+            peds,
+            first_ped,
+            archetype_names,
+            duration_s,
+            &mut rng,
+        )
+        .and_then(|pedestrians| {
+            plan_vehicles(spec, town, &route, &pedestrians, vehicle_profiles, needed_m, &mut rng)
+                .map(|v| (pedestrians, v))
+        });
         match placed {
             Ok((pedestrians, vehicles)) => {
                 planned = Some((ego, pedestrians, vehicles));

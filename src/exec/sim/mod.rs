@@ -40,10 +40,10 @@ use rayon::prelude::*;
 use crate::exec::trace::{ClipTrace, Event, PedFrame, PedState, VehicleFrame};
 use crate::planner::{ClipScript, Plan, SimParams, TownContext, seeds};
 use crate::world::RoadNetwork;
-pub use pedestrian::{allowed_speed_range_mps, profile_multiplier, state_speed_mps};
 use pedestrian::{LeaderFacts, Ped, StepCtx};
-use vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
+pub use pedestrian::{allowed_speed_range_mps, profile_multiplier, state_speed_mps};
 pub use vehicle::EGO_TIME_HEADWAY_S;
+use vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
 
 /// Length of every vehicle's footprint box, metres.
 pub const VEHICLE_LENGTH_M: f64 = 4.6;
@@ -125,7 +125,14 @@ impl<'a> Sim<'a> {
         let mut peds: Vec<Ped> = script
             .pedestrians
             .iter()
-            .map(|p| Ped::new(p, params, net, seeds::clip_rng(script.seed, &format!("sim/ped/{}", p.id))))
+            .map(|p| {
+                Ped::new(
+                    p,
+                    params,
+                    net,
+                    seeds::clip_rng(script.seed, &format!("sim/ped/{}", p.id)),
+                )
+            })
             .collect();
         // Groups: followers point at their leader (by index), leaders list their followers.
         let index_of = |id: u32| script.pedestrians.iter().position(|p| p.id == id);
@@ -313,7 +320,13 @@ impl<'a> Sim<'a> {
         }));
         self.accels.clear();
         for i in 0..self.vehicles.len() {
-            self.accels.push(vehicle::accel_for(i, &self.vehicles, &self.zones[i], &self.views, &self.params.idm));
+            self.accels.push(vehicle::accel_for(
+                i,
+                &self.vehicles,
+                &self.zones[i],
+                &self.views,
+                &self.params.idm,
+            ));
         }
         // 6. Integrate.
         for (v, &a) in self.vehicles.iter_mut().zip(&self.accels) {
@@ -405,7 +418,10 @@ fn push_out_of_box(p: DVec2, centre: DVec2, heading_rad: f64) -> DVec2 {
     let d = p - centre;
     let local = DVec2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
     let r = PED_RADIUS_M + 0.01;
-    let clamped = DVec2::new(local.x.clamp(-HALF_LENGTH_M, HALF_LENGTH_M), local.y.clamp(-HALF_WIDTH_M, HALF_WIDTH_M));
+    let clamped = DVec2::new(
+        local.x.clamp(-HALF_LENGTH_M, HALF_LENGTH_M),
+        local.y.clamp(-HALF_WIDTH_M, HALF_WIDTH_M),
+    );
     let out = if clamped != local {
         // Outside the box but within the radius: push along the normal.
         clamped + (local - clamped).normalize_or(DVec2::Y) * r
@@ -442,7 +458,12 @@ mod tests {
     fn box_overlap_and_push_out() {
         assert!(boxes_overlap(DVec2::ZERO, 0.0, DVec2::new(4.0, 0.0), 0.0));
         assert!(!boxes_overlap(DVec2::ZERO, 0.0, DVec2::new(4.7, 0.0), 0.0));
-        assert!(boxes_overlap(DVec2::ZERO, 0.0, DVec2::new(3.0, 0.0), std::f64::consts::FRAC_PI_2));
+        assert!(boxes_overlap(
+            DVec2::ZERO,
+            0.0,
+            DVec2::new(3.0, 0.0),
+            std::f64::consts::FRAC_PI_2
+        ));
         let p = push_out_of_box(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0);
         assert!(ttc::distance_to_box_m(p, DVec2::ZERO, 0.0, HALF_LENGTH_M, HALF_WIDTH_M) >= PED_RADIUS_M);
         let p = push_out_of_box(DVec2::new(2.5, 0.0), DVec2::ZERO, 1.0);

@@ -204,7 +204,6 @@ impl Line {
 #[derive(Clone, Debug)]
 pub(crate) struct Ped {
     pub id: u32,
-    pub role: Role,
     pub behaviour: Behaviour,
     pub source: CrosserSource,
     pub base_speed_mps: f64,
@@ -296,7 +295,6 @@ impl Ped {
         let role = script.role;
         let mut p = Ped {
             id: script.id,
-            role,
             behaviour: script.behaviour,
             source: script.crosser_source,
             base_speed_mps: script.base_speed_mps.max(0.05),
@@ -386,7 +384,11 @@ fn scan_interval_s(rng: &mut ChaCha20Rng, attention: f64) -> f64 {
 
 /// How long a scan lasts, seconds (attentive pedestrians look longer).
 fn scan_duration_s(attention: f64, brief: bool) -> f64 {
-    if brief { 0.3 + 0.5 * attention } else { 0.5 + 1.5 * attention }
+    if brief {
+        0.3 + 0.5 * attention
+    } else {
+        0.5 + 1.5 * attention
+    }
 }
 
 /// Perception from the state at the start of the step: TTC against every vehicle in range, the ego's distance
@@ -397,7 +399,10 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
         vehicles.iter().map(|v| (v.pose.pos, v.velocity())),
         params.gap_acceptance.vehicle_range_m,
     );
-    p.nearest_vehicle_m = vehicles.iter().map(|v| v.pose.pos.distance(p.pos)).fold(f64::INFINITY, f64::min);
+    p.nearest_vehicle_m = vehicles
+        .iter()
+        .map(|v| v.pose.pos.distance(p.pos))
+        .fold(f64::INFINITY, f64::min);
     let ego = &vehicles[0];
     p.ego_dist_m = ego.pose.pos.distance(p.pos);
     p.ego_ahead = (p.pos - ego.pose.pos).dot(DVec2::from_angle(ego.pose.heading_rad)) > 0.0;
@@ -411,7 +416,11 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
     }
     // A pausing pedestrian probes as if walking on.
     let dir = line.dir;
-    let velocity = if p.state == PedState::PausingMidCross { dir * p.base_speed_mps } else { p.velocity };
+    let velocity = if p.state == PedState::PausingMidCross {
+        dir * p.base_speed_mps
+    } else {
+        p.velocity
+    };
     ttc::probe_points(
         p.pos,
         dir,
@@ -517,7 +526,11 @@ pub(crate) fn transition(
         match p.state {
             PedState::WalkingSidewalk | PedState::LookingAround | PedState::CheckingTraffic | PedState::Hesitating => {
                 p.distraction_done = true;
-                p.resume = if p.at_curb && crosser_waiting { PedState::LookingAround } else { PedState::WalkingSidewalk };
+                p.resume = if p.at_curb && crosser_waiting {
+                    PedState::LookingAround
+                } else {
+                    PedState::WalkingSidewalk
+                };
                 switch_profile(p, params, SpeedProfile::Distracted);
                 p.on_phone = true;
                 set_state(p, PedState::DistractedBehavior, frame, events);
@@ -539,9 +552,14 @@ pub(crate) fn transition(
     if crosser_waiting
         && p.at_curb
         && p.wait_s >= p.patience_s
-        && matches!(p.state, PedState::LookingAround | PedState::CheckingTraffic | PedState::Hesitating)
+        && matches!(
+            p.state,
+            PedState::LookingAround | PedState::CheckingTraffic | PedState::Hesitating
+        )
     {
-        let sudden = p.rng.random_bool(params.patience.sudden_crossing_probability.clamp(0.0, 1.0));
+        let sudden = p
+            .rng
+            .random_bool(params.patience.sudden_crossing_probability.clamp(0.0, 1.0));
         events.push(Event::PatienceExpired {
             frame,
             pedestrian: p.id,
@@ -656,7 +674,10 @@ pub(crate) fn transition(
                 p.resume = p.state;
                 p.pause_is_distraction = false;
                 set_state(p, PedState::PausingMidCross, frame, events);
-            } else if along > 0.0 && p.state != PedState::RunningAcross && p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s {
+            } else if along > 0.0
+                && p.state != PedState::RunningAcross
+                && p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s
+            {
                 // A vehicle is approaching while on the road: run.
                 switch_profile(p, params, SpeedProfile::Rushed);
                 set_state(p, PedState::RunningAcross, frame, events);
@@ -681,7 +702,11 @@ pub(crate) fn transition(
                 p.conflict_clear_s += ctx.dt_s;
                 if p.conflict_clear_s >= CONFLICT_CLEAR_S {
                     p.conflict_active = false;
-                    let next = if p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s { PedState::RunningAcross } else { p.resume };
+                    let next = if p.min_ttc_s < RUN_TTC_FRACTION * p.ttc_threshold_s {
+                        PedState::RunningAcross
+                    } else {
+                        p.resume
+                    };
                     if next == PedState::RunningAcross {
                         switch_profile(p, params, SpeedProfile::Rushed);
                     }
@@ -788,7 +813,9 @@ fn ai_velocity(p: &mut Ped, ctx: &StepCtx, speed: f64) -> DVec2 {
     let mut target = p.walker.target(ctx.net);
     let mut guard = 0;
     while (target - p.pos).length() < 0.3 && guard < 4 {
-        let heading = (target - p.pos).try_normalize().unwrap_or_else(|| DVec2::from_angle(p.yaw_rad));
+        let heading = (target - p.pos)
+            .try_normalize()
+            .unwrap_or_else(|| DVec2::from_angle(p.yaw_rad));
         p.walker.advance(ctx.net, heading);
         target = p.walker.target(ctx.net);
         guard += 1;
@@ -819,7 +846,11 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
             // Never faster than its own speed in this state (with slack for a wider line than the leader's).
             let max_step = 1.3 * p.own_speed_mps(m) * dt;
             let len = step.length();
-            new_pos = if len > max_step && len > 0.0 { old + step * (max_step / len) } else { old + step };
+            new_pos = if len > max_step && len > 0.0 {
+                old + step * (max_step / len)
+            } else {
+                old + step
+            };
         } else {
             let speed = match p.state {
                 PedState::PausingMidCross => 0.0,
@@ -837,13 +868,21 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
             let step = line.near_curb + line.dir * target_along + off * 0.8 - old;
             let max_step = speed * dt;
             let len = step.length();
-            new_pos = if len > max_step && len > 0.0 { old + step * (max_step / len) } else { old + step };
+            new_pos = if len > max_step && len > 0.0 {
+                old + step * (max_step / len)
+            } else {
+                old + step
+            };
         }
     } else {
         let speed = match p.state {
             PedState::DistractedBehavior => {
                 let f = p.state_time_s / p.distraction_len_s.max(1e-6);
-                if (0.3..0.6).contains(&f) { 0.0 } else { p.own_speed_mps(m) }
+                if (0.3..0.6).contains(&f) {
+                    0.0
+                } else {
+                    p.own_speed_mps(m)
+                }
             }
             _ => p.own_speed_mps(m),
         };
@@ -873,7 +912,11 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     }
     // AI mode never steps onto a driving lane; the lane under the new position is recorded.
     let hit = ctx.net.lane_at(new_pos);
-    if !manual && new_pos != old && hit.is_some_and(|h| h.lane_type == LaneType::Driving) && p.lane_type != Some(LaneType::Driving) {
+    if !manual
+        && new_pos != old
+        && hit.is_some_and(|h| h.lane_type == LaneType::Driving)
+        && p.lane_type != Some(LaneType::Driving)
+    {
         p.walker.turn_around();
         new_pos = old;
     } else if let Some(h) = hit {
@@ -886,15 +929,14 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     p.velocity = step / dt;
     p.pos = new_pos;
     let dist = step.length();
-    if dist > 1e-4 && p.state != PedState::Retreat {
+    if dist > 1e-4 {
+        // Facing the way it walks (turned around when retreating).
         p.yaw_rad = step.y.atan2(step.x);
-    } else if p.state == PedState::Retreat && dist > 1e-4 {
-        // Turned around, walking back.
-        p.yaw_rad = step.y.atan2(step.x);
-    } else if let (Some(line), false) = (p.line, p.attempt_over) {
-        if p.at_curb {
-            p.yaw_rad = line.dir.y.atan2(line.dir.x);
-        }
+    } else if let Some(line) = p.line
+        && !p.attempt_over
+        && p.at_curb
+    {
+        p.yaw_rad = line.dir.y.atan2(line.dir.x);
     }
     p.gait_phase = (p.gait_phase + dist / STRIDE_M).fract();
     if p.state.is_crossing() && p.entered_road_check() {
@@ -917,7 +959,10 @@ impl Ped {
             PedState::LookingAround => 1.0 * (std::f64::consts::TAU * 0.5 * self.state_time_s).sin(),
             PedState::CheckingTraffic | PedState::Hesitating | PedState::RunningAcross | PedState::PausingMidCross => {
                 let nearest = vehicles.iter().min_by(|a, b| {
-                    a.pose.pos.distance_squared(self.pos).total_cmp(&b.pose.pos.distance_squared(self.pos))
+                    a.pose
+                        .pos
+                        .distance_squared(self.pos)
+                        .total_cmp(&b.pose.pos.distance_squared(self.pos))
                 });
                 match nearest {
                     Some(v) => {

@@ -103,17 +103,23 @@ mod tests {
 
     #[test]
     fn ttc_is_infinite_when_not_closing() {
-        assert_eq!(ttc_s(DVec2::new(20.0, 0.0), DVec2::ZERO, DVec2::new(-10.0, 0.0)), f64::INFINITY);
+        assert_eq!(
+            ttc_s(DVec2::new(20.0, 0.0), DVec2::ZERO, DVec2::new(-10.0, 0.0)),
+            f64::INFINITY
+        );
         assert_eq!(ttc_s(DVec2::new(20.0, 0.0), DVec2::ZERO, DVec2::ZERO), f64::INFINITY);
-        assert_eq!(ttc_s(DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::new(10.0, 0.0)), f64::INFINITY);
+        assert_eq!(
+            ttc_s(DVec2::new(0.0, 20.0), DVec2::ZERO, DVec2::new(10.0, 0.0)),
+            f64::INFINITY
+        );
     }
 
     #[test]
     fn min_ttc_considers_every_vehicle_in_range() {
         let p = DVec2::new(0.0, 0.0);
         let vehicles = [
-            (DVec2::new(-50.0, 0.0), DVec2::new(10.0, 0.0)), // 5 s
-            (DVec2::new(30.0, 0.0), DVec2::new(-10.0, 0.0)), // 3 s
+            (DVec2::new(-50.0, 0.0), DVec2::new(10.0, 0.0)),   // 5 s
+            (DVec2::new(30.0, 0.0), DVec2::new(-10.0, 0.0)),   // 3 s
             (DVec2::new(100.0, 0.0), DVec2::new(-100.0, 0.0)), // out of range
         ];
         assert!((min_ttc_s(p, vehicles, 60.0) - 3.0).abs() < 1e-12);
@@ -130,7 +136,10 @@ mod tests {
 
     #[test]
     fn box_distance() {
-        assert_eq!(distance_to_box_m(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0, 2.3, 0.95), 0.0);
+        assert_eq!(
+            distance_to_box_m(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0, 2.3, 0.95),
+            0.0
+        );
         assert!((distance_to_box_m(DVec2::new(5.3, 0.0), DVec2::ZERO, 0.0, 2.3, 0.95) - 3.0).abs() < 1e-12);
         // Rotated a quarter turn: the long side is along y.
         let h = std::f64::consts::FRAC_PI_2;
@@ -140,7 +149,14 @@ mod tests {
     #[test]
     fn probes_cover_points_and_prediction() {
         let mut out = Vec::new();
-        probe_points(DVec2::ZERO, DVec2::X, DVec2::new(1.0, 0.0), &[0.5, 1.5, 2.5], 0.5, &mut out);
+        probe_points(
+            DVec2::ZERO,
+            DVec2::X,
+            DVec2::new(1.0, 0.0),
+            &[0.5, 1.5, 2.5],
+            0.5,
+            &mut out,
+        );
         assert_eq!(out.len(), 4);
         assert_eq!(out[2], DVec2::new(2.5, 0.0));
         assert_eq!(out[3], DVec2::new(0.5, 0.0));

@@ -106,7 +106,11 @@ impl VehiclePath {
             }
             let (a, b) = (raw[seg], raw[seg + 1]);
             let span = b.3 - a.3;
-            let t = if span > 0.0 { ((sk - a.3) / span).clamp(0.0, 1.0) } else { 0.0 };
+            let t = if span > 0.0 {
+                ((sk - a.3) / span).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             points.push(PathPoint {
                 pos: a.0.lerp(b.0, t),
                 z_m: a.1 + (b.1 - a.1) * t,
@@ -165,7 +169,11 @@ impl VehiclePath {
             let (a, b) = (self.points[i].pos, self.points[i + 1].pos);
             let ab = b - a;
             let len2 = ab.length_squared();
-            let t = if len2 > 0.0 { ((p - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            let t = if len2 > 0.0 {
+                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let d2 = (a + ab * t - p).length_squared();
             if d2 < best.0 {
                 best = (d2, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
@@ -347,19 +355,14 @@ fn lookahead_m(v: f64, idm: &Idm) -> f64 {
 /// The longitudinal acceleration of vehicle `i` this step: IDM towards the most constraining leader among the
 /// other vehicles, the pedestrians in its path (walkers are ignored by vehicles that ignore them until an
 /// emergency stop is needed), the ego's braking rule and the end of its route.
-pub(crate) fn accel_for(
-    i: usize,
-    vehicles: &[Vehicle],
-    zones: &[ConflictZone],
-    peds: &[PedView],
-    idm: &Idm,
-) -> f64 {
+pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], peds: &[PedView], idm: &Idm) -> f64 {
     let me = &vehicles[i];
     let v = me.speed_mps;
     let look = lookahead_m(v, idm);
     let fwd = DVec2::from_angle(me.pose.heading_rad);
     let target = me.target_speed_mps();
-    let idm_to = |gap: f64, lead: f64| idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, Some((gap, lead)));
+    let idm_to =
+        |gap: f64, lead: f64| idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, Some((gap, lead)));
     let mut accel = idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, None);
 
     // End of route: a standing obstacle.
@@ -381,7 +384,8 @@ pub(crate) fn accel_for(
         };
         // Mutual intrusion (both in each other's path, e.g. at a junction): the lower id goes first, the ego
         // before everyone.
-        if vehicle_in_path(other, me, lookahead_m(other.speed_mps, idm)).is_some() && priority(me.id) < priority(other.id)
+        if vehicle_in_path(other, me, lookahead_m(other.speed_mps, idm)).is_some()
+            && priority(me.id) < priority(other.id)
         {
             continue;
         }
@@ -562,15 +566,19 @@ fn zone_yield_gap_m(me: &Vehicle, vehicles: &[Vehicle], zone: &ConflictZone, loo
 }
 
 fn priority(id: u32) -> u64 {
-    if id == crate::exec::trace::EGO_ID { 0 } else { u64::from(id) + 1 }
+    if id == crate::exec::trace::EGO_ID {
+        0
+    } else {
+        u64::from(id) + 1
+    }
 }
 
 /// If `other`'s footprint intrudes on the corridor of `me`'s path ahead within `look` metres: the gap from
 /// `me`'s front bumper to it along the path and its speed along the path.
 fn vehicle_in_path(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64)> {
-    let (s_o, lateral, path_heading) =
-        me.path
-            .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M);
+    let (s_o, lateral, path_heading) = me
+        .path
+        .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M);
     if s_o <= me.s_m {
         return None;
     }
