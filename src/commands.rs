@@ -112,14 +112,17 @@ pub fn render_diagnostic(diagnostic: &dyn miette::Diagnostic) -> String {
 
 /// Loads every town a spec names (built-in towns are generated, OpenDRIVE maps read relative to the spec).
 pub fn load_towns(loaded: &LoadedSpec) -> Result<BTreeMap<String, TownContext>, String> {
+    load_spec_towns(&loaded.spec, &loaded.base_dir)
+}
+
+/// Loads the towns of `spec`, resolving OpenDRIVE paths against `base_dir`.
+pub fn load_spec_towns(spec: &crate::dsl::Spec, base_dir: &std::path::Path) -> Result<BTreeMap<String, TownContext>, String> {
     let mut towns = BTreeMap::new();
-    for town in &loaded.spec.dataset.towns {
+    for town in &spec.dataset.towns {
         let network = match town {
-            TownRef::Builtin(t) => RoadNetwork::builtin(t.name())
-                .ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
+            TownRef::Builtin(t) => RoadNetwork::builtin(t.name()).ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
             TownRef::OpenDrive(t) => {
-                let mut network = RoadNetwork::from_xodr_file(&loaded.resolve_path(&t.opendrive))
-                    .map_err(|e| render_diagnostic(&e))?;
+                let mut network = RoadNetwork::from_xodr_file(&base_dir.join(&t.opendrive)).map_err(|e| render_diagnostic(&e))?;
                 network.name = t.name.clone();
                 network
             }
@@ -251,6 +254,103 @@ pub fn town_show(
             } else {
                 exit::INVALID
             }
+        }
+    }
+}
+
+/// Options of `pedsynth generate`.
+#[derive(Clone, Debug, Default)]
+pub struct GenerateArgs {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Worker threads.
+    pub jobs: Option<usize>,
+    /// Generate only this clip.
+    pub only: Option<String>,
+    /// No progress output.
+    pub quiet: bool,
+}
+
+/// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.
+pub fn generate(input: &std::path::Path, options: &LoadOptions, args: &GenerateArgs, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
+    let is_plan = input.extension().is_some_and(|e| e == "json");
+    let (plan, towns) = if is_plan {
+        if !options.overrides.is_empty() {
+            let _ = writeln!(err, "--set applies to specs, not to a plan file: re-plan with `pedsynth plan SPEC --set ... --emit PLAN`");
+            return exit::INVALID;
+        }
+        let plan: Plan = match std::fs::read_to_string(input).map_err(|e| e.to_string()).and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string())) {
+            Ok(plan) => plan,
+            Err(e) => {
+                let _ = writeln!(err, "{}: not a pedsynth plan: {e}", input.display());
+                return exit::INVALID;
+            }
+        };
+        if plan.format_version != planner::PLAN_FORMAT_VERSION {
+            let _ = writeln!(err, "{}: plan format {} is not supported (this pedsynth reads {})", input.display(), plan.format_version, planner::PLAN_FORMAT_VERSION);
+            return exit::INVALID;
+        }
+        match load_spec_towns(&plan.spec, std::path::Path::new(&plan.spec_dir)) {
+            Ok(towns) => (plan, towns),
+            Err(message) => {
+                let _ = writeln!(err, "{message}");
+                return exit::INVALID;
+            }
+        }
+    } else {
+        let (loaded, plan) = match compile_plan(input, options, None, err) {
+            Ok(x) => x,
+            Err(code) => return code,
+        };
+        match load_towns(&loaded) {
+            Ok(towns) => (plan, towns),
+            Err(message) => {
+                let _ = writeln!(err, "{message}");
+                return exit::INVALID;
+            }
+        }
+    };
+    let gen_options = crate::exec::generate::GenerateOptions { out_dir: args.out.clone(), jobs: args.jobs, only: args.only.clone() };
+    match crate::exec::generate::generate(&plan, &towns, &gen_options, args.quiet) {
+        Ok(report) => {
+            let _ = writeln!(
+                out,
+                "{}: generated {} clip{} ({} already done): {} frames, {} pedestrian-frames, {} annotated samples\nnext: pedsynth stats {}",
+                args.out.display(),
+                report.generated,
+                if report.generated == 1 { "" } else { "s" },
+                report.skipped,
+                report.frames,
+                report.pedestrian_frames,
+                report.samples,
+                args.out.display()
+            );
+            exit::OK
+        }
+        Err(e @ crate::exec::generate::GenerateError::Refused(_)) => {
+            let _ = writeln!(err, "{e}");
+            exit::INVALID
+        }
+        Err(e) => {
+            let _ = writeln!(err, "{e}");
+            exit::FAILURE
+        }
+    }
+}
+
+/// `pedsynth stats DIR [--json]`: statistics computed from the written tables.
+pub fn stats(dir: &std::path::Path, json: bool, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
+    match crate::exec::stats::compute(dir) {
+        Ok(stats) => {
+            let text = if json { serde_json::to_string_pretty(&stats).unwrap_or_default() + "\n" } else { crate::exec::stats::render_text(&stats) };
+            match out.write_all(text.as_bytes()) {
+                Ok(()) => exit::OK,
+                Err(_) => exit::FAILURE,
+            }
+        }
+        Err(e) => {
+            let _ = writeln!(err, "cannot read the dataset: {e}");
+            exit::INVALID
         }
     }
 }

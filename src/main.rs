@@ -55,6 +55,33 @@ enum Command {
         #[command(flatten)]
         spec_args: SpecArgs,
     },
+    /// Generate a dataset: plan, simulate, annotate and write Parquet tables (resumable).
+    Generate {
+        /// Spec file (.yaml) or plan file (.json from `pedsynth plan --emit`).
+        input: PathBuf,
+        /// Output directory (new, empty, or a partly generated dataset of the same spec to resume).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Worker threads (default: one per core).
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Generate only this clip.
+        #[arg(long, value_name = "CLIP_ID")]
+        only: Option<String>,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
+    /// Dataset statistics computed from the written tables.
+    Stats {
+        /// Dataset directory.
+        dir: PathBuf,
+        /// Print JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
     /// Inspect towns.
@@ -94,8 +121,9 @@ fn main() -> ExitCode {
             return ExitCode::from(code as u8);
         }
     };
-    let mut out = std::io::stdout().lock();
-    let mut err = std::io::stderr().lock();
+    // Unlocked handles: worker threads print progress to stderr while a command runs.
+    let mut out = std::io::stdout();
+    let mut err = std::io::stderr();
     let code = match cli.command {
         Command::Validate {
             specs,
@@ -127,6 +155,12 @@ fn main() -> ExitCode {
                 &mut err,
             )
         }
+        Command::Generate { input, out: dir, jobs, only, quiet, spec_args } => {
+            let options = LoadOptions { overrides: spec_args.overrides, allow_large: spec_args.allow_large };
+            let args = commands::GenerateArgs { out: dir, jobs, only, quiet };
+            commands::generate(&input, &options, &args, &mut out, &mut err)
+        }
+        Command::Stats { dir, json } => commands::stats(&dir, json, &mut out, &mut err),
         Command::Schema => commands::schema(&mut out),
         Command::Town {
             command: TownCommand::List,

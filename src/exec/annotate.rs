@@ -12,17 +12,12 @@ use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M};
 use super::camera::{Camera, CameraPose};
+use super::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use super::trace::{ClipTrace, Event, PedFrame, PedState};
 use crate::dsl::types::Annotations;
 use crate::planner::ClipScript;
 use crate::world::{LaneType, RoadNetwork};
 
-/// Vehicle footprint length, metres.
-pub const VEHICLE_LENGTH_M: f64 = 4.6;
-/// Vehicle width, metres.
-pub const VEHICLE_WIDTH_M: f64 = 1.9;
-/// Vehicle height, metres.
-pub const VEHICLE_HEIGHT_M: f64 = 1.5;
 /// Radius of the cylinder standing in for another pedestrian when testing occlusion, as a share of height.
 const PED_OCCLUDER_RADIUS_PER_M: f64 = 0.14;
 

@@ -1,0 +1,541 @@
+//! Rule tests of the simulation on a hand-built straight road (two driving lanes, a sidewalk on each side) with
+//! hand-built clip scripts: gap acceptance waits and crosses, non-closing vehicles do not block, the lookahead
+//! stops a crosser before a vehicle, groups cross together, patience expiry leads to a sudden crossing or to
+//! abandoning, the ego brakes for a crosser, and nothing interpenetrates.
+
+use glam::DVec2;
+use pedsynth::dsl::types::{Body, Spec, WeatherParams};
+use pedsynth::exec::sim::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
+use pedsynth::exec::trace::{ClipTrace, EGO_ID, Event, PedState};
+use pedsynth::planner::{
+    Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef, PedestrianScript,
+    Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
+};
+use pedsynth::world::{LaneType, RoadNetwork};
+
+/// A straight 400 m road along +x from x = −50: lane −1 (y ∈ [−3.5, 0], towards +x), lane 1 (y ∈ [0, 3.5],
+/// towards −x), sidewalks y ∈ [−6.5, −3.5] and [3.5, 6.5]; 30 km/h.
+const STRAIGHT_ROAD: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<OpenDRIVE>
+  <header revMajor="1" revMinor="4" name="straight"/>
+  <road name="r" length="400" id="1" junction="-1">
+    <type s="0" type="town"><speed max="30" unit="km/h"/></type>
+    <planView><geometry s="0" x="-50" y="0" hdg="0" length="400"><line/></geometry></planView>
+    <lanes>
+      <laneSection s="0">
+        <left>
+          <lane id="2" type="sidewalk" level="false"><width sOffset="0" a="3" b="0" c="0" d="0"/></lane>
+          <lane id="1" type="driving" level="false"><width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane>
+        </left>
+        <center><lane id="0" type="none" level="false"/></center>
+        <right>
+          <lane id="-1" type="driving" level="false"><width sOffset="0" a="3.5" b="0" c="0" d="0"/></lane>
+          <lane id="-2" type="sidewalk" level="false"><width sOffset="0" a="3" b="0" c="0" d="0"/></lane>
+        </right>
+      </laneSection>
+    </lanes>
+  </road>
+</OpenDRIVE>
+"#;
+
+fn road() -> RoadNetwork {
+    RoadNetwork::from_xodr_str(STRAIGHT_ROAD, "straight.xodr").expect("valid road")
+}
+
+fn params() -> SimParams {
+    SimParams::from_spec(&Spec::default())
+}
+
+fn lane_index(net: &RoadNetwork, lane_id: i32) -> u32 {
+    net.lanes
+        .iter()
+        .position(|l| l.lane_id == lane_id && l.lane_type == LaneType::Driving)
+        .expect("lane") as u32
+}
+
+/// A route along lane −1 (towards +x) starting at `x`, or lane 1 (towards −x).
+fn route(net: &RoadNetwork, towards_plus_x: bool, x: f64) -> RouteScript {
+    let lane = lane_index(net, if towards_plus_x { -1 } else { 1 });
+    let (start, heading, s) = if towards_plus_x {
+        (DVec2::new(x, -1.75), 0.0, x + 50.0)
+    } else {
+        (DVec2::new(x, 1.75), std::f64::consts::PI, 350.0 - x)
+    };
+    RouteScript {
+        lanes: vec![lane],
+        length_m: 400.0,
+        start_s_m: s,
+        start,
+        start_heading_rad: heading,
+    }
+}
+
+fn ego_at(net: &RoadNetwork, x: f64, speed_below_limit_pct: f64) -> EgoScript {
+    EgoScript {
+        route: route(net, true, x),
+        speed_below_limit_pct,
+        min_gap_m: 2.5,
+        brake_ahead_m: 15.0,
+        brake_lateral_m: 5.0,
+    }
+}
+
+fn vehicle(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64, pct: f64, ignores_walkers: bool) -> VehicleScript {
+    VehicleScript {
+        id,
+        profile: DrivingProfileKind::Normal,
+        speed_difference_pct: pct,
+        min_gap_m: 2.0,
+        time_headway_s: 1.5,
+        ignores_lights: false,
+        ignores_walkers,
+        route: route(net, towards_plus_x, x),
+    }
+}
+
+/// A crosser standing on the south sidewalk at `x`, crossing north.
+fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: CrosserSource) -> PedestrianScript {
+    let spawn = DVec2::new(x, -5.0);
+    let c = net.crossing_at(spawn).expect("a crossing from the sidewalk");
+    PedestrianScript {
+        id,
+        archetype: "casual_person".to_owned(),
+        body: Body::Adult,
+        base_speed_mps: 1.2,
+        hesitation_s: 0.5,
+        attention: 0.7,
+        ttc_threshold_s: 4.0,
+        safety_margin_s: 0.5,
+        patience_s: 12.0,
+        distracted_at_s: None,
+        role: Role::Crosser,
+        crosser_source: source,
+        behaviour,
+        group: None,
+        speed_profile: SpeedProfile::Normal,
+        spawn_place: SpawnPlace::Sidewalk,
+        spawn,
+        spawn_heading_rad: c.direction.to_angle(),
+        ahead_of_ego_m: 0.0,
+        crossing: Some(CrossingScript {
+            near_curb: c.near_curb,
+            far_curb: c.far_curb,
+            end: c.end,
+            direction: c.direction,
+            carriageway_width_m: c.carriageway_width_m,
+        }),
+    }
+}
+
+fn clip(ego: EgoScript, vehicles: Vec<VehicleScript>, pedestrians: Vec<PedestrianScript>, seconds: u32) -> ClipScript {
+    ClipScript {
+        clip_id: "straight-clear_noon-0000".to_owned(),
+        seed: 7,
+        town: "straight".to_owned(),
+        weather: "clear_noon".to_owned(),
+        weather_params: WeatherParams::default(),
+        split: pedsynth::dsl::types::Split::Train,
+        fps: 30,
+        frame_count: seconds * 30,
+        ego,
+        vehicles,
+        pedestrians,
+    }
+}
+
+/// First frame where pedestrian `i` is on a driving lane in a crossing-type state.
+fn first_in_road(trace: &ClipTrace, i: usize) -> Option<usize> {
+    trace.pedestrians[i]
+        .iter()
+        .position(|f| f.state.is_crossing() && f.lane_type == Some(LaneType::Driving))
+}
+
+fn states(trace: &ClipTrace, i: usize) -> Vec<PedState> {
+    let mut out: Vec<PedState> = Vec::new();
+    for f in &trace.pedestrians[i] {
+        if out.last() != Some(&f.state) {
+            out.push(f.state);
+        }
+    }
+    out
+}
+
+/// No pedestrian disc overlaps a vehicle footprint in any frame, and there is no contact event.
+fn assert_no_interpenetration(trace: &ClipTrace) {
+    for (k, ped) in trace.pedestrians.iter().enumerate() {
+        for (f, pf) in ped.iter().enumerate() {
+            for v in std::iter::once(&trace.ego).chain(trace.vehicles.iter()) {
+                let vf = &v[f];
+                let d = ttc::distance_to_box_m(
+                    pf.pos.truncate(),
+                    vf.pos.truncate(),
+                    vf.yaw_rad,
+                    VEHICLE_LENGTH_M / 2.0,
+                    VEHICLE_WIDTH_M / 2.0,
+                );
+                assert!(
+                    d >= PED_RADIUS_M - 1e-9,
+                    "pedestrian {k} overlaps a vehicle at frame {f}"
+                );
+            }
+        }
+    }
+    assert!(
+        !trace.events.iter().any(|e| matches!(e, Event::Contact { .. })),
+        "contacts: {:?}",
+        trace
+            .events
+            .iter()
+            .filter(|e| matches!(e, Event::Contact { .. }))
+            .collect::<Vec<_>>()
+    );
+}
+
+/// State-change events agree with the recorded states.
+fn assert_events_match_trace(trace: &ClipTrace) {
+    for e in &trace.events {
+        if let Event::StateChange {
+            frame,
+            pedestrian,
+            from,
+            to,
+        } = e
+        {
+            let p = &trace.pedestrians[*pedestrian as usize];
+            assert_eq!(p[*frame as usize].state, *to);
+            assert_eq!(p[*frame as usize - 1].state, *from);
+        }
+    }
+}
+
+#[test]
+fn a_closing_vehicle_below_the_threshold_makes_the_pedestrian_wait() {
+    let net = road();
+    // The ego has passed (so only the gap matters); a traffic vehicle 45 m away closing at ~8.3 m/s: TTC ≈ 5.4 s,
+    // below the threshold 4 + 0.5 + 7 / 1.2 ≈ 10.3 s.
+    let script = clip(
+        ego_at(&net, 160.0, 0.0),
+        vec![vehicle(&net, 0, false, 195.0, 0.0, false)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        5,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    assert_events_match_trace(&trace);
+    assert_eq!(first_in_road(&trace, 0), None, "states: {:?}", states(&trace, 0));
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .any(|f| f.state == PedState::CheckingTraffic)
+    );
+    assert!(!trace.events.iter().any(|e| matches!(e, Event::CrossingDecision { .. })));
+}
+
+#[test]
+fn a_gap_above_the_threshold_is_accepted() {
+    let net = road();
+    // The same vehicle crawling at ~1 m/s: TTC ≈ 45 s.
+    let script = clip(
+        ego_at(&net, 160.0, 0.0),
+        vec![vehicle(&net, 0, false, 195.0, 88.0, false)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        14,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    assert_events_match_trace(&trace);
+    let entered = first_in_road(&trace, 0).expect("crosses");
+    let s = states(&trace, 0);
+    assert!(s.len() >= 6, "{s:?}");
+    assert_eq!(
+        &s[..6],
+        &[
+            PedState::WalkingSidewalk,
+            PedState::LookingAround,
+            PedState::CheckingTraffic,
+            PedState::Hesitating,
+            PedState::CrossingRoad,
+            PedState::FinishedCrossing
+        ],
+        "{s:?}"
+    );
+    let decision = trace
+        .events
+        .iter()
+        .find_map(|e| match e {
+            Event::CrossingDecision { frame, .. } => Some(*frame as usize),
+            _ => None,
+        })
+        .expect("decision");
+    assert!(decision < entered);
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn a_vehicle_that_is_not_closing_does_not_block() {
+    let net = road();
+    // A vehicle 10 m past the pedestrian, driving away at 8.3 m/s (the ego too).
+    let script = clip(
+        ego_at(&net, 170.0, 0.0),
+        vec![vehicle(&net, 0, true, 160.0, 0.0, false)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        8,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    assert!(first_in_road(&trace, 0).is_some(), "states: {:?}", states(&trace, 0));
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn an_allocated_crosser_waits_for_the_decision_window_and_the_gap() {
+    let net = road();
+    // The ego approaches at 8.3 m/s from 60 m: inside the window its TTC is far below the threshold, so the
+    // crosser only commits once the ego has passed.
+    let script = clip(
+        ego_at(&net, 90.0, 0.0),
+        vec![],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        14,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    assert_events_match_trace(&trace);
+    let entered = first_in_road(&trace, 0).expect("crosses after the ego passed");
+    let ego_x = trace.ego[entered].pos.x;
+    assert!(ego_x > 150.0, "entered the road with the ego at x = {ego_x}");
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn the_lookahead_stops_a_crosser_before_a_vehicle_in_its_path() {
+    let net = road();
+    // A mid-road jaywalker in the south lane walking north; a vehicle that ignores walkers comes along the north
+    // lane. The probes see it within 3 m and the pedestrian halts (pause or retreat) until it has passed.
+    let mut p = crosser(&net, 0, 150.0, Behaviour::MidroadJaywalker, CrosserSource::Allocated);
+    let c = p.crossing.clone().expect("crossing");
+    p.spawn = c.near_curb + c.direction * 2.0;
+    p.spawn_place = SpawnPlace::DrivingLane;
+    let script = clip(
+        ego_at(&net, -45.0, 0.0),
+        vec![vehicle(&net, 0, false, 170.0, 0.0, true)],
+        vec![p],
+        8,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    assert_events_match_trace(&trace);
+    let s = states(&trace, 0);
+    assert_eq!(s[0], PedState::Jaywalking);
+    assert!(
+        s.contains(&PedState::PausingMidCross) || s.contains(&PedState::Retreat),
+        "states: {s:?}"
+    );
+    assert!(
+        trace
+            .events
+            .iter()
+            .any(|e| matches!(e, Event::Conflict { vehicle: 0, .. }))
+    );
+    assert!(matches!(
+        trace.events[0],
+        Event::CrossingDecision {
+            frame: 0,
+            pedestrian: 0
+        }
+    ));
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn the_ego_brakes_for_a_pedestrian_crossing_in_its_path() {
+    let net = road();
+    let mut p = crosser(&net, 0, 60.0, Behaviour::MidroadJaywalker, CrosserSource::Allocated);
+    let c = p.crossing.clone().expect("crossing");
+    p.spawn = c.near_curb + c.direction * 1.5;
+    p.spawn_place = SpawnPlace::DrivingLane;
+    p.base_speed_mps = 0.6;
+    let script = clip(ego_at(&net, 40.0, 0.0), vec![], vec![p], 8);
+    let trace = sim::simulate(&script, &params(), &net);
+    let min_speed = trace.ego.iter().map(|f| f.speed_mps).fold(f64::INFINITY, f64::min);
+    assert!(min_speed < 2.0, "ego never slowed down: {min_speed}");
+    assert!(trace.ego.iter().any(|f| f.accel_mps2 < -2.0));
+    assert!(first_in_road(&trace, 0).is_some());
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn groups_cross_together() {
+    let net = road();
+    let mut leader = crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated);
+    let mut follower = crosser(&net, 1, 151.8, Behaviour::Normal, CrosserSource::Allocated);
+    follower.base_speed_mps = 1.0;
+    follower.hesitation_s = 1.5;
+    leader.group = Some(GroupRef { group_id: 0, leader: 0 });
+    follower.group = Some(GroupRef { group_id: 0, leader: 0 });
+    // The ego has already passed.
+    let script = clip(ego_at(&net, 170.0, 0.0), vec![], vec![leader, follower], 12);
+    let trace = sim::simulate(&script, &params(), &net);
+    assert_events_match_trace(&trace);
+    for f in 1..trace.frame_count as usize {
+        assert_eq!(
+            trace.pedestrians[0][f].state, trace.pedestrians[1][f].state,
+            "states differ at frame {f}"
+        );
+    }
+    let (a, b) = (
+        first_in_road(&trace, 0).expect("leader crosses"),
+        first_in_road(&trace, 1).expect("follower crosses"),
+    );
+    assert!(a.abs_diff(b) <= 3, "entered the road at frames {a} and {b}");
+    // Same decision frame.
+    let decisions: Vec<_> = trace
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            Event::CrossingDecision { frame, .. } => Some(*frame),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(decisions.len(), 2);
+    assert_eq!(decisions[0], decisions[1]);
+    // The follower never outruns its own speed by more than the width ratio allows.
+    let max_follower_speed = trace.pedestrians[1]
+        .iter()
+        .filter(|f| f.state == PedState::CrossingRoad)
+        .map(|f| f.velocity.length())
+        .fold(0.0, f64::max);
+    assert!(max_follower_speed <= 1.0 * 1.05, "{max_follower_speed}");
+}
+
+fn patience_clip(net: &RoadNetwork, sudden_probability: f64) -> (ClipTrace, ClipScript) {
+    let mut p = crosser(net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated);
+    p.patience_s = 2.0;
+    p.ttc_threshold_s = 100.0;
+    // A vehicle crawling towards the pedestrian keeps the TTC finite but below 100 s.
+    let script = clip(
+        ego_at(net, 160.0, 0.0),
+        vec![vehicle(net, 0, false, 200.0, 88.0, false)],
+        vec![p],
+        10,
+    );
+    let mut params = params();
+    params.patience.sudden_crossing_probability = sudden_probability;
+    (sim::simulate(&script, &params, net), script)
+}
+
+#[test]
+fn patience_expiry_leads_to_a_sudden_crossing() {
+    let net = road();
+    let (trace, _) = patience_clip(&net, 1.0);
+    assert_events_match_trace(&trace);
+    assert!(
+        trace.events.iter().any(|e| matches!(
+            e,
+            Event::PatienceExpired {
+                sudden_crossing: true,
+                ..
+            }
+        )),
+        "{:?}",
+        states(&trace, 0)
+    );
+    let entered = first_in_road(&trace, 0).expect("crosses suddenly");
+    assert_eq!(trace.pedestrians[0][entered].state, PedState::SuddenCrossing);
+}
+
+#[test]
+fn patience_expiry_can_abandon_the_attempt() {
+    let net = road();
+    let (trace, _) = patience_clip(&net, 0.0);
+    assert!(trace.events.iter().any(|e| matches!(
+        e,
+        Event::PatienceExpired {
+            sudden_crossing: false,
+            ..
+        }
+    )));
+    assert_eq!(first_in_road(&trace, 0), None);
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .all(|f| f.lane_type != Some(LaneType::Driving))
+    );
+    assert_eq!(
+        trace.pedestrians[0].last().expect("frames").state,
+        PedState::WalkingSidewalk
+    );
+}
+
+#[test]
+fn a_baseline_crosser_stops_and_checks_like_carla() {
+    let net = road();
+    // No decision window and no TTC threshold: it crosses once nothing is within 6 m or about to arrive, even
+    // with the ego approaching 50 m away.
+    let script = clip(
+        ego_at(&net, 100.0, 50.0),
+        vec![],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
+        10,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    let entered = first_in_road(&trace, 0).expect("crosses");
+    assert!(trace.ego[entered].pos.x < 150.0, "crossed in front of the ego");
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn non_crossers_stay_on_the_sidewalk_and_sudden_crossers_go_without_checking() {
+    let net = road();
+    let mut walker = crosser(&net, 0, 100.0, Behaviour::None, CrosserSource::None);
+    walker.role = Role::NonCrosser;
+    walker.crossing = None;
+    walker.spawn_heading_rad = 0.0;
+    let sudden = crosser(&net, 1, 150.0, Behaviour::Sudden, CrosserSource::Allocated);
+    let script = clip(ego_at(&net, 80.0, 0.0), vec![], vec![walker, sudden], 10);
+    let trace = sim::simulate(&script, &params(), &net);
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .all(|f| f.lane_type == Some(LaneType::Sidewalk))
+    );
+    assert!(
+        trace.pedestrians[0].last().expect("frames").pos.x > 105.0,
+        "the walker walks"
+    );
+    let s = states(&trace, 1);
+    assert_eq!(&s[..2], &[PedState::WalkingSidewalk, PedState::SuddenCrossing], "{s:?}");
+    // Triggered by the ego entering the 40 m window.
+    let decision = trace
+        .events
+        .iter()
+        .find_map(|e| match e {
+            Event::CrossingDecision { frame, pedestrian: 1 } => Some(*frame as usize),
+            _ => None,
+        })
+        .expect("decision");
+    let gap = 150.0 - trace.ego[decision].pos.x;
+    assert!(gap <= 40.5 && gap > 30.0, "decided with the ego {gap} m away");
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn vehicles_follow_without_passing_through_each_other() {
+    let net = road();
+    // A slow vehicle ahead of the ego in the same lane.
+    let script = clip(
+        ego_at(&net, 0.0, 0.0),
+        vec![vehicle(&net, 0, true, 25.0, 70.0, false)],
+        vec![],
+        15,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    for f in 0..trace.frame_count as usize {
+        let gap = trace.vehicles[0][f].pos.x - trace.ego[f].pos.x - VEHICLE_LENGTH_M;
+        assert!(gap > 1.0, "gap {gap} at frame {f}");
+    }
+    assert!(
+        !trace
+            .events
+            .iter()
+            .any(|e| matches!(e, Event::Contact { vehicle: EGO_ID, .. }))
+    );
+    // It ends up following at about the leader's speed.
+    let last = trace.ego.last().expect("frames");
+    assert!((last.speed_mps - trace.vehicles[0].last().expect("frames").speed_mps).abs() < 0.5);
+}
