@@ -29,7 +29,14 @@ fn simulate_13s_clip_10_peds_10_vehicles(bencher: divan::Bencher, town: &str) {
     };
     let loaded = dsl::load_file(&path, &options).expect("valid spec");
     let towns = load_towns(&loaded).expect("towns load");
-    let plan = planner::plan(&loaded.spec, &loaded.hash(), &loaded.base_dir.display().to_string(), &towns, None).expect("feasible");
+    let plan = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .expect("feasible");
     let clip = &plan.clips[0];
     let net = &towns[&clip.town].network;
     let agents = (clip.pedestrians.len() + clip.vehicles.len() + 1) as u64;

@@ -116,13 +116,18 @@ pub fn load_towns(loaded: &LoadedSpec) -> Result<BTreeMap<String, TownContext>, 
 }
 
 /// Loads the towns of `spec`, resolving OpenDRIVE paths against `base_dir`.
-pub fn load_spec_towns(spec: &crate::dsl::Spec, base_dir: &std::path::Path) -> Result<BTreeMap<String, TownContext>, String> {
+pub fn load_spec_towns(
+    spec: &crate::dsl::Spec,
+    base_dir: &std::path::Path,
+) -> Result<BTreeMap<String, TownContext>, String> {
     let mut towns = BTreeMap::new();
     for town in &spec.dataset.towns {
         let network = match town {
-            TownRef::Builtin(t) => RoadNetwork::builtin(t.name()).ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
+            TownRef::Builtin(t) => RoadNetwork::builtin(t.name())
+                .ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
             TownRef::OpenDrive(t) => {
-                let mut network = RoadNetwork::from_xodr_file(&base_dir.join(&t.opendrive)).map_err(|e| render_diagnostic(&e))?;
+                let mut network =
+                    RoadNetwork::from_xodr_file(&base_dir.join(&t.opendrive)).map_err(|e| render_diagnostic(&e))?;
                 network.name = t.name.clone();
                 network
             }
@@ -272,14 +277,26 @@ pub struct GenerateArgs {
 }
 
 /// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.
-pub fn generate(input: &std::path::Path, options: &LoadOptions, args: &GenerateArgs, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
+pub fn generate(
+    input: &std::path::Path,
+    options: &LoadOptions,
+    args: &GenerateArgs,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> i32 {
     let is_plan = input.extension().is_some_and(|e| e == "json");
     let (plan, towns) = if is_plan {
         if !options.overrides.is_empty() {
-            let _ = writeln!(err, "--set applies to specs, not to a plan file: re-plan with `pedsynth plan SPEC --set ... --emit PLAN`");
+            let _ = writeln!(
+                err,
+                "--set applies to specs, not to a plan file: re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"
+            );
             return exit::INVALID;
         }
-        let plan: Plan = match std::fs::read_to_string(input).map_err(|e| e.to_string()).and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string())) {
+        let plan: Plan = match std::fs::read_to_string(input)
+            .map_err(|e| e.to_string())
+            .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
+        {
             Ok(plan) => plan,
             Err(e) => {
                 let _ = writeln!(err, "{}: not a pedsynth plan: {e}", input.display());
@@ -287,7 +304,13 @@ pub fn generate(input: &std::path::Path, options: &LoadOptions, args: &GenerateA
             }
         };
         if plan.format_version != planner::PLAN_FORMAT_VERSION {
-            let _ = writeln!(err, "{}: plan format {} is not supported (this pedsynth reads {})", input.display(), plan.format_version, planner::PLAN_FORMAT_VERSION);
+            let _ = writeln!(
+                err,
+                "{}: plan format {} is not supported (this pedsynth reads {})",
+                input.display(),
+                plan.format_version,
+                planner::PLAN_FORMAT_VERSION
+            );
             return exit::INVALID;
         }
         match load_spec_towns(&plan.spec, std::path::Path::new(&plan.spec_dir)) {
@@ -310,7 +333,11 @@ pub fn generate(input: &std::path::Path, options: &LoadOptions, args: &GenerateA
             }
         }
     };
-    let gen_options = crate::exec::generate::GenerateOptions { out_dir: args.out.clone(), jobs: args.jobs, only: args.only.clone() };
+    let gen_options = crate::exec::generate::GenerateOptions {
+        out_dir: args.out.clone(),
+        jobs: args.jobs,
+        only: args.only.clone(),
+    };
     match crate::exec::generate::generate(&plan, &towns, &gen_options, args.quiet) {
         Ok(report) => {
             let _ = writeln!(
@@ -342,7 +369,11 @@ pub fn generate(input: &std::path::Path, options: &LoadOptions, args: &GenerateA
 pub fn stats(dir: &std::path::Path, json: bool, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
     match crate::exec::stats::compute(dir) {
         Ok(stats) => {
-            let text = if json { serde_json::to_string_pretty(&stats).unwrap_or_default() + "\n" } else { crate::exec::stats::render_text(&stats) };
+            let text = if json {
+                serde_json::to_string_pretty(&stats).unwrap_or_default() + "\n"
+            } else {
+                crate::exec::stats::render_text(&stats)
+            };
             match out.write_all(text.as_bytes()) {
                 Ok(()) => exit::OK,
                 Err(_) => exit::FAILURE,

@@ -155,9 +155,24 @@ fn main() -> ExitCode {
                 &mut err,
             )
         }
-        Command::Generate { input, out: dir, jobs, only, quiet, spec_args } => {
-            let options = LoadOptions { overrides: spec_args.overrides, allow_large: spec_args.allow_large };
-            let args = commands::GenerateArgs { out: dir, jobs, only, quiet };
+        Command::Generate {
+            input,
+            out: dir,
+            jobs,
+            only,
+            quiet,
+            spec_args,
+        } => {
+            let options = LoadOptions {
+                overrides: spec_args.overrides,
+                allow_large: spec_args.allow_large,
+            };
+            let args = commands::GenerateArgs {
+                out: dir,
+                jobs,
+                only,
+                quiet,
+            };
             commands::generate(&input, &options, &args, &mut out, &mut err)
         }
         Command::Stats { dir, json } => commands::stats(&dir, json, &mut out, &mut err),

@@ -19,7 +19,14 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     };
     let loaded = dsl::load_file(&path, &options).map_err(|e| format!("{e:?}"))?;
     let towns = load_towns(&loaded)?;
-    let plan = planner::plan(&loaded.spec, &loaded.hash(), &loaded.base_dir.display().to_string(), &towns, None).map_err(|e| format!("{e:?}"))?;
+    let plan = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .map_err(|e| format!("{e:?}"))?;
     assert!(plan.clips.len() >= 8);
     let run = |threads: usize| -> Result<(String, String), Box<dyn std::error::Error>> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;

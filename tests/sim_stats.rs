@@ -23,7 +23,14 @@ fn plan_and_simulate(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
     };
     let loaded = dsl::load_file(&path, &options).expect("valid spec");
     let towns = load_towns(&loaded).expect("towns load");
-    let plan = planner::plan(&loaded.spec, &loaded.hash(), &loaded.base_dir.display().to_string(), &towns, None).expect("feasible");
+    let plan = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .expect("feasible");
     let traces = sim::simulate_all(&plan, &towns).expect("towns present");
     (plan, traces)
 }

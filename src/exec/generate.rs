@@ -103,7 +103,9 @@ pub struct GenerateReport {
 
 /// blake3 of a plan's canonical JSON.
 pub fn plan_hash(plan: &Plan) -> String {
-    blake3::hash(serde_json::to_string(plan).unwrap_or_default().as_bytes()).to_hex().to_string()
+    blake3::hash(serde_json::to_string(plan).unwrap_or_default().as_bytes())
+        .to_hex()
+        .to_string()
 }
 
 fn manifest_path(out: &Path) -> PathBuf {
@@ -121,13 +123,21 @@ fn check_out_dir(out: &Path, spec_hash: &str, plan_hash: &str) -> Result<Option<
         return Ok(None);
     }
     let refuse = |why: String| GenerateError::Refused(format!("refusing to write into {}: {why}", out.display()));
-    let text = std::fs::read_to_string(manifest_path(out)).map_err(|_| refuse("the directory is not empty and is not a pedsynth dataset (no manifest.json)".into()))?;
-    let manifest: Manifest = serde_json::from_str(&text).map_err(|e| refuse(format!("manifest.json is not a pedsynth manifest ({e})")))?;
+    let text = std::fs::read_to_string(manifest_path(out))
+        .map_err(|_| refuse("the directory is not empty and is not a pedsynth dataset (no manifest.json)".into()))?;
+    let manifest: Manifest =
+        serde_json::from_str(&text).map_err(|e| refuse(format!("manifest.json is not a pedsynth manifest ({e})")))?;
     if manifest.spec_hash != spec_hash {
-        return Err(refuse(format!("it holds a dataset of another spec ({}…); use a new --out directory", &manifest.spec_hash[..12.min(manifest.spec_hash.len())])));
+        return Err(refuse(format!(
+            "it holds a dataset of another spec ({}…); use a new --out directory",
+            &manifest.spec_hash[..12.min(manifest.spec_hash.len())]
+        )));
     }
     if manifest.plan_hash != plan_hash {
-        return Err(refuse("it holds a dataset of another plan of this spec (another pedsynth version?); use a new --out directory".into()));
+        return Err(refuse(
+            "it holds a dataset of another plan of this spec (another pedsynth version?); use a new --out directory"
+                .into(),
+        ));
     }
     Ok(Some(manifest))
 }
@@ -139,21 +149,37 @@ fn clip_done(out: &Path, clip_id: &str) -> bool {
 fn file_hashes(out: &Path, clip_id: &str) -> std::io::Result<BTreeMap<String, String>> {
     TABLES
         .iter()
-        .map(|t| Ok((t.to_string(), blake3::hash(&std::fs::read(tables::table_path(out, t, clip_id))?).to_hex().to_string())))
+        .map(|t| {
+            Ok((
+                t.to_string(),
+                blake3::hash(&std::fs::read(tables::table_path(out, t, clip_id))?)
+                    .to_hex()
+                    .to_string(),
+            ))
+        })
         .collect()
 }
 
 fn write_manifest(out: &Path, manifest: &Manifest) -> Result<(), GenerateError> {
     let mut text = serde_json::to_string_pretty(manifest).unwrap_or_default();
     text.push('\n');
-    crate::fsutil::write_atomically(&manifest_path(out), text.as_bytes()).map_err(|e| GenerateError::Failed(format!("cannot write manifest.json: {e}")))
+    crate::fsutil::write_atomically(&manifest_path(out), text.as_bytes())
+        .map_err(|e| GenerateError::Failed(format!("cannot write manifest.json: {e}")))
 }
 
 /// Simulates, annotates and writes one clip; returns its file hashes and counts.
-fn generate_clip(plan: &Plan, script: &ClipScript, town: &TownContext, camera: &Camera, out: &Path) -> std::io::Result<(BTreeMap<String, String>, u64, u64)> {
+fn generate_clip(
+    plan: &Plan,
+    script: &ClipScript,
+    town: &TownContext,
+    camera: &Camera,
+    out: &Path,
+) -> std::io::Result<(BTreeMap<String, String>, u64, u64)> {
     let trace = sim::simulate(script, &plan.sim, &town.network);
     let ann = annotate::annotate(script, &trace, &plan.spec.annotations, camera, &town.network);
-    let meta = FileMeta { spec_hash: plan.spec_hash.clone() };
+    let meta = FileMeta {
+        spec_hash: plan.spec_hash.clone(),
+    };
     let batches = [
         ("frames", tables::frames_batch(script, &trace)),
         ("pedestrians", tables::pedestrians_batch(script, &ann)),
@@ -164,7 +190,14 @@ fn generate_clip(plan: &Plan, script: &ClipScript, town: &TownContext, camera: &
     ];
     let mut hashes = BTreeMap::new();
     for (table, batch) in &batches {
-        let hash = tables::write_parquet(&tables::table_path(out, table, &script.clip_id), batch, &plan.spec.output, &meta, table, &script.clip_id)?;
+        let hash = tables::write_parquet(
+            &tables::table_path(out, table, &script.clip_id),
+            batch,
+            &plan.spec.output,
+            &meta,
+            table,
+            &script.clip_id,
+        )?;
         hashes.insert(table.to_string(), hash);
     }
     let ped_frames = u64::from(script.frame_count) * script.pedestrians.len() as u64;
@@ -186,11 +219,19 @@ impl Progress {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let bar = indicatif::ProgressBar::new(total as u64);
             bar.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} clips  {msg}  ETA {eta}").unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} clips  {msg}  ETA {eta}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
             );
             bar
         });
-        Progress { bar, total, done: AtomicUsize::new(0), frames: AtomicU64::new(0), started: Instant::now(), every: if quiet { usize::MAX } else { (total / 20).max(1) } }
+        Progress {
+            bar,
+            total,
+            done: AtomicUsize::new(0),
+            frames: AtomicU64::new(0),
+            started: Instant::now(),
+            every: if quiet { usize::MAX } else { (total / 20).max(1) },
+        }
     }
 
     fn clip_done(&self, clip_id: &str, frames: u64) {
@@ -205,7 +246,10 @@ impl Progress {
             }
             None if done % self.every == 0 || done == self.total => {
                 let eta = secs / done as f64 * (self.total - done) as f64;
-                eprintln!("[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)", self.total);
+                eprintln!(
+                    "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
+                    self.total
+                );
             }
             None => {}
         }
@@ -219,7 +263,12 @@ impl Progress {
 }
 
 /// Generates the dataset of `plan` into `options.out_dir`.
-pub fn generate(plan: &Plan, towns: &BTreeMap<String, TownContext>, options: &GenerateOptions, quiet: bool) -> Result<GenerateReport, GenerateError> {
+pub fn generate(
+    plan: &Plan,
+    towns: &BTreeMap<String, TownContext>,
+    options: &GenerateOptions,
+    quiet: bool,
+) -> Result<GenerateReport, GenerateError> {
     let out = &options.out_dir;
     let hash = plan_hash(plan);
     let existing = check_out_dir(out, &plan.spec_hash, &hash)?;
@@ -230,12 +279,26 @@ pub fn generate(plan: &Plan, towns: &BTreeMap<String, TownContext>, options: &Ge
     }
     std::fs::create_dir_all(out).map_err(|e| GenerateError::Failed(format!("cannot create {}: {e}", out.display())))?;
     let spec_yaml = crate::dsl::to_yaml(&plan.spec);
-    crate::fsutil::write_atomically(&out.join("spec.resolved.yaml"), spec_yaml.as_bytes()).map_err(|e| GenerateError::Failed(format!("cannot write spec.resolved.yaml: {e}")))?;
+    crate::fsutil::write_atomically(&out.join("spec.resolved.yaml"), spec_yaml.as_bytes())
+        .map_err(|e| GenerateError::Failed(format!("cannot write spec.resolved.yaml: {e}")))?;
     let s = &plan.spec.sensors;
-    let sensors: BTreeMap<String, String> = [("rgb", s.rgb.enabled), ("lidar", s.lidar.enabled), ("dvs", s.dvs.enabled)]
-        .into_iter()
-        .map(|(name, on)| (name.to_owned(), if on { "enabled in the spec; not rendered by this pedsynth version (annotations only)".to_owned() } else { "disabled".to_owned() }))
-        .collect();
+    let sensors: BTreeMap<String, String> = [
+        ("rgb", s.rgb.enabled),
+        ("lidar", s.lidar.enabled),
+        ("dvs", s.dvs.enabled),
+    ]
+    .into_iter()
+    .map(|(name, on)| {
+        (
+            name.to_owned(),
+            if on {
+                "enabled in the spec; not rendered by this pedsynth version (annotations only)".to_owned()
+            } else {
+                "disabled".to_owned()
+            },
+        )
+    })
+    .collect();
     let mut manifest = Manifest {
         pedsynth_dataset: DATASET_FORMAT,
         pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
@@ -246,30 +309,55 @@ pub fn generate(plan: &Plan, towns: &BTreeMap<String, TownContext>, options: &Ge
         target_crossing_ratio: plan.target_crossing_ratio,
         tables: TABLES.iter().map(|t| t.to_string()).collect(),
         sensors,
-        clips: plan.clips.iter().map(|c| ManifestClip { clip_id: c.clip_id.clone(), status: "pending".into(), files: BTreeMap::new() }).collect(),
+        clips: plan
+            .clips
+            .iter()
+            .map(|c| ManifestClip {
+                clip_id: c.clip_id.clone(),
+                status: "pending".into(),
+                files: BTreeMap::new(),
+            })
+            .collect(),
     };
     if existing.is_none() {
         write_manifest(out, &manifest)?;
     }
 
-    let todo: Vec<&ClipScript> =
-        plan.clips.iter().filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id)).filter(|c| !clip_done(out, &c.clip_id)).collect();
-    let selected = plan.clips.iter().filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id)).count();
+    let todo: Vec<&ClipScript> = plan
+        .clips
+        .iter()
+        .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
+        .filter(|c| !clip_done(out, &c.clip_id))
+        .collect();
+    let selected = plan
+        .clips
+        .iter()
+        .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
+        .count();
     let camera = Camera::from_spec(&plan.spec.sensors.rgb);
     let progress = Progress::new(todo.len(), quiet);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(options.jobs.unwrap_or(0)).build().map_err(|e| GenerateError::Failed(format!("cannot start workers: {e}")))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| GenerateError::Failed(format!("cannot start workers: {e}")))?;
     let results: Vec<Result<(u64, u64, u64), String>> = pool.install(|| {
         todo.par_iter()
             .map(|script| {
-                let town = towns.get(&script.town).ok_or_else(|| format!("town `{}` is not loaded", script.town))?;
-                let (_, ped_frames, samples) = generate_clip(plan, script, town, &camera, out).map_err(|e| format!("clip {}: {e}", script.clip_id))?;
+                let town = towns
+                    .get(&script.town)
+                    .ok_or_else(|| format!("town `{}` is not loaded", script.town))?;
+                let (_, ped_frames, samples) = generate_clip(plan, script, town, &camera, out)
+                    .map_err(|e| format!("clip {}: {e}", script.clip_id))?;
                 progress.clip_done(&script.clip_id, u64::from(script.frame_count));
                 Ok((u64::from(script.frame_count), ped_frames, samples))
             })
             .collect()
     });
     progress.finish();
-    let mut report = GenerateReport { skipped: selected - todo.len(), ..GenerateReport::default() };
+    let mut report = GenerateReport {
+        skipped: selected - todo.len(),
+        ..GenerateReport::default()
+    };
     let mut failures = Vec::new();
     for r in results {
         match r {
@@ -285,7 +373,8 @@ pub fn generate(plan: &Plan, towns: &BTreeMap<String, TownContext>, options: &Ge
     for clip in &mut manifest.clips {
         if clip_done(out, &clip.clip_id) {
             clip.status = "done".into();
-            clip.files = file_hashes(out, &clip.clip_id).map_err(|e| GenerateError::Failed(format!("cannot hash clip {}: {e}", clip.clip_id)))?;
+            clip.files = file_hashes(out, &clip.clip_id)
+                .map_err(|e| GenerateError::Failed(format!("cannot hash clip {}: {e}", clip.clip_id)))?;
         }
     }
     write_manifest(out, &manifest)?;

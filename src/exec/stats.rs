@@ -95,11 +95,22 @@ fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, String>
     let schema = builder.parquet_schema();
     let indices: Vec<usize> = columns
         .iter()
-        .map(|c| schema.columns().iter().position(|col| col.path().parts()[0] == *c).ok_or_else(|| format!("{}: no column `{c}`", path.display())))
+        .map(|c| {
+            schema
+                .columns()
+                .iter()
+                .position(|col| col.path().parts()[0] == *c)
+                .ok_or_else(|| format!("{}: no column `{c}`", path.display()))
+        })
         .collect::<Result<_, _>>()?;
     let mask = parquet::arrow::ProjectionMask::roots(schema, indices);
-    let reader = builder.with_projection(mask).build().map_err(|e| format!("{}: {e}", path.display()))?;
-    reader.collect::<Result<Vec<_>, _>>().map_err(|e| format!("{}: {e}", path.display()))
+    let reader = builder
+        .with_projection(mask)
+        .build()
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    reader
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn files(dir: &Path, table: &str) -> Result<Vec<PathBuf>, String> {
@@ -114,13 +125,18 @@ fn files(dir: &Path, table: &str) -> Result<Vec<PathBuf>, String> {
 }
 
 fn col<'a>(batch: &'a RecordBatch, name: &str) -> &'a dyn Array {
-    batch.column_by_name(name).map(|c| c.as_ref()).expect("projected column")
+    batch
+        .column_by_name(name)
+        .map(|c| c.as_ref())
+        .expect("projected column")
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
 pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
     let mut s = DatasetStats::default();
-    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json")).ok().and_then(|t| serde_json::from_str(&t).ok());
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
     s.target_crossing_ratio = manifest.as_ref().and_then(|m| m["target_crossing_ratio"].as_f64());
     let mut towns = std::collections::BTreeSet::new();
     let mut weathers = std::collections::BTreeSet::new();
@@ -129,7 +145,23 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
     let mut speed_sums: BTreeMap<String, (f64, u64)> = BTreeMap::new();
     for path in files(dir, "clips")? {
         let mut split = String::new();
-        for b in read_table(&path, &["town", "weather", "split", "frame_count", "duration_s", "annotated_samples", "rejected_too_far", "rejected_behind", "rejected_too_small", "rejected_outside_image", "rejected_occluded", "contacts"])? {
+        for b in read_table(
+            &path,
+            &[
+                "town",
+                "weather",
+                "split",
+                "frame_count",
+                "duration_s",
+                "annotated_samples",
+                "rejected_too_far",
+                "rejected_behind",
+                "rejected_too_small",
+                "rejected_outside_image",
+                "rejected_occluded",
+                "contacts",
+            ],
+        )? {
             for i in 0..b.num_rows() {
                 let town = col(&b, "town").as_string::<i32>().value(i).to_owned();
                 let weather = col(&b, "weather").as_string::<i32>().value(i).to_owned();
@@ -139,10 +171,14 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
                 s.clips += 1;
                 s.frames += frames;
                 s.annotated_samples += samples;
-                duration_s += col(&b, "duration_s").as_primitive::<arrow_array::types::Float64Type>().value(i);
+                duration_s += col(&b, "duration_s")
+                    .as_primitive::<arrow_array::types::Float64Type>()
+                    .value(i);
                 s.contacts += u64::from(col(&b, "contacts").as_primitive::<UInt32Type>().value(i));
                 for reason in ["too_far", "behind", "too_small", "outside_image", "occluded"] {
-                    *s.rejected.entry(reason.to_owned()).or_default() += col(&b, &format!("rejected_{reason}")).as_primitive::<UInt64Type>().value(i);
+                    *s.rejected.entry(reason.to_owned()).or_default() += col(&b, &format!("rejected_{reason}"))
+                        .as_primitive::<UInt64Type>()
+                        .value(i);
                 }
                 let sp = s.splits.entry(split.clone()).or_default();
                 sp.clips += 1;
@@ -152,10 +188,16 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
                 weathers.insert(weather);
             }
         }
-        let clip_id = path.file_stem().map(|x| x.to_string_lossy().into_owned()).unwrap_or_default();
+        let clip_id = path
+            .file_stem()
+            .map(|x| x.to_string_lossy().into_owned())
+            .unwrap_or_default();
         // Pedestrians of this clip: sequence labels and archetypes.
         let mut archetype_of: Vec<String> = Vec::new();
-        for b in read_table(&dir.join("tables/pedestrians").join(format!("{clip_id}.parquet")), &["pedestrian", "archetype", "crosser"])? {
+        for b in read_table(
+            &dir.join("tables/pedestrians").join(format!("{clip_id}.parquet")),
+            &["pedestrian", "archetype", "crosser"],
+        )? {
             for i in 0..b.num_rows() {
                 let id = col(&b, "pedestrian").as_primitive::<UInt32Type>().value(i) as usize;
                 let archetype = col(&b, "archetype").as_string::<i32>().value(i).to_owned();
@@ -174,7 +216,10 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
                 sp.crossers += u64::from(crosser);
             }
         }
-        for b in read_table(&dir.join("tables/annotations").join(format!("{clip_id}.parquet")), &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"])? {
+        for b in read_table(
+            &dir.join("tables/annotations").join(format!("{clip_id}.parquet")),
+            &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"],
+        )? {
             let ped = col(&b, "pedestrian").as_primitive::<UInt32Type>();
             let state = col(&b, "state").as_string::<i32>();
             let crossing = col(&b, "crossing").as_boolean();
@@ -225,16 +270,42 @@ pub fn render_text(s: &DatasetStats) -> String {
     let _ = writeln!(o, "  avg frames per clip        {:.1}", s.mean_frames_per_clip);
     let _ = writeln!(o, "  avg clip duration          {:.1} s", s.mean_duration_s);
     let _ = writeln!(o, "  unique pedestrians         {}", s.pedestrians);
-    let _ = writeln!(o, "    crossing (C)             {} ({:.1}%)", s.crossing, 100.0 * s.crossing_share);
-    let _ = writeln!(o, "    non-crossing (NC)        {} ({:.1}%)", s.non_crossing, 100.0 * s.non_crossing_share);
+    let _ = writeln!(
+        o,
+        "    crossing (C)             {} ({:.1}%)",
+        s.crossing,
+        100.0 * s.crossing_share
+    );
+    let _ = writeln!(
+        o,
+        "    non-crossing (NC)        {} ({:.1}%)",
+        s.non_crossing,
+        100.0 * s.non_crossing_share
+    );
     let _ = writeln!(o, "  C/NC ratio                 {:.2}:1", s.c_nc_ratio);
     let _ = writeln!(o, "  annotated samples          {}", s.annotated_samples);
     let _ = writeln!(o, "  avg samples per clip       {:.0}", s.samples_per_clip);
-    let _ = writeln!(o, "  weathers                   {} ({})", s.weathers.len(), s.weathers.join(", "));
-    let _ = writeln!(o, "  towns                      {} ({})", s.towns.len(), s.towns.join(", "));
+    let _ = writeln!(
+        o,
+        "  weathers                   {} ({})",
+        s.weathers.len(),
+        s.weathers.join(", ")
+    );
+    let _ = writeln!(
+        o,
+        "  towns                      {} ({})",
+        s.towns.len(),
+        s.towns.join(", ")
+    );
     match s.target_crossing_ratio {
         Some(t) => {
-            let _ = writeln!(o, "\ncrossing ratio: target {:.3}, achieved {:.3} ({:+.1} pp)", t, s.achieved_crossing_ratio, 100.0 * (s.achieved_crossing_ratio - t));
+            let _ = writeln!(
+                o,
+                "\ncrossing ratio: target {:.3}, achieved {:.3} ({:+.1} pp)",
+                t,
+                s.achieved_crossing_ratio,
+                100.0 * (s.achieved_crossing_ratio - t)
+            );
         }
         None => {
             let _ = writeln!(o, "\ncrossing ratio: achieved {:.3}", s.achieved_crossing_ratio);
@@ -244,13 +315,27 @@ pub fn render_text(s: &DatasetStats) -> String {
     for (k, v) in &s.state_shares {
         let _ = writeln!(o, "  {k:<20} {:6.2}%", 100.0 * v);
     }
-    let _ = writeln!(o, "\nper archetype                pedestrians crossers  rate   moving speed");
+    let _ = writeln!(
+        o,
+        "\nper archetype                pedestrians crossers  rate   moving speed"
+    );
     for (k, a) in &s.archetypes {
-        let _ = writeln!(o, "  {k:<26} {:>9} {:>8} {:5.1}%  {:.2} m/s", a.pedestrians, a.crossers, 100.0 * a.crossing_rate, a.mean_moving_speed_mps);
+        let _ = writeln!(
+            o,
+            "  {k:<26} {:>9} {:>8} {:5.1}%  {:.2} m/s",
+            a.pedestrians,
+            a.crossers,
+            100.0 * a.crossing_rate,
+            a.mean_moving_speed_mps
+        );
     }
     let _ = writeln!(o, "\nper split");
     for (k, sp) in &s.splits {
-        let _ = writeln!(o, "  {k:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers {:>9} samples", sp.clips, sp.frames, sp.pedestrians, sp.crossers, sp.samples);
+        let _ = writeln!(
+            o,
+            "  {k:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers {:>9} samples",
+            sp.clips, sp.frames, sp.pedestrians, sp.crossers, sp.samples
+        );
     }
     let _ = writeln!(o, "\nvisibility gate rejections (pedestrian-frames)");
     for (k, v) in &s.rejected {

@@ -512,6 +512,8 @@ fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
 
 /// Ego routes tried before a clip is declared infeasible.
 const ROUTE_ATTEMPTS: usize = 8;
+/// How far from the curb a crosser starts, metres.
+const CURB_STANDOFF_M: f64 = 0.3;
 /// Minimum distance between two pedestrians' spawn points, metres.
 const PED_SPACING_M: f64 = 1.0;
 /// Attempts to place one pedestrian before the clip is declared infeasible.
@@ -591,11 +593,8 @@ fn plan_pedestrians(
                     rng,
                 ),
                 (Role::Crosser, _) => {
-                    let (lo, hi) = if alloc.source == CrosserSource::Allocated {
-                        (spawn_ahead.min(), spawn_ahead.max())
-                    } else {
-                        (0.0, far_m)
-                    };
+                    // Allocated and baseline crossers alike start within the spawn range ahead of the ego.
+                    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max());
                     let placed = place_crosser(net, route, lo, hi.min(far_m), crosser_side, &scripts, rng);
                     crosser_side = if crosser_side == Side::Left {
                         Side::Right
@@ -699,9 +698,13 @@ fn place_crosser(
         if crossing.carriageway_width_m < 2.0 {
             continue;
         }
+        // A crosser starts at its curb, facing the road (if that spot is free sidewalk).
         let heading = crossing.direction.to_angle();
+        let at_curb = crossing.near_curb - crossing.direction * CURB_STANDOFF_M;
+        let free = is_lane(net, at_curb, LaneType::Sidewalk) && far_from_others(at_curb, scripts);
+        let spawn = if free { at_curb } else { sample.pos };
         return Some((
-            sample.pos,
+            spawn,
             heading,
             s,
             Some(crossing_script(&crossing)),

@@ -236,6 +236,8 @@ pub(crate) struct Ped {
 
     /// The decision to cross has been announced (CrossingDecision emitted).
     pub decided: bool,
+    /// The decision to cross was a decision-window commit (the ego approaches inside the window and brakes).
+    pub window_commit: bool,
     /// Has been on the road in a crossing state.
     pub entered_road: bool,
     /// The crossing is over (finished) or given up (abandoned): never cross again.
@@ -256,10 +258,15 @@ pub(crate) struct Ped {
 
     // Perception (from the state at the start of the step).
     pub min_ttc_s: f64,
+    /// Minimum TTC over every vehicle but the ego, seconds.
+    pub min_ttc_others_s: f64,
     pub ego_dist_m: f64,
     /// Distance to the nearest vehicle centre, metres.
     pub nearest_vehicle_m: f64,
     pub ego_ahead: bool,
+    /// Where the pedestrian stands along the ego's route (its planned distance ahead of the ego's start),
+    /// metres: "ahead of the ego" is decided along the route, which stays right where the route turns.
+    pub route_s_m: f64,
     /// Vehicle id of a lookahead conflict this step (own probes).
     pub conflict_vehicle: Option<u32>,
     /// The conflict is a standing vehicle blocking the way.
@@ -336,9 +343,12 @@ impl Ped {
             walker: SidewalkWalker::default(),
             rng,
             min_ttc_s: f64::INFINITY,
+            min_ttc_others_s: f64::INFINITY,
+            window_commit: false,
             ego_dist_m: f64::INFINITY,
             nearest_vehicle_m: f64::INFINITY,
             ego_ahead: true,
+            route_s_m: script.ahead_of_ego_m,
             conflict_vehicle: None,
             blocked_by_standing: false,
             group_speed_mps: 0.0,
@@ -399,13 +409,18 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
         vehicles.iter().map(|v| (v.pose.pos, v.velocity())),
         params.gap_acceptance.vehicle_range_m,
     );
+    p.min_ttc_others_s = ttc::min_ttc_s(
+        p.pos,
+        vehicles.iter().skip(1).map(|v| (v.pose.pos, v.velocity())),
+        params.gap_acceptance.vehicle_range_m,
+    );
     p.nearest_vehicle_m = vehicles
         .iter()
         .map(|v| v.pose.pos.distance(p.pos))
         .fold(f64::INFINITY, f64::min);
     let ego = &vehicles[0];
     p.ego_dist_m = ego.pose.pos.distance(p.pos);
-    p.ego_ahead = (p.pos - ego.pose.pos).dot(DVec2::from_angle(ego.pose.heading_rad)) > 0.0;
+    p.ego_ahead = ego.s_m < p.route_s_m;
     p.conflict_vehicle = None;
     let Some(line) = p.line else {
         return;
@@ -492,6 +507,24 @@ fn ego_in_window_or_past(p: &Ped, params: &SimParams) -> bool {
     !p.ego_ahead || (p.ego_dist_m >= w.min() && p.ego_dist_m <= w.max())
 }
 
+/// Whether the ego approaches inside the decision window.
+fn ego_in_window(p: &Ped, params: &SimParams) -> bool {
+    let w = params.decision_window_m;
+    p.ego_ahead && p.ego_dist_m >= w.min() && p.ego_dist_m <= w.max()
+}
+
+/// Whether an allocated crosser may go now. The paper's crosser "commits to entering the road as soon as the
+/// ego-vehicle is within the 10–40 m decision window" (the ego then brakes for it): inside the window it only
+/// waits for another vehicle about to arrive (TTC below its τ_ttc); otherwise the full gap-acceptance rule
+/// min TTC > τ_ttc + Δ_safety + w_road / s_cross applies to every vehicle in range.
+fn gap_ok(p: &Ped, params: &SimParams) -> bool {
+    if ego_in_window(p, params) {
+        p.min_ttc_others_s > p.ttc_threshold_s
+    } else {
+        ttc::gap_accepted(p.min_ttc_s, gap_threshold_s(p, params))
+    }
+}
+
 /// Whether the ego has reached the decision window (or passed): the sudden crosser's trigger.
 fn ego_reached_window(p: &Ped, params: &SimParams) -> bool {
     !p.ego_ahead || p.ego_dist_m <= params.decision_window_m.max()
@@ -519,9 +552,12 @@ pub(crate) fn transition(
     let crosser_waiting = !p.attempt_over && !p.decided;
 
     // Distraction (phone use) starts at its planned time, whatever the pedestrian is doing.
+    // A crosser waiting for the ego's decision window does not pick up its phone before the attempt is over
+    // (it would miss the window); the phone comes out afterwards.
     if let Some(at) = p.distracted_at_s
         && !p.distraction_done
         && ctx.time_s >= at
+        && !(crosser_waiting && p.source == CrosserSource::Allocated)
     {
         match p.state {
             PedState::WalkingSidewalk | PedState::LookingAround | PedState::CheckingTraffic | PedState::Hesitating => {
@@ -597,7 +633,8 @@ pub(crate) fn transition(
             }
         }
         PedState::LookingAround => {
-            let brief = p.behaviour == Behaviour::Jaywalk;
+            // A jaywalker, or any crosser with the ego already inside the decision window, only glances.
+            let brief = p.behaviour == Behaviour::Jaywalk || (!p.attempt_over && ego_in_window(p, params));
             if t < scan_duration_s(p.attention, brief || p.attempt_over) {
                 return;
             }
@@ -605,7 +642,12 @@ pub(crate) fn transition(
                 set_state(p, PedState::WalkingSidewalk, frame, events);
             } else if p.behaviour == Behaviour::Jaywalk {
                 // Mid-block crossing after a brief check: only a vehicle about to arrive holds it back.
-                if ego_in_window_or_past(p, params) && p.min_ttc_s > JAYWALK_MIN_TTC_S {
+                let ttc = if ego_in_window(p, params) {
+                    p.min_ttc_others_s
+                } else {
+                    p.min_ttc_s
+                };
+                if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S {
                     decide_to_cross(p, frame, events);
                     set_state(p, PedState::Jaywalking, frame, events);
                 }
@@ -621,9 +663,10 @@ pub(crate) fn transition(
                 // CARLA's walkers stop and check: no vehicle within a few metres, none about to arrive.
                 p.nearest_vehicle_m > BASELINE_CLEAR_M && p.min_ttc_s > JAYWALK_MIN_TTC_S
             } else {
-                ego_in_window_or_past(p, params) && ttc::gap_accepted(p.min_ttc_s, gap_threshold_s(p, params))
+                ego_in_window_or_past(p, params) && gap_ok(p, params)
             };
             if go {
+                p.window_commit = p.source != CrosserSource::Baseline && ego_in_window(p, params);
                 decide_to_cross(p, frame, events);
                 set_state(p, PedState::Hesitating, frame, events);
             }
@@ -632,8 +675,11 @@ pub(crate) fn transition(
             let threshold = gap_threshold_s(p, params);
             let lost = if p.source == CrosserSource::Baseline {
                 p.nearest_vehicle_m <= BASELINE_CLEAR_M || p.min_ttc_s <= JAYWALK_MIN_TTC_S
+            } else if p.window_commit {
+                // Committed with the ego in the window: only another vehicle about to arrive holds it back.
+                p.min_ttc_others_s <= p.ttc_threshold_s
             } else {
-                !ttc::gap_accepted(p.min_ttc_s, threshold)
+                !gap_ok(p, params)
             };
             if lost {
                 set_state(p, PedState::CheckingTraffic, frame, events);
