@@ -1,6 +1,7 @@
 //! pedsynth: compile a YAML dataset spec into a synthetic pedestrian-crossing dataset, without CARLA.
 //!
 //! Pipeline: `dsl` (spec → validated, defaulted `Spec`) → `world` (road networks) → planner → executor.
+pub mod calibration;
 pub mod commands;
 pub mod dsl;
 pub mod exec;

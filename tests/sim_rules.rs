@@ -127,7 +127,17 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
     }
 }
 
-fn clip(ego: EgoScript, vehicles: Vec<VehicleScript>, pedestrians: Vec<PedestrianScript>, seconds: u32) -> ClipScript {
+/// A clip on the straight road; pedestrians' distance ahead of the ego's start is measured along x (the ego
+/// drives towards +x).
+fn clip(
+    ego: EgoScript,
+    vehicles: Vec<VehicleScript>,
+    mut pedestrians: Vec<PedestrianScript>,
+    seconds: u32,
+) -> ClipScript {
+    for p in &mut pedestrians {
+        p.ahead_of_ego_m = p.spawn.x - ego.route.start.x;
+    }
     ClipScript {
         clip_id: "straight-clear_noon-0000".to_owned(),
         seed: 7,
@@ -285,10 +295,11 @@ fn a_vehicle_that_is_not_closing_does_not_block() {
 }
 
 #[test]
-fn an_allocated_crosser_waits_for_the_decision_window_and_the_gap() {
+fn an_allocated_crosser_commits_when_the_ego_enters_the_decision_window() {
     let net = road();
-    // The ego approaches at 8.3 m/s from 60 m: inside the window its TTC is far below the threshold, so the
-    // crosser only commits once the ego has passed.
+    // The ego approaches at 8.3 m/s from 60 m. Outside the window the crosser waits (the ego's TTC is far
+    // below the gap threshold); once the ego is inside the 10–40 m window it commits (the paper's rule) and the
+    // ego brakes for it.
     let script = clip(
         ego_at(&net, 90.0, 0.0),
         vec![],
@@ -297,9 +308,50 @@ fn an_allocated_crosser_waits_for_the_decision_window_and_the_gap() {
     );
     let trace = sim::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
-    let entered = first_in_road(&trace, 0).expect("crosses after the ego passed");
+    let decision = trace
+        .events
+        .iter()
+        .find_map(|e| {
+            if let Event::CrossingDecision { frame, .. } = e {
+                Some(*frame as usize)
+            } else {
+                None
+            }
+        })
+        .expect("decides to cross");
+    let gap = 150.0 - trace.ego[decision].pos.x;
+    assert!((10.0..=40.5).contains(&gap), "decided with the ego {gap} m away");
+    let entered = first_in_road(&trace, 0).expect("crosses");
     let ego_x = trace.ego[entered].pos.x;
-    assert!(ego_x > 150.0, "entered the road with the ego at x = {ego_x}");
+    assert!(
+        ego_x < 150.0,
+        "entered the road in front of the ego (ego at x = {ego_x})"
+    );
+    assert!(
+        trace.ego.iter().any(|f| f.accel_mps2 < -1.0),
+        "the ego brakes for the crosser"
+    );
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn a_crosser_facing_another_closing_vehicle_inside_the_window_waits_for_it() {
+    let net = road();
+    // The ego is inside the window, but a traffic vehicle in the far lane is 12 m away closing at ~8.3 m/s
+    // (TTC ≈ 1.4 s): the crosser lets it pass before stepping out.
+    let script = clip(
+        ego_at(&net, 120.0, 60.0),
+        vec![vehicle(&net, 0, false, 162.0, 0.0, false)],
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        10,
+    );
+    let trace = sim::simulate(&script, &params(), &net);
+    let entered = first_in_road(&trace, 0).expect("crosses");
+    let other_x = trace.vehicles[0][entered].pos.x;
+    assert!(
+        other_x < 150.0,
+        "stepped out only after the other vehicle passed (it is at x = {other_x})"
+    );
     assert_no_interpenetration(&trace);
 }
 

@@ -67,11 +67,14 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
     frames * per_frame
 }
 
-/// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`.
+/// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, the
+/// highest is what its largest allocation yields once the measured share of planned crossers that end up
+/// labelled crossers is taken into account ([`crate::calibration::CROSSER_REALISATION`]).
 pub fn reachable_crossing_ratio(crossing: &Crossing) -> (f64, f64) {
     let l1 = &crossing.layers.crosser_allocation;
     if l1.enabled {
-        let hi = l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio;
+        let hi = (l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio)
+            * crate::calibration::CROSSER_REALISATION;
         (crossing.baseline_ratio, hi)
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)

@@ -179,19 +179,19 @@ struct PedAlloc {
     group: Option<usize>,
 }
 
-/// The share of pedestrians layer 1 allocates as crossers so that, with the baseline, the target is met.
+/// The share of pedestrians layer 1 allocates as crossers so that, with the baseline and the measured share of
+/// planned crossers that end up labelled crossers ([`crate::calibration::CROSSER_REALISATION`]), the expected
+/// labelled crossing ratio meets the target.
 pub fn allocated_crosser_ratio(spec: &Spec) -> f64 {
     let c = &spec.crossing;
     let l1 = &c.layers.crosser_allocation;
     if !l1.enabled {
         return 0.0;
     }
+    // Plan enough crossers that the expected share labelled crossers in the dataset meets the target.
+    let planned = (c.target_ratio / crate::calibration::CROSSER_REALISATION).min(1.0);
     let b = c.baseline_ratio;
-    let r = if b >= 1.0 {
-        0.0
-    } else {
-        (c.target_ratio - b) / (1.0 - b)
-    };
+    let r = if b >= 1.0 { 0.0 } else { (planned - b) / (1.0 - b) };
     r.clamp(0.0, l1.max_crosser_ratio)
 }
 
@@ -512,6 +512,9 @@ fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
 
 /// Ego routes tried before a clip is declared infeasible.
 const ROUTE_ATTEMPTS: usize = 8;
+/// Mid-road jaywalkers start at most this far ahead of the ego, metres: they cross at once, and farther away
+/// their whole crossing would be too small in the image to be annotated.
+const MIDROAD_MAX_AHEAD_M: f64 = 30.0;
 /// How far from the curb a crosser starts, metres.
 const CURB_STANDOFF_M: f64 = 0.3;
 /// Minimum distance between two pedestrians' spawn points, metres.
@@ -587,7 +590,10 @@ fn plan_pedestrians(
                 (Role::Crosser, Behaviour::MidroadJaywalker) => place_midroad(
                     net,
                     route,
-                    spawn_ahead,
+                    crate::dsl::types::Range(
+                        spawn_ahead.min(),
+                        spawn_ahead.max().min(MIDROAD_MAX_AHEAD_M).max(spawn_ahead.min()),
+                    ),
                     c.layers.midroad_jaywalkers.lateral_offset_m,
                     &scripts,
                     rng,
@@ -793,7 +799,7 @@ fn place_follower(
     let along = DVec2::from_angle(leader.spawn_heading_rad).perp();
     for _ in 0..PLACEMENT_ATTEMPTS {
         let offset = rng.random_range(1.0..2.5) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-        let back = rng.random_range(-0.6..0.3);
+        let back = 0.0; // side by side with the leader, at the same distance from the curb
         let p = leader.spawn + along * offset + DVec2::from_angle(leader.spawn_heading_rad) * back;
         let kind = if leader.spawn_place == SpawnPlace::DrivingLane {
             LaneType::Driving

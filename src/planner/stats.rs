@@ -100,6 +100,9 @@ pub struct PlanStats {
     pub crossers_by_source: BTreeMap<String, usize>,
     /// Planned sequence-level crossing ratio.
     pub planned_crossing_ratio: f64,
+    /// Expected share of pedestrians labelled crossers in the dataset (planned crossers × the measured
+    /// realisation, `calibration::CROSSER_REALISATION`).
+    pub expected_crossing_ratio: f64,
     /// Target crossing ratio.
     pub target_crossing_ratio: f64,
     /// Pedestrians per archetype.
@@ -144,6 +147,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         crossers: 0,
         crossers_by_source: BTreeMap::new(),
         planned_crossing_ratio: 0.0,
+        expected_crossing_ratio: 0.0,
         target_crossing_ratio: plan.target_crossing_ratio,
         archetypes: spec.pedestrians.archetype_mix.keys().map(|k| (k.clone(), 0)).collect(),
         behaviours: Behaviour::ALL.iter().map(|b| (b.name().to_owned(), 0)).collect(),
@@ -224,6 +228,9 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
     }
     if stats.pedestrians > 0 {
         stats.planned_crossing_ratio = round(stats.crossers as f64 / stats.pedestrians as f64, 4);
+        let allocated = stats.crossers_by_source.get("allocated").copied().unwrap_or(0) as f64;
+        let expected = allocated * crate::calibration::CROSSER_REALISATION + (stats.crossers as f64 - allocated);
+        stats.expected_crossing_ratio = round(expected / stats.pedestrians as f64, 4);
     }
     stats.estimated_annotated_samples = (stats.pedestrian_frames as f64 * EXPECTED_VISIBLE_SHARE).round() as u64;
     stats.estimated_bytes = estimate_bytes(&stats, spec, vehicle_frames);
@@ -349,8 +356,8 @@ pub fn render_text(stats: &PlanStats) -> String {
     );
     let _ = writeln!(
         out,
-        "planned crossing ratio {:.3} (target {:.3})",
-        stats.planned_crossing_ratio, stats.target_crossing_ratio
+        "planned crossing ratio {:.3}: expected labelled crossing ratio {:.3} (target {:.3})",
+        stats.planned_crossing_ratio, stats.expected_crossing_ratio, stats.target_crossing_ratio
     );
     let _ = writeln!(out, "vehicles              {}", stats.vehicles);
     let _ = writeln!(

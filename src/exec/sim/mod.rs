@@ -134,6 +134,10 @@ impl<'a> Sim<'a> {
                 )
             })
             .collect();
+        // A pedestrian's place along the ego's route is its planned distance ahead of the ego's start.
+        for p in &mut peds {
+            p.route_s_m += vehicles[0].s_m;
+        }
         // Groups: followers point at their leader (by index), leaders list their followers.
         let index_of = |id: u32| script.pedestrians.iter().position(|p| p.id == id);
         for (i, s) in script.pedestrians.iter().enumerate() {

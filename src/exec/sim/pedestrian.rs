@@ -29,6 +29,10 @@ const CURB_STANDOFF_M: f64 = 0.3;
 const CHECK_MIN_S: f64 = 0.5;
 /// A jaywalker's brief check only waits while a vehicle would arrive within this time, seconds.
 const JAYWALK_MIN_TTC_S: f64 = 2.0;
+/// A committed crosser stops hesitating when the ego comes this much closer than the window's near edge, metres.
+const HESITATION_CUTOFF_M: f64 = 3.0;
+/// A crosser committing inside the decision window waits only for another vehicle this close in time, seconds.
+const COMMIT_MIN_TTC_S: f64 = 2.0;
 /// A baseline (CARLA-like) crosser waits until no vehicle is this close, metres (CARLA's stop-and-check).
 const BASELINE_CLEAR_M: f64 = 6.0;
 /// A conflict ends after the lookahead has been clear this long, seconds.
@@ -363,6 +367,20 @@ impl Ped {
         if script.behaviour == Behaviour::MidroadJaywalker && script.spawn_place == SpawnPlace::DrivingLane {
             p.state = PedState::Jaywalking;
             p.decided = true;
+        } else if script.crosser_source != CrosserSource::None
+            && matches!(script.behaviour, Behaviour::Normal | Behaviour::Jaywalk)
+            && p.line.is_some_and(|l| l.curb_point().distance(p.pos) < 0.1)
+            && script.ahead_of_ego_m <= params.decision_window_m.max()
+        {
+            // A crosser that starts at its curb with the ego already inside the decision window has been waiting
+            // there before the clip began: it is already checking traffic (a jaywalker: glancing).
+            p.at_curb = true;
+            p.state = if script.behaviour == Behaviour::Jaywalk {
+                PedState::LookingAround
+            } else {
+                PedState::CheckingTraffic
+            };
+            p.state_time_s = CHECK_MIN_S;
         }
         p
     }
@@ -515,11 +533,11 @@ fn ego_in_window(p: &Ped, params: &SimParams) -> bool {
 
 /// Whether an allocated crosser may go now. The paper's crosser "commits to entering the road as soon as the
 /// ego-vehicle is within the 10–40 m decision window" (the ego then brakes for it): inside the window it only
-/// waits for another vehicle about to arrive (TTC below its τ_ttc); otherwise the full gap-acceptance rule
-/// min TTC > τ_ttc + Δ_safety + w_road / s_cross applies to every vehicle in range.
+/// waits for another vehicle about to arrive (TTC below `COMMIT_MIN_TTC_S`); otherwise the full gap-acceptance
+/// rule min TTC > τ_ttc + Δ_safety + w_road / s_cross applies to every vehicle in range.
 fn gap_ok(p: &Ped, params: &SimParams) -> bool {
     if ego_in_window(p, params) {
-        p.min_ttc_others_s > p.ttc_threshold_s
+        p.min_ttc_others_s > COMMIT_MIN_TTC_S
     } else {
         ttc::gap_accepted(p.min_ttc_s, gap_threshold_s(p, params))
     }
@@ -557,7 +575,7 @@ pub(crate) fn transition(
     if let Some(at) = p.distracted_at_s
         && !p.distraction_done
         && ctx.time_s >= at
-        && !(crosser_waiting && p.source == CrosserSource::Allocated)
+        && (p.source != CrosserSource::Allocated || p.attempt_over)
     {
         match p.state {
             PedState::WalkingSidewalk | PedState::LookingAround | PedState::CheckingTraffic | PedState::Hesitating => {
@@ -677,13 +695,17 @@ pub(crate) fn transition(
                 p.nearest_vehicle_m <= BASELINE_CLEAR_M || p.min_ttc_s <= JAYWALK_MIN_TTC_S
             } else if p.window_commit {
                 // Committed with the ego in the window: only another vehicle about to arrive holds it back.
-                p.min_ttc_others_s <= p.ttc_threshold_s
+                p.min_ttc_others_s <= COMMIT_MIN_TTC_S
             } else {
                 !gap_ok(p, params)
             };
+            // Committed inside the window, a crosser cuts its hesitation short rather than let the ego come so
+            // close that stepping out would be unsafe.
+            let ego_closing_in =
+                p.window_commit && p.ego_ahead && p.ego_dist_m <= params.decision_window_m.min() + HESITATION_CUTOFF_M;
             if lost {
                 set_state(p, PedState::CheckingTraffic, frame, events);
-            } else if t >= p.hesitation_s {
+            } else if t >= p.hesitation_s || ego_closing_in {
                 // Closing a tight gap: rushed.
                 if p.min_ttc_s < 1.5 * threshold {
                     switch_profile(p, params, SpeedProfile::Rushed);

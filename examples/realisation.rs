@@ -1,0 +1,82 @@
+//! Measures the crossing realisation that `src/calibration.rs` records: the share of planned crossers (layer 1)
+//! that end up labelled crossers (C = 1 in at least one annotated frame), per spec.
+//!
+//! Run: `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml`
+
+use std::path::Path;
+
+use pedsynth::commands::load_towns;
+use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::exec::{annotate, camera::Camera, sim};
+use pedsynth::planner::{self, CrosserSource, Role};
+use pedsynth::world::LaneType;
+use rayon::prelude::*;
+
+fn main() {
+    for spec in std::env::args().skip(1) {
+        let loaded = match dsl::load_file(Path::new(&spec), &LoadOptions::default()) {
+            Ok(l) => l,
+            Err(e) => {
+                eprintln!("{}", e.render_plain(100));
+                std::process::exit(2);
+            }
+        };
+        let towns = load_towns(&loaded).expect("towns load");
+        let plan = planner::plan(
+            &loaded.spec,
+            &loaded.hash(),
+            &loaded.base_dir.display().to_string(),
+            &towns,
+            None,
+        )
+        .expect("feasible");
+        let camera = Camera::from_spec(&plan.spec.sensors.rgb);
+        // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled)
+        let counts: Vec<[usize; 6]> = plan
+            .clips
+            .par_iter()
+            .map(|clip| {
+                let net = &towns[&clip.town].network;
+                let trace = sim::simulate(clip, &plan.sim, net);
+                let ann = annotate::annotate(clip, &trace, &plan.spec.annotations, &camera, net);
+                let mut c = [0usize; 6];
+                for (i, p) in clip.pedestrians.iter().enumerate() {
+                    c[0] += 1;
+                    let labelled = usize::from(ann.pedestrians[i].crosser);
+                    let on_road = trace.pedestrians[i]
+                        .iter()
+                        .any(|f| f.state.is_crossing() && f.lane_type == Some(LaneType::Driving));
+                    match (p.role, p.crosser_source) {
+                        (Role::Crosser, CrosserSource::Allocated) => {
+                            c[1] += 1;
+                            c[2] += labelled;
+                            c[3] += usize::from(on_road);
+                        }
+                        (Role::Crosser, CrosserSource::Baseline) => {
+                            c[4] += 1;
+                            c[5] += labelled;
+                        }
+                        _ => {}
+                    }
+                }
+                c
+            })
+            .collect();
+        let t = counts.iter().fold([0usize; 6], |mut acc, c| {
+            for k in 0..6 {
+                acc[k] += c[k];
+            }
+            acc
+        });
+        let share = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+        println!(
+            "{spec}: {} pedestrians; allocated crossers {}: on a driving lane {:.3}, labelled {:.3}; baseline crossers {}: labelled {:.3}",
+            t[0],
+            t[1],
+            share(t[3], t[1]),
+            share(t[2], t[1]),
+            t[4],
+            share(t[5], t[4])
+        );
+    }
+}
