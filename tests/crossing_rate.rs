@@ -19,9 +19,20 @@ fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
         ],
         allow_large: false,
     };
-    let args = GenerateArgs { out: out.clone(), jobs: None, only: None, quiet: true };
+    let args = GenerateArgs {
+        out: out.clone(),
+        jobs: None,
+        only: None,
+        quiet: true,
+    };
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let code = commands::generate(std::path::Path::new("specs/balanced_50.yaml"), &options, &args, &mut stdout, &mut stderr);
+    let code = commands::generate(
+        std::path::Path::new("specs/balanced_50.yaml"),
+        &options,
+        &args,
+        &mut stdout,
+        &mut stderr,
+    );
     assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
     let stats = stats::compute(&out).expect("the tables read back");
     (out, stats)
@@ -34,7 +45,11 @@ fn achieved_crossing_ratio_is_within_3_pp_of_the_target() {
         assert!(stats.pedestrians >= 1000, "{} pedestrians", stats.pedestrians);
         assert_eq!(stats.target_crossing_ratio, Some(target));
         let achieved = stats.achieved_crossing_ratio;
-        assert!((achieved - target).abs() <= 0.03, "target {target}: achieved {achieved:.3} over {} pedestrians", stats.pedestrians);
+        assert!(
+            (achieved - target).abs() <= 0.03,
+            "target {target}: achieved {achieved:.3} over {} pedestrians",
+            stats.pedestrians
+        );
         let _ = std::fs::remove_dir_all(&out);
     }
 }

@@ -9,15 +9,22 @@ use serde::Serialize;
 use super::script::{Behaviour, CrosserSource, Plan, Role};
 use crate::dsl::types::Spec;
 
-/// Share of pedestrian-frames expected to pass the visibility gate (PedSynth++ reports 1.63 M samples for
-/// 3,426 pedestrians over 177 k frames with every row written twice: about 0.7 of pedestrian-frames).
-pub const EXPECTED_VISIBLE_SHARE: f64 = 0.7;
-/// Compressed bytes per `annotations` row (box, 17×3 keypoints, state, 3D state), zstd.
-pub const ANNOTATION_ROW_BYTES: f64 = 120.0;
-/// Compressed bytes per `frames` row.
-pub const FRAME_ROW_BYTES: f64 = 40.0;
-/// Compressed bytes per `vehicles` row.
-pub const VEHICLE_ROW_BYTES: f64 = 30.0;
+// Table-size constants measured on `specs/pedsynth_pp.yaml` (600 clips: 1,701,362 pedestrian-frames, 581,588
+// annotated samples; `du -sb out/tables/*`), zstd level 3.
+/// Share of pedestrian-frames that pass the visibility gate (measured: 0.342).
+pub const EXPECTED_VISIBLE_SHARE: f64 = 0.342;
+/// Bytes per `annotations` row (box, 2 × 17×3 keypoints, state, 3D state) (measured: 420).
+pub const ANNOTATION_ROW_BYTES: f64 = 420.0;
+/// Bytes per `frames` row (measured: 40.5).
+pub const FRAME_ROW_BYTES: f64 = 40.5;
+/// Bytes per `vehicles` row (measured: 14.5).
+pub const VEHICLE_ROW_BYTES: f64 = 14.5;
+/// Bytes per clip of the one-row `clips` table: mostly Parquet metadata (measured: 8,500).
+pub const CLIP_FILE_BYTES: f64 = 8_500.0;
+/// Bytes per pedestrian of the `pedestrians` table (measured: 924).
+pub const PEDESTRIAN_ROW_BYTES: f64 = 924.0;
+/// Bytes of the `events` table per pedestrian (measured: 570).
+pub const EVENT_BYTES_PER_PEDESTRIAN: f64 = 570.0;
 /// Bytes per pixel of a fast-compressed PNG frame of a rendered street scene (an estimate).
 pub const PNG_BYTES_PER_PIXEL: f64 = 1.0;
 /// Bytes per LiDAR point (x, y, z, intensity as f32).
@@ -26,6 +33,11 @@ pub const LIDAR_POINT_BYTES: f64 = 16.0;
 pub const DVS_EVENTS_PER_PIXEL: f64 = 0.02;
 /// Bytes per DVS event (x u16, y u16, t i64, polarity), before compression.
 pub const DVS_EVENT_BYTES: f64 = 13.0;
+
+/// Pedestrian-frames simulated, annotated and written per CPU-second by `pedsynth generate` (annotation tables
+/// only), release build: 1,701,362 pedestrian-frames of `specs/pedsynth_pp.yaml` in 13.1 CPU-seconds
+/// (BENCHMARKS.md, "Generation").
+pub const GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S: f64 = 130_000.0;
 
 /// Clips in one (town, weather) cell.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -123,6 +135,8 @@ pub struct PlanStats {
     pub estimated_annotated_samples: u64,
     /// Estimated output size.
     pub estimated_bytes: SizeEstimate,
+    /// Estimated generation time on one core, seconds (annotation tables; sensors are not rendered yet).
+    pub estimated_generation_cpu_s: f64,
     /// Counts per split.
     pub splits: BTreeMap<String, SplitStats>,
 }
@@ -164,6 +178,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         pedestrian_frames: 0,
         estimated_annotated_samples: 0,
         estimated_bytes: SizeEstimate::default(),
+        estimated_generation_cpu_s: 0.0,
         splits: BTreeMap::new(),
     };
     let mut vehicle_frames = 0u64;
@@ -175,7 +190,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         stats.pedestrians += clip.pedestrians.len();
         stats.pedestrian_frames += frames * clip.pedestrians.len() as u64;
         stats.vehicles += clip.vehicles.len();
-        vehicle_frames += frames * (clip.vehicles.len() as u64 + 1);
+        vehicle_frames += frames * clip.vehicles.len() as u64;
         let split = stats
             .splits
             .entry(format!("{:?}", clip.split).to_lowercase())
@@ -234,6 +249,10 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
     }
     stats.estimated_annotated_samples = (stats.pedestrian_frames as f64 * EXPECTED_VISIBLE_SHARE).round() as u64;
     stats.estimated_bytes = estimate_bytes(&stats, spec, vehicle_frames);
+    stats.estimated_generation_cpu_s = round(
+        stats.pedestrian_frames as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S,
+        1,
+    );
     stats
 }
 
@@ -247,11 +266,16 @@ fn estimate_bytes(stats: &PlanStats, spec: &Spec, vehicle_frames: u64) -> SizeEs
     e.tables.insert("frames".into(), (frames * FRAME_ROW_BYTES) as u64);
     e.tables
         .insert("vehicles".into(), (vehicle_frames as f64 * VEHICLE_ROW_BYTES) as u64);
+    e.tables.insert(
+        "pedestrians".into(),
+        (stats.pedestrians as f64 * PEDESTRIAN_ROW_BYTES) as u64,
+    );
     e.tables
-        .insert("pedestrians".into(), (stats.pedestrians as f64 * 200.0) as u64);
-    e.tables.insert("clips".into(), (stats.clips as f64 * 500.0) as u64);
-    e.tables
-        .insert("events".into(), (stats.pedestrians as f64 * 8.0 * 40.0) as u64);
+        .insert("clips".into(), (stats.clips as f64 * CLIP_FILE_BYTES) as u64);
+    e.tables.insert(
+        "events".into(),
+        (stats.pedestrians as f64 * EVENT_BYTES_PER_PEDESTRIAN) as u64,
+    );
     let s = &spec.sensors;
     let pixels = f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px);
     if s.rgb.enabled {
@@ -389,6 +413,12 @@ pub fn render_text(stats: &PlanStats) -> String {
             s.clips, s.frames, s.pedestrians, s.crossers
         );
     }
+    let _ = writeln!(
+        out,
+        "\nestimated generation time {:.1} s on one core, {:.1} s on two (annotation tables; sensors are not rendered yet)",
+        stats.estimated_generation_cpu_s,
+        stats.estimated_generation_cpu_s / 2.0
+    );
     let _ = writeln!(
         out,
         "\nestimated output size (total {})",
