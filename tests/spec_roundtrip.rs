@@ -64,7 +64,7 @@ const ARCHETYPES: [&str; 5] = [
 fn valid_overrides() -> impl Strategy<Value = Vec<String>> {
     (
         any::<u64>(),
-        0.1f64..0.85,
+        0.1f64..0.8,
         proptest::sample::subsequence(WEATHERS.to_vec(), 1..=12),
         proptest::sample::subsequence(vec!["town01_like", "town02_like", "town03_like", "town05_like"], 1..=4),
         (1u32..20, 1u32..20, 1u32..20),
