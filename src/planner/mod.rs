@@ -743,7 +743,8 @@ fn place_sidewalk(
         } else {
             wrap_angle(along + PI)
         };
-        let crossing = net.crossing_at(sample.pos).map(|c| crossing_script(&c));
+        // Non-crossers never cross: no crossing vector (the costliest query) is computed for them.
+        let crossing = None;
         return Some((sample.pos, heading, s, crossing, SpawnPlace::Sidewalk));
     }
     None
