@@ -704,6 +704,10 @@ fn quickstart_tables_satisfy_the_invariants() {
         d.annotations.iter().any(|a| a.crossing),
         "quickstart has crossing samples (the invariants on C are not vacuous)"
     );
+    assert!(
+        d.annotations.iter().any(|a| a.tte.is_some_and(|t| t > 0)),
+        "quickstart has samples before a first crossing (the TTE invariants are not vacuous)"
+    );
 }
 
 #[test]
@@ -712,7 +716,7 @@ fn a_spec_with_groups_and_several_towns_satisfies_the_invariants() {
     let out = tmp.join("out");
     let overrides = [
         "dataset.clips.count=1",
-        "dataset.weathers=[clear_noon, night_rainy, wet_sunset]",
+        "dataset.weathers=[clear_noon, night_rainy, rainy_sunset]",
         "dataset.clip_duration_s=[8, 9]",
     ];
     generate_ok(&spec("pedsynth_pp.yaml"), &overrides, &out, 2);
@@ -794,6 +798,15 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
     assert!(stdout.contains("generated 0 clips (3 already done)"), "{stdout}");
     assert_same_files(&one, &from_plan, "re-run of a finished dataset");
 
+    // The same spec from another directory — the dataset's own spec.resolved.yaml, copied elsewhere — is the
+    // same dataset: it resumes (nothing to do) instead of being refused.
+    let elsewhere = tmp.join("elsewhere");
+    std::fs::create_dir_all(&elsewhere).expect("mkdir");
+    std::fs::copy(one.join("spec.resolved.yaml"), elsewhere.join("resolved.yaml")).expect("copy");
+    let stdout = generate_ok(&elsewhere.join("resolved.yaml"), &[], &one, 1);
+    assert!(stdout.contains("generated 0 clips (3 already done)"), "{stdout}");
+    assert_same_files(&one, &from_plan, "re-run from spec.resolved.yaml");
+
     // A dataset of another spec is refused (exit 2) and left untouched.
     let (code, _, stderr) = generate(&qs, &["dataset.clips.count=3", "dataset.seed=8"], &one, 1);
     assert_eq!(code, 2, "another spec's dataset: {stderr}");
@@ -801,26 +814,56 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
     assert_same_files(&one, &from_plan, "after a refused run");
 }
 
+/// Runs the pedsynth binary; returns the exit code, stdout and stderr.
+fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+        .args(args)
+        .output()
+        .expect("run pedsynth");
+    (
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
 #[test]
-fn generate_refuses_a_directory_that_is_not_a_pedsynth_dataset() {
+fn generate_refuses_directories_it_must_not_write_into() {
     let tmp = TempDir::new("refuse");
+    let qs = spec("quickstart.yaml");
+    let gen_args = |out: &Path, extra: &[&str]| -> Vec<std::ffi::OsString> {
+        let mut v: Vec<std::ffi::OsString> = vec!["generate".into(), qs.clone().into(), "--out".into(), out.into()];
+        v.extend(extra.iter().map(|s| s.into()));
+        v
+    };
+    let run = |args: Vec<std::ffi::OsString>| {
+        let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        pedsynth(&refs)
+    };
+
+    // One clip of quickstart, quietly: nothing on stderr.
+    let dataset = tmp.join("dataset");
+    let (code, _, stderr) = run(gen_args(
+        &dataset,
+        &["--quiet", "--only", "town01_like-clear_noon-0000", "--jobs", "1"],
+    ));
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(stderr, "", "--quiet prints nothing on stderr");
+    let before = all_files(&dataset);
+
+    // A dataset of another spec.
+    let (code, _, stderr) = run(gen_args(&dataset, &["--quiet", "--set", "dataset.seed=8"]));
+    assert_eq!(code, Some(2), "another spec's dataset: {stderr}");
+    assert!(stderr.contains("another spec"), "{stderr}");
+    assert!(all_files(&dataset) == before, "a refused run changes nothing");
+
+    // A non-empty directory that is not a pedsynth dataset.
     let out = tmp.join("out");
     std::fs::create_dir_all(&out).expect("mkdir");
     std::fs::write(out.join("notes.txt"), b"my files").expect("write");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_pedsynth"))
-        .arg("generate")
-        .arg(spec("quickstart.yaml"))
-        .arg("--out")
-        .arg(&out)
-        .arg("--quiet")
-        .output()
-        .expect("run pedsynth");
-    assert_eq!(status.status.code(), Some(2), "{}", String::from_utf8_lossy(&status.stderr));
-    assert!(
-        String::from_utf8_lossy(&status.stderr).contains("not a pedsynth dataset"),
-        "{}",
-        String::from_utf8_lossy(&status.stderr)
-    );
+    let (code, _, stderr) = run(gen_args(&out, &["--quiet"]));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("not a pedsynth dataset"), "{stderr}");
     let names: Vec<String> = std::fs::read_dir(&out)
         .expect("read")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())

@@ -101,9 +101,13 @@ pub struct GenerateReport {
     pub samples: u64,
 }
 
-/// blake3 of a plan's canonical JSON.
+/// blake3 of a plan's canonical JSON, without `spec_dir`: where the spec file lies (and how its path was
+/// spelled) does not change the dataset, so the same spec run from another directory, or its
+/// `spec.resolved.yaml`, resumes the same dataset and writes the same manifest.
 pub fn plan_hash(plan: &Plan) -> String {
-    blake3::hash(serde_json::to_string(plan).unwrap_or_default().as_bytes())
+    let mut plan = plan.clone();
+    plan.spec_dir = String::new();
+    blake3::hash(serde_json::to_string(&plan).unwrap_or_default().as_bytes())
         .to_hex()
         .to_string()
 }
@@ -237,7 +241,8 @@ struct Progress {
     done: AtomicUsize,
     frames: AtomicU64,
     started: Instant,
-    every: usize,
+    /// Print a line every this many clips (plain output); None when quiet.
+    every: Option<usize>,
 }
 
 impl Progress {
@@ -256,7 +261,7 @@ impl Progress {
             done: AtomicUsize::new(0),
             frames: AtomicU64::new(0),
             started: Instant::now(),
-            every: if quiet { usize::MAX } else { (total / 20).max(1) },
+            every: (!quiet).then_some((total / 20).max(1)),
         }
     }
 
@@ -270,7 +275,7 @@ impl Progress {
                 bar.set_message(format!("{rate:.0} frames/s"));
                 bar.inc(1);
             }
-            None if done % self.every == 0 || done == self.total => {
+            None if self.every.is_some_and(|every| done % every == 0 || done == self.total) => {
                 let eta = secs / done as f64 * (self.total - done) as f64;
                 eprintln!(
                     "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
