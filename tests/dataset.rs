@@ -95,7 +95,11 @@ fn all_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
             if path.is_dir() {
                 walk(root, &path, out);
             } else {
-                let rel = path.strip_prefix(root).expect("under root").to_string_lossy().into_owned();
+                let rel = path
+                    .strip_prefix(root)
+                    .expect("under root")
+                    .to_string_lossy()
+                    .into_owned();
                 out.insert(rel, std::fs::read(&path).expect("read file"));
             }
         }
@@ -164,11 +168,17 @@ fn read_table(dir: &Path, table: &str, spec_hash: &str) -> Vec<RecordBatch> {
 }
 
 fn column<'a>(b: &'a RecordBatch, name: &str) -> &'a dyn Array {
-    b.column_by_name(name).unwrap_or_else(|| panic!("no column {name}")).as_ref()
+    b.column_by_name(name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+        .as_ref()
 }
 
 fn strs(b: &RecordBatch, name: &str) -> Vec<Option<String>> {
-    column(b, name).as_string::<i32>().iter().map(|s| s.map(str::to_owned)).collect()
+    column(b, name)
+        .as_string::<i32>()
+        .iter()
+        .map(|s| s.map(str::to_owned))
+        .collect()
 }
 
 fn u32s(b: &RecordBatch, name: &str) -> Vec<Option<u32>> {
@@ -176,19 +186,35 @@ fn u32s(b: &RecordBatch, name: &str) -> Vec<Option<u32>> {
 }
 
 fn u64s(b: &RecordBatch, name: &str) -> Vec<u64> {
-    column(b, name).as_primitive::<UInt64Type>().iter().map(|v| v.expect("non-null")).collect()
+    column(b, name)
+        .as_primitive::<UInt64Type>()
+        .iter()
+        .map(|v| v.expect("non-null"))
+        .collect()
 }
 
 fn f32s(b: &RecordBatch, name: &str) -> Vec<f32> {
-    column(b, name).as_primitive::<Float32Type>().iter().map(|v| v.expect("non-null")).collect()
+    column(b, name)
+        .as_primitive::<Float32Type>()
+        .iter()
+        .map(|v| v.expect("non-null"))
+        .collect()
 }
 
 fn f64s(b: &RecordBatch, name: &str) -> Vec<f64> {
-    column(b, name).as_primitive::<Float64Type>().iter().map(|v| v.expect("non-null")).collect()
+    column(b, name)
+        .as_primitive::<Float64Type>()
+        .iter()
+        .map(|v| v.expect("non-null"))
+        .collect()
 }
 
 fn bools(b: &RecordBatch, name: &str) -> Vec<bool> {
-    column(b, name).as_boolean().iter().map(|v| v.expect("non-null")).collect()
+    column(b, name)
+        .as_boolean()
+        .iter()
+        .map(|v| v.expect("non-null"))
+        .collect()
 }
 
 #[derive(Debug)]
@@ -279,7 +305,12 @@ fn read_dataset(dir: &Path) -> Dataset {
     for b in read_table(dir, "frames", &spec_hash) {
         let (ids, frame) = (strs(&b, "clip_id"), u32s(&b, "frame"));
         let ts = column(&b, "timestamp_ns").as_primitive::<Int64Type>();
-        let (x, y, z, yaw) = (f64s(&b, "ego_x_m"), f64s(&b, "ego_y_m"), f64s(&b, "ego_z_m"), f64s(&b, "ego_yaw_rad"));
+        let (x, y, z, yaw) = (
+            f64s(&b, "ego_x_m"),
+            f64s(&b, "ego_y_m"),
+            f64s(&b, "ego_z_m"),
+            f64s(&b, "ego_yaw_rad"),
+        );
         for i in 0..b.num_rows() {
             let key = (ids[i].clone().expect("id"), frame[i].expect("frame"));
             let row = FrameRow {
@@ -305,7 +336,10 @@ fn read_dataset(dir: &Path) -> Dataset {
                 annotated_frames: annotated[i].expect("annotated_frames"),
                 height_m: height[i],
             };
-            assert!(d.pedestrians.insert(key.clone(), row).is_none(), "duplicate pedestrian {key:?}");
+            assert!(
+                d.pedestrians.insert(key.clone(), row).is_none(),
+                "duplicate pedestrian {key:?}"
+            );
         }
     }
     for b in read_table(dir, "annotations", &spec_hash) {
@@ -399,10 +433,21 @@ fn check_table_invariants(d: &Dataset, smoothing: u32, width: f32, height: f32) 
             // C = 1 only in a crossing-type state, and on a driving lane except within the smoothing window
             // after the last driving-lane frame.
             if a.crossing {
-                assert!(CROSSING_STATES.contains(&a.state.as_str()), "{ctx}: C=1 in state {}", a.state);
-                assert!(fcf.is_some_and(|f| f <= a.frame), "{ctx}: C=1 before first_crossing_frame {fcf:?}");
+                assert!(
+                    CROSSING_STATES.contains(&a.state.as_str()),
+                    "{ctx}: C=1 in state {}",
+                    a.state
+                );
+                assert!(
+                    fcf.is_some_and(|f| f <= a.frame),
+                    "{ctx}: C=1 before first_crossing_frame {fcf:?}"
+                );
                 if fcf == Some(a.frame) {
-                    assert_eq!(a.lane.as_deref(), Some("driving"), "{ctx}: the first C=1 frame is on a driving lane");
+                    assert_eq!(
+                        a.lane.as_deref(),
+                        Some("driving"),
+                        "{ctx}: the first C=1 frame is on a driving lane"
+                    );
                 }
                 if a.lane.as_deref() != Some("driving") {
                     // Held by the smoothing: the last driving-lane frame lies within the window before, with
@@ -440,18 +485,29 @@ fn check_table_invariants(d: &Dataset, smoothing: u32, width: f32, height: f32) 
                         "{ctx}: C=1 on {:?} with no driving-lane frame in the {smoothing} frames before",
                         a.lane
                     );
-                    assert!(fcf.is_some_and(|f| f < a.frame), "{ctx}: held C=1 before any raw C=1 ({fcf:?})");
+                    assert!(
+                        fcf.is_some_and(|f| f < a.frame),
+                        "{ctx}: held C=1 before any raw C=1 ({fcf:?})"
+                    );
                 }
             }
             // TTE counts down to 0 at the first C=1 frame and is null after it and for non-crossing pedestrians.
             match fcf {
                 Some(f) if a.frame <= f => {
-                    assert_eq!(a.tte, Some((f - a.frame) as i32), "{ctx}: TTE (first crossing frame {f})")
+                    assert_eq!(
+                        a.tte,
+                        Some((f - a.frame) as i32),
+                        "{ctx}: TTE (first crossing frame {f})"
+                    )
                 }
                 _ => assert_eq!(a.tte, None, "{ctx}: TTE after the first crossing frame {fcf:?}"),
             }
             if i > 0 && a.frame == rows[i - 1].frame + 1 && rows[i - 1].tte.is_some_and(|t| t > 0) {
-                assert_eq!(a.tte, rows[i - 1].tte.map(|t| t - 1), "{ctx}: TTE decreases by one per frame");
+                assert_eq!(
+                    a.tte,
+                    rows[i - 1].tte.map(|t| t - 1),
+                    "{ctx}: TTE decreases by one per frame"
+                );
             }
             if fcf == Some(a.frame) {
                 assert!(a.crossing, "{ctx}: the first crossing frame is annotated but C=0");
@@ -499,9 +555,24 @@ fn check_table_invariants(d: &Dataset, smoothing: u32, width: f32, height: f32) 
 
     // The clips table agrees with the other tables.
     for c in &d.clips {
-        let frames: Vec<u32> = d.frames.keys().filter(|(id, _)| id == &c.clip).map(|(_, f)| *f).collect();
-        assert_eq!(frames, (0..c.frame_count).collect::<Vec<_>>(), "{}: frames 0..frame_count", c.clip);
-        let peds: Vec<&PedRow> = d.pedestrians.iter().filter(|((id, _), _)| id == &c.clip).map(|(_, p)| p).collect();
+        let frames: Vec<u32> = d
+            .frames
+            .keys()
+            .filter(|(id, _)| id == &c.clip)
+            .map(|(_, f)| *f)
+            .collect();
+        assert_eq!(
+            frames,
+            (0..c.frame_count).collect::<Vec<_>>(),
+            "{}: frames 0..frame_count",
+            c.clip
+        );
+        let peds: Vec<&PedRow> = d
+            .pedestrians
+            .iter()
+            .filter(|((id, _), _)| id == &c.clip)
+            .map(|(_, p)| p)
+            .collect();
         assert_eq!(peds.len() as u32, c.pedestrians, "{}: pedestrians", c.clip);
         assert_eq!(
             peds.iter().filter(|p| p.crosser).count() as u32,
@@ -520,12 +591,25 @@ fn check_table_invariants(d: &Dataset, smoothing: u32, width: f32, height: f32) 
             "{}: more vehicles in the vehicles table than planned",
             c.clip
         );
-        assert_eq!(d.contacts.get(&c.clip).copied().unwrap_or(0), c.contacts, "{}: contacts", c.clip);
-        assert!(["train", "val", "test"].contains(&c.split.as_str()), "{}: split {}", c.clip, c.split);
+        assert_eq!(
+            d.contacts.get(&c.clip).copied().unwrap_or(0),
+            c.contacts,
+            "{}: contacts",
+            c.clip
+        );
+        assert!(
+            ["train", "val", "test"].contains(&c.split.as_str()),
+            "{}: split {}",
+            c.clip,
+            c.split
+        );
     }
     let ids: BTreeSet<&String> = d.clips.iter().map(|c| &c.clip).collect();
     assert_eq!(ids.len(), d.clips.len(), "one clips row per clip");
-    assert!(d.frames.keys().all(|(id, _)| ids.contains(id)), "frames of unknown clips");
+    assert!(
+        d.frames.keys().all(|(id, _)| ids.contains(id)),
+        "frames of unknown clips"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -777,7 +861,9 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
     for t in TABLES {
         std::fs::remove_file(resumed.join("tables").join(t).join(format!("{}.parquet", ids[1]))).expect("rm");
     }
-    let stray = resumed.join("tables/annotations").join(format!(".{}.parquet.tmp-4242", ids[1]));
+    let stray = resumed
+        .join("tables/annotations")
+        .join(format!(".{}.parquet.tmp-4242", ids[1]));
     std::fs::write(&stray, b"half a parquet file").expect("write stray");
     std::fs::write(resumed.join("tables/frames/leftover.tmp"), b"junk").expect("write stray");
     let finished = resumed.join("tables/frames").join(format!("{}.parquet", ids[2]));

@@ -475,7 +475,10 @@ mod tests {
                 dlo = dlo.min(u);
                 dhi = dhi.max(u);
             }
-            assert!((lo - dlo).abs() < 1e-3 && (hi - dhi).abs() < 1e-3, "{x} {z} {r}: {lo} {hi} vs {dlo} {dhi}");
+            assert!(
+                (lo - dlo).abs() < 1e-3 && (hi - dhi).abs() < 1e-3,
+                "{x} {z} {r}: {lo} {hi} vs {dlo} {dhi}"
+            );
         }
     }
 

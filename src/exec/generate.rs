@@ -275,7 +275,10 @@ impl Progress {
                 bar.set_message(format!("{rate:.0} frames/s"));
                 bar.inc(1);
             }
-            None if self.every.is_some_and(|every| done % every == 0 || done == self.total) => {
+            None if self
+                .every
+                .is_some_and(|every| done.is_multiple_of(every) || done == self.total) =>
+            {
                 let eta = secs / done as f64 * (self.total - done) as f64;
                 eprintln!(
                     "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
