@@ -227,6 +227,7 @@ struct ClipRow {
     vehicles: u32,
     contacts: u32,
     annotated_samples: u64,
+    rejected: u64,
 }
 
 #[derive(Debug, Clone)]
@@ -289,6 +290,10 @@ fn read_dataset(dir: &Path) -> Dataset {
             u32s(&b, "contacts"),
         );
         let samples = u64s(&b, "annotated_samples");
+        let rejected: Vec<Vec<u64>> = ["too_far", "behind", "too_small", "outside_image", "occluded"]
+            .iter()
+            .map(|r| u64s(&b, &format!("rejected_{r}")))
+            .collect();
         for i in 0..b.num_rows() {
             d.clips.push(ClipRow {
                 clip: ids[i].clone().expect("clip_id"),
@@ -299,6 +304,7 @@ fn read_dataset(dir: &Path) -> Dataset {
                 vehicles: veh[i].expect("vehicles"),
                 contacts: con[i].expect("contacts"),
                 annotated_samples: samples[i],
+                rejected: rejected.iter().map(|r| r[i]).sum(),
             });
         }
     }
@@ -595,6 +601,12 @@ fn check_table_invariants(d: &Dataset, smoothing: u32, width: f32, height: f32) 
             d.contacts.get(&c.clip).copied().unwrap_or(0),
             c.contacts,
             "{}: contacts",
+            c.clip
+        );
+        assert_eq!(
+            c.annotated_samples + c.rejected,
+            u64::from(c.frame_count) * u64::from(c.pedestrians),
+            "{}: every pedestrian-frame is annotated or rejected by exactly one gate stage",
             c.clip
         );
         assert!(
