@@ -210,21 +210,38 @@ fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: D
     town.first_obstacle_hit(camera, camera + d * t_max).is_some()
 }
 
-/// The tight 2D box of a posed body: the extremes of every capsule's end spheres as seen by the camera.
-/// Returns None if any part of the body is behind the camera.
+/// The image interval `[lo, hi]` covered by a sphere along one image axis, exactly (perspective included):
+/// `lateral` and `depth` are the centre's optical coordinates along that axis and along the optical axis,
+/// `r` its radius, `focal` and `principal` the intrinsics along the axis. The bounds are the planes through
+/// the camera centre tangent to the sphere; the sphere must lie entirely in front of the camera.
+fn sphere_interval(lateral: f64, depth: f64, r: f64, focal: f64, principal: f64) -> (f64, f64) {
+    // A plane `lateral = k·depth` is tangent when (lateral − k·depth)² = r²(1 + k²).
+    let a = depth * depth - r * r;
+    let disc = (lateral * lateral + a).max(0.0).sqrt();
+    let k_lo = (lateral * depth - r * disc) / a;
+    let k_hi = (lateral * depth + r * disc) / a;
+    (focal * k_lo + principal, focal * k_hi + principal)
+}
+
+/// The tight 2D box of a posed body: the exact extremes of the projected silhouette. A capsule is the convex
+/// hull of its two end spheres, and a projection of a convex hull (in front of the camera) is the convex hull
+/// of the projections, so the box is the union of the end spheres' exact image intervals.
+/// Returns None if any part of the body is within 5 cm of the camera plane or behind it.
 pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
+    let c = &cam.camera;
+    let (cx, cy) = (f64::from(c.width_px) * 0.5, f64::from(c.height_px) * 0.5);
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for c in &pose.capsules {
-        for centre in [c.a, c.b] {
-            for offset in [cam.right, -cam.right, cam.down, -cam.down] {
-                let p = cam.project(centre + offset * c.radius_m);
-                if p.depth_m <= 0.05 {
-                    return None;
-                }
-                lo = lo.min(p.px);
-                hi = hi.max(p.px);
+    for cap in &pose.capsules {
+        for centre in [cap.a, cap.b] {
+            let p = cam.optical_from_world.transform_point3(centre);
+            if p.z - cap.radius_m <= 0.05 {
+                return None;
             }
+            let (u0, u1) = sphere_interval(p.x, p.z, cap.radius_m, c.focal_px, cx);
+            let (v0, v1) = sphere_interval(p.y, p.z, cap.radius_m, c.focal_px, cy);
+            lo = lo.min(DVec2::new(u0, v0));
+            hi = hi.max(DVec2::new(u1, v1));
         }
     }
     Some([lo.x, lo.y, hi.x, hi.y])
@@ -441,6 +458,28 @@ mod tests {
             crossing_labels(&frames, 0),
             vec![false, false, true, false, false, false, true, false]
         );
+    }
+
+    #[test]
+    fn sphere_bounds_are_exact_under_perspective() {
+        // Spheres near the axis, off-axis (wide angle) and close: the interval contains every projected
+        // surface point and is attained by one.
+        let (f, c) = (640.0, 640.0);
+        for (x, z, r) in [(0.0, 10.0, 0.2), (9.0, 10.0, 0.15), (-3.0, 2.0, 0.3), (1.5, 0.5, 0.2)] {
+            let (lo, hi) = sphere_interval(x, z, r, f, c);
+            let (mut dlo, mut dhi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for k in 0..100_000 {
+                let t = std::f64::consts::TAU * f64::from(k) / 100_000.0;
+                let (px, pz) = (x + r * t.cos(), z + r * t.sin());
+                let u = f * px / pz + c;
+                dlo = dlo.min(u);
+                dhi = dhi.max(u);
+            }
+            assert!(
+                (lo - dlo).abs() < 1e-3 && (hi - dhi).abs() < 1e-3,
+                "{x} {z} {r}: {lo} {hi} vs {dlo} {dhi}"
+            );
+        }
     }
 
     #[test]

@@ -101,9 +101,13 @@ pub struct GenerateReport {
     pub samples: u64,
 }
 
-/// blake3 of a plan's canonical JSON.
+/// blake3 of a plan's canonical JSON, without `spec_dir`: where the spec file lies (and how its path was
+/// spelled) does not change the dataset, so the same spec run from another directory, or its
+/// `spec.resolved.yaml`, resumes the same dataset and writes the same manifest.
 pub fn plan_hash(plan: &Plan) -> String {
-    blake3::hash(serde_json::to_string(plan).unwrap_or_default().as_bytes())
+    let mut plan = plan.clone();
+    plan.spec_dir = String::new();
+    blake3::hash(serde_json::to_string(&plan).unwrap_or_default().as_bytes())
         .to_hex()
         .to_string()
 }
@@ -140,6 +144,32 @@ fn check_out_dir(out: &Path, spec_hash: &str, plan_hash: &str) -> Result<Option<
         ));
     }
     Ok(Some(manifest))
+}
+
+/// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
+/// `fsutil::write_atomically`) or another `*.tmp` file.
+fn is_temporary(name: &str) -> bool {
+    let pid_suffix = name
+        .rsplit_once(".tmp-")
+        .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+    (name.starts_with('.') && pid_suffix) || name.ends_with(".tmp")
+}
+
+/// Removes the temporary files an interrupted run left in the dataset's own directories (the root and
+/// `tables/<table>/`), so that a resumed dataset holds exactly the files of an uninterrupted run.
+fn remove_temporaries(out: &Path) -> Result<(), GenerateError> {
+    let dirs = std::iter::once(out.to_path_buf()).chain(TABLES.iter().map(|t| out.join("tables").join(t)));
+    for dir in dirs {
+        let Ok(entries) = std::fs::read_dir(&dir) else { continue };
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if is_temporary(&name) && entry.file_type().is_ok_and(|t| t.is_file()) {
+                std::fs::remove_file(entry.path())
+                    .map_err(|e| GenerateError::Failed(format!("cannot remove {}: {e}", entry.path().display())))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 fn clip_done(out: &Path, clip_id: &str) -> bool {
@@ -211,7 +241,8 @@ struct Progress {
     done: AtomicUsize,
     frames: AtomicU64,
     started: Instant,
-    every: usize,
+    /// Print a line every this many clips (plain output); None when quiet.
+    every: Option<usize>,
 }
 
 impl Progress {
@@ -230,7 +261,7 @@ impl Progress {
             done: AtomicUsize::new(0),
             frames: AtomicU64::new(0),
             started: Instant::now(),
-            every: if quiet { usize::MAX } else { (total / 20).max(1) },
+            every: (!quiet).then_some((total / 20).max(1)),
         }
     }
 
@@ -244,7 +275,10 @@ impl Progress {
                 bar.set_message(format!("{rate:.0} frames/s"));
                 bar.inc(1);
             }
-            None if done.is_multiple_of(self.every) || done == self.total => {
+            None if self
+                .every
+                .is_some_and(|every| done.is_multiple_of(every) || done == self.total) =>
+            {
                 let eta = secs / done as f64 * (self.total - done) as f64;
                 eprintln!(
                     "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
@@ -321,6 +355,8 @@ pub fn generate(
     };
     if existing.is_none() {
         write_manifest(out, &manifest)?;
+    } else {
+        remove_temporaries(out)?;
     }
 
     let todo: Vec<&ClipScript> = plan
@@ -382,4 +418,20 @@ pub fn generate(
         return Err(GenerateError::Failed(failures.join("\n")));
     }
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporaries_are_recognised_and_tables_are_not() {
+        assert!(is_temporary(".town01_like-clear_noon-0001.parquet.tmp-4242"));
+        assert!(is_temporary(".manifest.json.tmp-1"));
+        assert!(is_temporary("leftover.tmp"));
+        assert!(!is_temporary("town01_like-clear_noon-0001.parquet"));
+        assert!(!is_temporary("manifest.json"));
+        assert!(!is_temporary(".x.tmp-"));
+        assert!(!is_temporary(".x.tmp-12a"));
+    }
 }

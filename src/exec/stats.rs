@@ -77,6 +77,8 @@ pub struct DatasetStats {
     pub achieved_crossing_ratio: f64,
     /// Share of annotated samples in each behaviour state.
     pub state_shares: BTreeMap<String, f64>,
+    /// Annotated samples in each behaviour state.
+    pub state_samples: BTreeMap<String, u64>,
     /// Annotated samples with C = 1.
     pub crossing_samples: u64,
     /// Per archetype.
@@ -249,7 +251,8 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
     s.mean_duration_s = if s.clips == 0 { 0.0 } else { duration_s / s.clips as f64 };
     s.samples_per_clip = ratio(s.annotated_samples, s.clips);
     let total: u64 = states.values().sum();
-    s.state_shares = states.into_iter().map(|(k, v)| (k, ratio(v, total))).collect();
+    s.state_shares = states.iter().map(|(k, v)| (k.clone(), ratio(*v, total))).collect();
+    s.state_samples = states;
     for (name, a) in &mut s.archetypes {
         a.crossing_rate = ratio(a.crossers, a.pedestrians);
         if let Some((sum, n)) = speed_sums.get(name) {

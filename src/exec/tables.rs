@@ -448,7 +448,7 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 kind: "contact",
                 pedestrian,
                 vehicle: vehicle_id(vehicle),
-                other: other_vehicle,
+                other: other_vehicle.and_then(vehicle_id),
                 ..Row::default()
             },
         })
@@ -478,7 +478,12 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             Arc::new(BooleanArray::from_iter(trace.events.iter().map(|e| {
                 Some(matches!(
                     e,
-                    Event::Conflict { vehicle: EGO_ID, .. } | Event::Contact { vehicle: EGO_ID, .. }
+                    Event::Conflict { vehicle: EGO_ID, .. }
+                        | Event::Contact { vehicle: EGO_ID, .. }
+                        | Event::Contact {
+                            other_vehicle: Some(EGO_ID),
+                            ..
+                        }
                 ))
             }))),
             Arc::new(StringArray::from_iter(rows.iter().map(|r| r.from))),

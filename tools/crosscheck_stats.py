@@ -1,0 +1,207 @@
+#!/usr/bin/env python3
+"""Cross-checks `pedsynth stats --json` against an independent reading of the dataset's Parquet tables.
+
+Reads each table directory (`DIR/tables/<table>/`) as one pyarrow dataset, recomputes the clip, frame and
+pedestrian counts, the sequence-level crossing / non-crossing counts (from `pedestrians.crosser`), the
+annotated and C = 1 samples, the samples per behaviour state, the per-split counts, towns, weathers,
+visibility-gate rejections and contacts, and compares them with the statistics pedsynth computed.
+
+Usage:
+    python3 tools/crosscheck_stats.py DIR --pedsynth path/to/pedsynth   # runs `pedsynth stats DIR --json`
+    python3 tools/crosscheck_stats.py DIR --stats-json stats.json       # or reads its output from a file
+
+Prints `crosscheck: N passed, 0 failed` and exits 0 when everything agrees; prints every mismatch and exits 1
+otherwise (2 when the dataset or the statistics cannot be read).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.dataset as ds
+
+
+def read_table(root: Path, name: str, columns: list[str]) -> pa.Table:
+    """Reads one table directory as a dataset (hidden `.`/`_` files such as temporaries are skipped)."""
+    path = root / "tables" / name
+    if not path.is_dir():
+        raise FileNotFoundError(f"{path}: no such table directory (is this a pedsynth dataset?)")
+    return ds.dataset(str(path), format="parquet").to_table(columns=columns)
+
+
+def counts_by(table: pa.Table, key: str, value: str | None = None) -> dict[str, int]:
+    """Rows per `key` value, or the sum of the boolean/integer column `value` per `key` value."""
+    if table.num_rows == 0:
+        return {}
+    if value is None:
+        grouped = table.group_by(key).aggregate([(key, "count")])
+        col = f"{key}_count"
+    else:
+        t = table.set_column(
+            table.schema.get_field_index(value), value, pc.cast(table[value], pa.int64())
+        )
+        grouped = t.group_by(key).aggregate([(value, "sum")])
+        col = f"{value}_sum"
+    return {k: int(v) for k, v in zip(grouped[key].to_pylist(), grouped[col].to_pylist())}
+
+
+def recompute(root: Path) -> dict:
+    """The statistics, recomputed from the tables."""
+    clips = read_table(
+        root,
+        "clips",
+        [
+            "clip_id",
+            "town",
+            "weather",
+            "split",
+            "rejected_too_far",
+            "rejected_behind",
+            "rejected_too_small",
+            "rejected_outside_image",
+            "rejected_occluded",
+        ],
+    )
+    frames = read_table(root, "frames", ["clip_id", "frame"])
+    peds = read_table(root, "pedestrians", ["clip_id", "pedestrian", "crosser"])
+    ann = read_table(root, "annotations", ["clip_id", "frame", "pedestrian", "state", "crossing"])
+    events = read_table(root, "events", ["clip_id", "kind"])
+
+    split_of = clips.select(["clip_id", "split"])
+    n_peds = peds.num_rows
+    unique_peds = len(set(zip(peds["clip_id"].to_pylist(), peds["pedestrian"].to_pylist())))
+    crossing = int(pc.sum(pc.cast(peds["crosser"], pa.int64())).as_py() or 0)
+    state_samples = counts_by(ann, "state")
+
+    splits: dict[str, dict[str, int]] = {}
+
+    def add(field: str, per_split: dict[str, int]) -> None:
+        for split, n in per_split.items():
+            splits.setdefault(split, {"clips": 0, "frames": 0, "pedestrians": 0, "crossers": 0, "samples": 0})
+            splits[split][field] = n
+
+    add("clips", counts_by(clips, "split"))
+    add("frames", counts_by(frames.join(split_of, "clip_id"), "split"))
+    peds_split = peds.join(split_of, "clip_id")
+    add("pedestrians", counts_by(peds_split, "split"))
+    add("crossers", counts_by(peds_split, "split", "crosser"))
+    add("samples", counts_by(ann.join(split_of, "clip_id"), "split"))
+
+    rejected = {
+        reason: int(pc.sum(clips[f"rejected_{reason}"]).as_py() or 0)
+        for reason in ["too_far", "behind", "too_small", "outside_image", "occluded"]
+    }
+    ratio = lambda a, b: 0.0 if b == 0 else a / b  # noqa: E731
+    total_samples = ann.num_rows
+    return {
+        "clips": clips.num_rows,
+        "clips_with_frames": len(set(frames["clip_id"].to_pylist())),
+        "frames": frames.num_rows,
+        "pedestrians": n_peds,
+        "unique_pedestrians": unique_peds,
+        "crossing": crossing,
+        "non_crossing": n_peds - crossing,
+        "crossing_share": ratio(crossing, n_peds),
+        "annotated_samples": total_samples,
+        "crossing_samples": int(pc.sum(pc.cast(ann["crossing"], pa.int64())).as_py() or 0),
+        "state_samples": state_samples,
+        "state_shares": {k: ratio(v, total_samples) for k, v in state_samples.items()},
+        "splits": splits,
+        "towns": sorted(set(clips["town"].to_pylist())),
+        "weathers": sorted(set(clips["weather"].to_pylist())),
+        "rejected": rejected,
+        "contacts": int(pc.sum(pc.cast(pc.equal(events["kind"], "contact"), pa.int64())).as_py() or 0),
+    }
+
+
+class Checker:
+    """Collects comparison results."""
+
+    def __init__(self) -> None:
+        self.passed = 0
+        self.failures: list[str] = []
+
+    def equal(self, what: str, mine, theirs) -> None:
+        if mine == theirs:
+            self.passed += 1
+        else:
+            self.failures.append(f"{what}: tables say {mine!r}, pedsynth stats says {theirs!r}")
+
+    def close(self, what: str, mine: float, theirs, tol: float = 1e-9) -> None:
+        if isinstance(theirs, (int, float)) and math.isclose(mine, theirs, rel_tol=tol, abs_tol=tol):
+            self.passed += 1
+        else:
+            self.failures.append(f"{what}: tables say {mine!r}, pedsynth stats says {theirs!r}")
+
+
+def compare(mine: dict, stats: dict) -> Checker:
+    c = Checker()
+    for key in ["clips", "frames", "pedestrians", "crossing", "non_crossing", "annotated_samples", "crossing_samples"]:
+        c.equal(key, mine[key], stats.get(key))
+    c.equal("clips (distinct clip ids in frames)", mine["clips_with_frames"], stats.get("clips"))
+    c.equal("pedestrians (distinct clip, pedestrian)", mine["unique_pedestrians"], stats.get("pedestrians"))
+    c.close("crossing_share", mine["crossing_share"], stats.get("crossing_share"))
+    c.equal("towns", mine["towns"], stats.get("towns"))
+    c.equal("weathers", mine["weathers"], stats.get("weathers"))
+    c.equal("contacts", mine["contacts"], stats.get("contacts"))
+    c.equal("rejected", mine["rejected"], stats.get("rejected"))
+    their_counts = stats.get("state_samples")
+    if their_counts is not None:
+        c.equal("states with samples", sorted(mine["state_samples"]), sorted(their_counts))
+        for state, n in sorted(mine["state_samples"].items()):
+            c.equal(f"state_samples[{state}]", n, their_counts.get(state))
+    their_shares = stats.get("state_shares", {})
+    c.equal("states with a share", sorted(mine["state_shares"]), sorted(their_shares))
+    for state, share in sorted(mine["state_shares"].items()):
+        c.close(f"state_shares[{state}]", share, their_shares.get(state))
+    their_splits = stats.get("splits", {})
+    c.equal("splits", sorted(mine["splits"]), sorted(their_splits))
+    for split, counts in sorted(mine["splits"].items()):
+        for field, n in counts.items():
+            c.equal(f"splits[{split}].{field}", n, their_splits.get(split, {}).get(field))
+    return c
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("dataset", type=Path, help="dataset directory written by `pedsynth generate`")
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--pedsynth", help="the pedsynth binary: runs `pedsynth stats DIR --json`")
+    source.add_argument("--stats-json", type=Path, help="a file holding the output of `pedsynth stats DIR --json`")
+    args = parser.parse_args(argv)
+
+    try:
+        if args.pedsynth:
+            run = subprocess.run(
+                [args.pedsynth, "stats", str(args.dataset), "--json"], capture_output=True, text=True, check=False
+            )
+            if run.returncode != 0:
+                print(f"crosscheck: `pedsynth stats` failed ({run.returncode}):\n{run.stderr}", file=sys.stderr)
+                return 2
+            stats = json.loads(run.stdout)
+        else:
+            stats = json.loads(args.stats_json.read_text())
+        mine = recompute(args.dataset)
+    except (OSError, ValueError, pa.ArrowException) as e:
+        print(f"crosscheck: cannot read the dataset or the statistics: {e}", file=sys.stderr)
+        return 2
+
+    result = compare(mine, stats)
+    for failure in result.failures:
+        print(f"crosscheck: MISMATCH {failure}", file=sys.stderr)
+    print(f"crosscheck: {result.passed} passed, {len(result.failures)} failed")
+    if mine["annotated_samples"] == 0 or mine["clips"] == 0:
+        print("crosscheck: the dataset is empty (no clips or no annotated samples)", file=sys.stderr)
+        return 1
+    return 1 if result.failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
