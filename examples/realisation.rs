@@ -5,31 +5,21 @@
 
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
-use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::{annotate, camera::Camera, sim};
-use pedsynth::planner::{self, CrosserSource, Role};
+use pedsynth::planner::{CrosserSource, Role};
 use pedsynth::world::LaneType;
 use rayon::prelude::*;
 
 fn main() {
     for spec in std::env::args().skip(1) {
-        let loaded = match dsl::load_file(Path::new(&spec), &LoadOptions::default()) {
-            Ok(l) => l,
+        let (_, towns, plan) = match pedsynth::commands::plan_spec_file(Path::new(&spec), &LoadOptions::default()) {
+            Ok(x) => x,
             Err(e) => {
-                eprintln!("{}", e.render_plain(100));
+                eprintln!("{e}");
                 std::process::exit(2);
             }
         };
-        let towns = load_towns(&loaded).expect("towns load");
-        let plan = planner::plan(
-            &loaded.spec,
-            &loaded.hash(),
-            &loaded.base_dir.display().to_string(),
-            &towns,
-            None,
-        )
-        .expect("feasible");
         let camera = Camera::from_spec(&plan.spec.sensors.rgb);
         // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled)
         let counts: Vec<[usize; 6]> = plan

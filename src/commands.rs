@@ -385,3 +385,22 @@ pub fn stats(dir: &std::path::Path, json: bool, out: &mut dyn Write, err: &mut d
         }
     }
 }
+
+/// Loads a spec file, its towns and its full plan: the programmatic path to a plan (tests, benchmarks, tools).
+/// Problems come back as rendered text.
+pub fn plan_spec_file(
+    path: &std::path::Path,
+    options: &LoadOptions,
+) -> Result<(LoadedSpec, BTreeMap<String, TownContext>, Plan), String> {
+    let loaded = dsl::load_file(path, options).map_err(|e| e.render_plain(DIAGNOSTIC_WIDTH))?;
+    let towns = load_towns(&loaded)?;
+    let plan = planner::plan(
+        &loaded.spec,
+        &loaded.hash(),
+        &loaded.base_dir.display().to_string(),
+        &towns,
+        None,
+    )
+    .map_err(|problems| problems.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("\n"))?;
+    Ok((loaded, towns, plan))
+}

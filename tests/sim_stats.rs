@@ -8,11 +8,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
-use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::sim::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
 use pedsynth::exec::trace::{ClipTrace, Event, PedState};
-use pedsynth::planner::{self, CrosserSource, Plan, Role};
+use pedsynth::planner::{CrosserSource, Plan, Role};
 use pedsynth::world::LaneType;
 
 fn plan_and_simulate(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
@@ -21,16 +20,7 @@ fn plan_and_simulate(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
         overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
         allow_large: true,
     };
-    let loaded = dsl::load_file(&path, &options).expect("valid spec");
-    let towns = load_towns(&loaded).expect("towns load");
-    let plan = planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        None,
-    )
-    .expect("feasible");
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
     let traces = sim::simulate_all(&plan, &towns).expect("towns present");
     (plan, traces)
 }
