@@ -208,13 +208,18 @@ impl VehiclePath {
         // A little slack so that rounding never skips a segment that could tie.
         const SLACK_M: f64 = 1e-6;
         let mut i = i0;
+        let mut bound_for = f64::NAN;
+        let (mut bound, mut far2) = (0.0, 0.0);
         while i < end {
             let da2 = consider(i, &mut best);
-            let bound = best.0.sqrt().min(max_lateral_m) + SLACK_M;
+            if best.0 != bound_for {
+                bound_for = best.0;
+                bound = best.0.sqrt().min(max_lateral_m) + SLACK_M;
+                far2 = (bound + 2.0 * PATH_SPACING_M).powi(2);
+            }
             // Segments k ≥ i with (k − i + 1)·spacing < |p − a_i| − bound are farther than `bound`.
-            let margin = if da2 > bound * bound { da2.sqrt() - bound } else { 0.0 };
-            i += if margin > 2.0 * PATH_SPACING_M {
-                (margin / PATH_SPACING_M) as usize - 1
+            i += if da2 > far2 {
+                ((da2.sqrt() - bound) / PATH_SPACING_M) as usize - 1
             } else {
                 1
             };
@@ -503,8 +508,8 @@ const ZONE_HORIZON_M: f64 = 260.0;
 /// Samples of one path closer than this along it belong to the same zone, metres.
 const ZONE_GAP_M: f64 = 10.0;
 
-/// The conflict zones of every vehicle with every other, found once at set-up with a 2 m grid over the path
-/// samples (1 m apart). Sorted by zone start; lookups only, so no hash order leaks out.
+/// The conflict zones of every vehicle with every other, found once at set-up with a 2.5 m grid over the path
+/// samples (1 m apart). Sorted by zone start.
 pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
     const CELL_M: f64 = 2.5;
     let cell = |p: DVec2| ((p.x / CELL_M).floor() as i64, (p.y / CELL_M).floor() as i64);
@@ -519,32 +524,38 @@ pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
             s += 1.0;
         }
     }
-    let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = std::collections::HashMap::new();
-    for (k, smp) in samples.iter().enumerate() {
-        grid.entry(cell(smp.2)).or_default().push(k as u32);
-    }
-    // Close pairs per ordered (i, j): (s_i, s_j).
+    // The grid: sample indices sorted by cell (row, then column), so the three cells of a row next to a
+    // sample are one contiguous run, found by binary search.
+    let mut grid: Vec<((i64, i64), u32)> = samples
+        .iter()
+        .enumerate()
+        .map(|(k, smp)| {
+            let (x, y) = cell(smp.2);
+            ((y, x), k as u32)
+        })
+        .collect();
+    grid.sort_unstable();
+    // Close pairs per ordered (i, j): (s_i, s_j). Their order does not matter: each list is sorted below.
     let n = vehicles.len();
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n * n];
     for a in &samples {
         let (cx, cy) = cell(a.2);
         for y in cy - 1..=cy + 1 {
-            for x in cx - 1..=cx + 1 {
-                let Some(bucket) = grid.get(&(x, y)) else {
+            let lo = grid.partition_point(|e| e.0 < (y, cx - 1));
+            let hi = lo + grid[lo..].partition_point(|e| e.0 <= (y, cx + 1));
+            for &(_, kb) in &grid[lo..hi] {
+                let b = &samples[kb as usize];
+                // Each pair of samples of two vehicles once (the test is symmetric), recorded both ways.
+                if b.0 <= a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
                     continue;
-                };
-                for &kb in bucket {
-                    let b = &samples[kb as usize];
-                    if b.0 == a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
-                        continue;
-                    }
-                    let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
-                    if d > std::f64::consts::PI {
-                        d = std::f64::consts::TAU - d;
-                    }
-                    if d > ZONE_MIN_ANGLE_RAD {
-                        pairs[a.0 * n + b.0].push((a.1, b.1));
-                    }
+                }
+                let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
+                if d > std::f64::consts::PI {
+                    d = std::f64::consts::TAU - d;
+                }
+                if d > ZONE_MIN_ANGLE_RAD {
+                    pairs[a.0 * n + b.0].push((a.1, b.1));
+                    pairs[b.0 * n + a.0].push((b.1, a.1));
                 }
             }
         }
@@ -733,7 +744,11 @@ mod tests {
             let from = uniform(-5.0, path.length_m());
             let to = from + uniform(0.0, 90.0);
             let expected = project_by_scan(&path, p, from, to);
-            assert_eq!(path.project(p, from, to, f64::INFINITY), Some(expected), "p {p} window {from}..{to}");
+            assert_eq!(
+                path.project(p, from, to, f64::INFINITY),
+                Some(expected),
+                "p {p} window {from}..{to}"
+            );
             let reach = uniform(0.5, 6.0);
             let got = path.project(p, from, to, reach);
             if expected.1 <= reach {
@@ -744,7 +759,10 @@ mod tests {
                 far += 1;
             }
         }
-        assert!(near > 1000 && far > 1000, "both cases exercised: {near} near, {far} far");
+        assert!(
+            near > 1000 && far > 1000,
+            "both cases exercised: {near} near, {far} far"
+        );
     }
 
     #[test]
