@@ -244,7 +244,7 @@ impl Progress {
                 bar.set_message(format!("{rate:.0} frames/s"));
                 bar.inc(1);
             }
-            None if done % self.every == 0 || done == self.total => {
+            None if done.is_multiple_of(self.every) || done == self.total => {
                 let eta = secs / done as f64 * (self.total - done) as f64;
                 eprintln!(
                     "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",

@@ -62,7 +62,7 @@ fn field(name: &str, data_type: DataType, nullable: bool) -> Field {
     Field::new(name, data_type, nullable)
 }
 
-fn utf8<'a>(n: usize, value: &'a str) -> ArrayRef {
+fn utf8(n: usize, value: &str) -> ArrayRef {
     Arc::new(StringArray::from_iter_values(std::iter::repeat_n(value, n)))
 }
 
