@@ -122,8 +122,8 @@ pub fn crossing_labels(frames: &[PedFrame], smoothing_frames: u32) -> Vec<bool> 
 /// An obstacle for occlusion rays in one frame.
 #[derive(Clone, Copy, Debug)]
 enum Occluder {
-    /// A vehicle: ground centre, yaw.
-    Vehicle { centre: DVec3, yaw_rad: f64 },
+    /// A vehicle: ground centre and `yaw.sin_cos()` (computed once per frame, not once per ray).
+    Vehicle { centre: DVec3, sin_cos: (f64, f64) },
     /// A pedestrian body as an upright cylinder: ground point, radius, height, owner id.
     Person {
         ground: DVec3,
@@ -136,8 +136,10 @@ enum Occluder {
 /// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
 fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
     match *occ {
-        Occluder::Vehicle { centre, yaw_rad } => {
-            let (s, c) = yaw_rad.sin_cos();
+        Occluder::Vehicle {
+            centre,
+            sin_cos: (s, c),
+        } => {
             let rel = from - centre - DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5);
             let o = DVec3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
             let v = DVec3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
@@ -192,22 +194,32 @@ fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
     }
 }
 
-/// Whether the line of sight from the camera to `target` is blocked (the pedestrian `owner` never blocks
-/// itself).
-fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: DVec3, owner: u32) -> bool {
+/// Whether the line of sight from the camera to `target` is blocked by one of `occluders` (already stripped of
+/// the target pedestrian's own body) or by a static obstacle.
+fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: DVec3) -> bool {
     let d = target - camera;
     let t_max = 1.0 - 0.05 / d.length().max(0.05);
-    for occ in occluders {
-        if let Occluder::Person { owner: o, .. } = occ
-            && *o == owner
-        {
-            continue;
-        }
-        if blocks(occ, camera, d, t_max) {
-            return true;
-        }
-    }
-    town.first_obstacle_hit(camera, camera + d * t_max).is_some()
+    occluders.iter().any(|occ| blocks(occ, camera, d, t_max))
+        || town.first_obstacle_hit(camera, camera + d * t_max).is_some()
+}
+
+/// Whether `occ` could block any line of sight from `camera` to a point within `reach_m` (in plan view) of
+/// `target`: such a line stays within `reach_m` of the segment `camera → target` in plan view, and an
+/// occluder lies within its bounding circle, so one farther than both radii from that segment blocks none.
+fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f64) -> bool {
+    let (centre, radius_m) = match *occ {
+        Occluder::Vehicle { centre, .. } => (centre.truncate(), VEHICLE_LENGTH_M.hypot(VEHICLE_WIDTH_M) * 0.5),
+        Occluder::Person { ground, radius_m, .. } => (ground.truncate(), radius_m),
+    };
+    let ab = target - camera;
+    let len2 = ab.length_squared();
+    let t = if len2 > 0.0 {
+        ((centre - camera).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let r = radius_m + reach_m + 1e-6;
+    (camera + ab * t).distance_squared(centre) <= r * r
 }
 
 /// The image interval `[lo, hi]` covered by a sphere along one image axis, exactly (perspective included):
@@ -291,6 +303,7 @@ pub fn annotate(
     }
 
     let mut occluders: Vec<Occluder> = Vec::with_capacity(trace.vehicles.len() + 2 * n_peds);
+    let mut near: Vec<Occluder> = Vec::with_capacity(occluders.capacity());
     let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
     for frame in 0..trace.frame_count as usize {
         let Some(ego) = trace.ego.get(frame) else { break };
@@ -300,7 +313,7 @@ pub fn annotate(
             if let Some(f) = v.get(frame) {
                 occluders.push(Occluder::Vehicle {
                     centre: f.pos,
-                    yaw_rad: f.yaw_rad,
+                    sin_cos: f.yaw_rad.sin_cos(),
                 });
             }
         }
@@ -354,43 +367,63 @@ pub fn annotate(
                 continue;
             }
             // Keypoints and occlusion: the 17 joints plus torso and head samples.
-            let mut keypoints = [0f32; 51];
-            let mut keypoints_3d = [0f32; 51];
-            let (mut seen, mut hidden) = (0u32, 0u32);
-            for (k, joint) in pose.joints.iter().enumerate() {
-                let p = cam.project(*joint);
-                let inside = p.depth_m > 0.05 && cam.in_image(p.px);
-                let flag = if !inside {
-                    0.0
-                } else if occluded(town, &occluders, cam.centre, *joint, id as u32) {
-                    hidden += 1;
-                    1.0
-                } else {
-                    2.0
-                };
-                seen += u32::from(inside);
-                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
-                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
-            }
-            for sample in [
+            let samples = [
                 pose.capsules[0].a,
                 pose.capsules[0].b,
                 pose.capsules[2].a,
                 (pose.capsules[7].a + pose.capsules[7].b) * 0.5,
                 (pose.capsules[8].a + pose.capsules[8].b) * 0.5,
-            ] {
-                seen += 1;
-                hidden += u32::from(occluded(town, &occluders, cam.centre, sample, id as u32));
+            ];
+            let projected = pose.joints.map(|j| cam.project(j));
+            let inside = projected.map(|p| p.depth_m > 0.05 && cam.in_image(p.px));
+            let seen = inside.iter().map(|&i| u32::from(i)).sum::<u32>() + samples.len() as u32;
+            // Only the occluders near the lines of sight to this body take part in the ray tests.
+            let ground = f.pos.truncate();
+            let reach = pose
+                .joints
+                .iter()
+                .chain(&samples)
+                .map(|q| q.truncate().distance(ground))
+                .fold(0.0, f64::max);
+            near.clear();
+            near.extend(occluders.iter().filter(|occ| {
+                !matches!(occ, Occluder::Person { owner, .. } if *owner == id as u32)
+                    && may_block(occ, cam.centre.truncate(), ground, reach)
+            }));
+            // Stop casting rays once the body is hidden beyond the threshold (hidden only grows).
+            let too_hidden = |hidden: u32| f64::from(hidden) / f64::from(seen) > gate.max_occlusion;
+            let mut keypoints = [0f32; 51];
+            let mut keypoints_3d = [0f32; 51];
+            let mut hidden = 0u32;
+            for (k, joint) in pose.joints.iter().enumerate() {
+                if too_hidden(hidden) {
+                    break;
+                }
+                let p = projected[k];
+                let flag = if !inside[k] {
+                    0.0
+                } else if occluded(town, &near, cam.centre, *joint) {
+                    hidden += 1;
+                    1.0
+                } else {
+                    2.0
+                };
+                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
+                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
             }
-            let occlusion = if seen == 0 {
-                1.0
-            } else {
-                f64::from(hidden) / f64::from(seen)
-            };
-            if occlusion > gate.max_occlusion {
+            let mut rejected = too_hidden(hidden);
+            for sample in samples {
+                if rejected {
+                    break;
+                }
+                hidden += u32::from(occluded(town, &near, cam.centre, sample));
+                rejected = too_hidden(hidden);
+            }
+            if rejected {
                 out.rejections.occluded += 1;
                 continue;
             }
+            let occlusion = f64::from(hidden) / f64::from(seen);
             let crossing = labels[id][frame];
             let tte = first_crossing[id].and_then(|fc| (frame as u32 <= fc).then(|| (fc - frame as u32) as i32));
             let (box_centre, box_size) = pose.box3d();
@@ -486,7 +519,7 @@ mod tests {
     fn occluders_block_only_what_they_cover() {
         let car = Occluder::Vehicle {
             centre: DVec3::new(10.0, 0.0, 0.0),
-            yaw_rad: 0.3,
+            sin_cos: 0.3_f64.sin_cos(),
         };
         let from = DVec3::new(0.0, 0.0, 1.0);
         assert!(blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 1.0));

@@ -375,7 +375,7 @@ impl<'a> Sim<'a> {
             for b in a + 1..nv {
                 let (va, vb) = (&self.vehicles[a], &self.vehicles[b]);
                 let touching = va.pose.pos.distance_squared(vb.pose.pos) < (VEHICLE_LENGTH_M + 0.1).powi(2)
-                    && boxes_overlap(va.pose.pos, va.pose.heading_rad, vb.pose.pos, vb.pose.heading_rad);
+                    && boxes_overlap(va.pose.pos, va.pose.dir, vb.pose.pos, vb.pose.dir);
                 let flag = &mut self.vehicle_contact[a * nv + b];
                 if touching {
                     if !*flag {
@@ -387,13 +387,13 @@ impl<'a> Sim<'a> {
                         });
                     }
                     // The one behind (the other is ahead along its heading) backs off and stops.
-                    let a_behind = (vb.pose.pos - va.pose.pos).dot(DVec2::from_angle(va.pose.heading_rad)) > 0.0;
+                    let a_behind = (vb.pose.pos - va.pose.pos).dot(va.pose.dir) > 0.0;
                     let (back, other) = if a_behind { (a, b) } else { (b, a) };
-                    let (op, oh) = (self.vehicles[other].pose.pos, self.vehicles[other].pose.heading_rad);
+                    let (op, oh) = (self.vehicles[other].pose.pos, self.vehicles[other].pose.dir);
                     for _ in 0..40 {
                         let v = &mut self.vehicles[back];
                         v.back_off_and_stop(0.25);
-                        if !boxes_overlap(v.pose.pos, v.pose.heading_rad, op, oh) || v.s_m <= 0.0 {
+                        if !boxes_overlap(v.pose.pos, v.pose.dir, op, oh) || v.s_m <= 0.0 {
                             break;
                         }
                     }
@@ -442,9 +442,8 @@ fn push_out_of_box(p: DVec2, centre: DVec2, heading_rad: f64) -> DVec2 {
     centre + DVec2::new(out.x * c - out.y * s, out.x * s + out.y * c)
 }
 
-/// Whether two vehicle footprints overlap (separating axis test).
-fn boxes_overlap(ca: DVec2, ha: f64, cb: DVec2, hb: f64) -> bool {
-    let (ua, ub) = (DVec2::from_angle(ha), DVec2::from_angle(hb));
+/// Whether two vehicle footprints (centre, unit heading) overlap (separating axis test).
+fn boxes_overlap(ca: DVec2, ua: DVec2, cb: DVec2, ub: DVec2) -> bool {
     let axes = [ua, ua.perp(), ub, ub.perp()];
     let d = cb - ca;
     axes.iter().all(|&ax| {
@@ -460,13 +459,13 @@ mod tests {
 
     #[test]
     fn box_overlap_and_push_out() {
-        assert!(boxes_overlap(DVec2::ZERO, 0.0, DVec2::new(4.0, 0.0), 0.0));
-        assert!(!boxes_overlap(DVec2::ZERO, 0.0, DVec2::new(4.7, 0.0), 0.0));
+        assert!(boxes_overlap(DVec2::ZERO, DVec2::X, DVec2::new(4.0, 0.0), DVec2::X));
+        assert!(!boxes_overlap(DVec2::ZERO, DVec2::X, DVec2::new(4.7, 0.0), DVec2::X));
         assert!(boxes_overlap(
             DVec2::ZERO,
-            0.0,
+            DVec2::X,
             DVec2::new(3.0, 0.0),
-            std::f64::consts::FRAC_PI_2
+            DVec2::from_angle(std::f64::consts::FRAC_PI_2)
         ));
         let p = push_out_of_box(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0);
         assert!(ttc::distance_to_box_m(p, DVec2::ZERO, 0.0, HALF_LENGTH_M, HALF_WIDTH_M) >= PED_RADIUS_M);

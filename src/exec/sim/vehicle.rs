@@ -49,6 +49,8 @@ pub(crate) struct VehiclePath {
     points: Vec<PathPoint>,
     /// Heading of the segment from point `i` to `i + 1` (last one repeated).
     headings_rad: Vec<f64>,
+    /// `DVec2::from_angle(headings_rad[i])`, computed once.
+    dirs: Vec<DVec2>,
     length_m: f64,
 }
 
@@ -57,6 +59,8 @@ pub(crate) struct VehiclePath {
 pub(crate) struct PathPose {
     pub pos: DVec2,
     pub heading_rad: f64,
+    /// `DVec2::from_angle(heading_rad)` (the unit heading), bit for bit.
+    pub dir: DVec2,
     pub z_m: f64,
     pub speed_limit_mps: f64,
 }
@@ -129,9 +133,11 @@ impl VehiclePath {
             .collect();
         let last = headings_rad.last().copied().unwrap_or(route.start_heading_rad);
         headings_rad.push(last);
+        let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
         VehiclePath {
             points,
             headings_rad,
+            dirs,
             length_m: s,
         }
     }
@@ -153,19 +159,31 @@ impl VehiclePath {
         PathPose {
             pos: a.pos.lerp(b.pos, t),
             heading_rad: self.headings_rad[i],
+            dir: self.dirs[i],
             z_m: a.z_m + (b.z_m - a.z_m) * t,
             speed_limit_mps: a.speed_limit_mps,
         }
     }
 
     /// Projects `p` onto the path between arc lengths `from_s_m` and `to_s_m`: `(s_m, lateral_m, heading_rad)`
-    /// of the nearest point (lateral distance unsigned).
-    pub fn project(&self, p: DVec2, from_s_m: f64, to_s_m: f64) -> (f64, f64, f64) {
+    /// of the nearest point (lateral distance unsigned), or `None` when no point of that stretch lies within
+    /// `max_lateral_m` of `p` (callers pass the largest lateral distance whose answer they would act on).
+    ///
+    /// The result is exactly that of scanning every segment of the stretch and keeping the first nearest one,
+    /// but most segments are skipped: samples are at most [`PATH_SPACING_M`] apart along the path, so every
+    /// point of segment `k ≥ i` is within `(k − i + 1)·PATH_SPACING_M` of sample `a_i`, hence at least
+    /// `|p − a_i| − (k − i + 1)·PATH_SPACING_M` from `p`; segments whose bound exceeds both the best distance
+    /// so far and `max_lateral_m` can neither win nor matter. The scan is seeded with the segments around the
+    /// point's arc length as guessed from the heading at `from_s_m`, so the skipping starts at once.
+    pub fn project(&self, p: DVec2, from_s_m: f64, to_s_m: f64, max_lateral_m: f64) -> Option<(f64, f64, f64)> {
         let last = self.points.len().saturating_sub(1);
         let i0 = ((from_s_m.max(0.0) / PATH_SPACING_M) as usize).min(last.saturating_sub(1));
         let i1 = ((to_s_m.max(0.0) / PATH_SPACING_M).ceil() as usize).min(last);
-        let mut best = (f64::INFINITY, from_s_m, 0.0);
-        for i in i0..i1.max(i0 + 1) {
+        let end = i1.max(i0 + 1);
+        // (squared distance, segment, s, heading) of the best segment; ties go to the lower segment index.
+        let mut best = (f64::INFINITY, usize::MAX, from_s_m, 0.0);
+        // Evaluates segment `i` into `best`; returns |p − a_i|².
+        let consider = |i: usize, best: &mut (f64, usize, f64, f64)| -> f64 {
             let (a, b) = (self.points[i].pos, self.points[i + 1].pos);
             let ab = b - a;
             let len2 = ab.length_squared();
@@ -175,11 +193,39 @@ impl VehiclePath {
                 0.0
             };
             let d2 = (a + ab * t - p).length_squared();
-            if d2 < best.0 {
-                best = (d2, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
+            if d2 < best.0 || (d2 == best.0 && i < best.1) {
+                *best = (d2, i, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
+            }
+            (p - a).length_squared()
+        };
+        if end - i0 > 8 {
+            let ahead = (p - self.points[i0].pos).dot(self.dirs[i0]);
+            let guess = i0 + ((ahead.max(0.0) / PATH_SPACING_M) as usize).min(end - 1 - i0);
+            for i in guess.saturating_sub(1).max(i0)..(guess + 2).min(end) {
+                consider(i, &mut best);
             }
         }
-        (best.1, best.0.sqrt(), best.2)
+        // A little slack so that rounding never skips a segment that could tie.
+        const SLACK_M: f64 = 1e-6;
+        let mut i = i0;
+        let mut bound_for = f64::NAN;
+        let (mut bound, mut far2) = (0.0, 0.0);
+        while i < end {
+            let da2 = consider(i, &mut best);
+            if best.0 != bound_for {
+                bound_for = best.0;
+                bound = best.0.sqrt().min(max_lateral_m) + SLACK_M;
+                far2 = (bound + 2.0 * PATH_SPACING_M).powi(2);
+            }
+            // Segments k ≥ i with (k − i + 1)·spacing < |p − a_i| − bound are farther than `bound`.
+            i += if da2 > far2 {
+                ((da2.sqrt() - bound) / PATH_SPACING_M) as usize - 1
+            } else {
+                1
+            };
+        }
+        let lateral = best.0.sqrt();
+        (lateral <= max_lateral_m).then_some((best.2, lateral, best.3))
     }
 }
 
@@ -287,7 +333,7 @@ impl Vehicle {
 
     /// Velocity vector, m/s.
     pub fn velocity(&self) -> DVec2 {
-        DVec2::from_angle(self.pose.heading_rad) * self.speed_mps
+        self.pose.dir * self.speed_mps
     }
 
     /// Target (desired) speed at the current position, m/s.
@@ -359,7 +405,7 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
     let me = &vehicles[i];
     let v = me.speed_mps;
     let look = lookahead_m(v, idm);
-    let fwd = DVec2::from_angle(me.pose.heading_rad);
+    let fwd = me.pose.dir;
     let target = me.target_speed_mps();
     let idm_to =
         |gap: f64, lead: f64| idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, Some((gap, lead)));
@@ -404,16 +450,23 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
         if d.length_squared() > (look + HALF_LENGTH_M).powi(2) || d.dot(fwd) <= 0.0 {
             continue;
         }
-        let (s_p, lateral, _) = me.path.project(p.pos, me.s_m, me.s_m + look + HALF_LENGTH_M);
-        if s_p <= me.s_m {
-            continue;
-        }
-        let gap = s_p - me.s_m - HALF_LENGTH_M - PED_RADIUS_M;
         let mut corridor = HALF_WIDTH_M + PED_RADIUS_M + PED_CORRIDOR_MARGIN_M;
         if p.crossing {
             // A crosser walking towards the path counts a second early.
             corridor += p.velocity.length();
         }
+        // Farther from the path than this, the pedestrian matters neither as a leader nor to the ego's rule.
+        let reach = match me.ego_brake_m {
+            Some((_, side)) if p.crossing => corridor.max(side),
+            _ => corridor,
+        };
+        let Some((s_p, lateral, _)) = me.path.project(p.pos, me.s_m, me.s_m + look + HALF_LENGTH_M, reach) else {
+            continue;
+        };
+        if s_p <= me.s_m {
+            continue;
+        }
+        let gap = s_p - me.s_m - HALF_LENGTH_M - PED_RADIUS_M;
         let in_path = lateral < corridor;
         let ego_rule = me
             .ego_brake_m
@@ -455,8 +508,8 @@ const ZONE_HORIZON_M: f64 = 260.0;
 /// Samples of one path closer than this along it belong to the same zone, metres.
 const ZONE_GAP_M: f64 = 10.0;
 
-/// The conflict zones of every vehicle with every other, found once at set-up with a 2 m grid over the path
-/// samples (1 m apart). Sorted by zone start; lookups only, so no hash order leaks out.
+/// The conflict zones of every vehicle with every other, found once at set-up with a 2.5 m grid over the path
+/// samples (1 m apart). Sorted by zone start.
 pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
     const CELL_M: f64 = 2.5;
     let cell = |p: DVec2| ((p.x / CELL_M).floor() as i64, (p.y / CELL_M).floor() as i64);
@@ -471,32 +524,38 @@ pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
             s += 1.0;
         }
     }
-    let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = std::collections::HashMap::new();
-    for (k, smp) in samples.iter().enumerate() {
-        grid.entry(cell(smp.2)).or_default().push(k as u32);
-    }
-    // Close pairs per ordered (i, j): (s_i, s_j).
+    // The grid: sample indices sorted by cell (row, then column), so the three cells of a row next to a
+    // sample are one contiguous run, found by binary search.
+    let mut grid: Vec<((i64, i64), u32)> = samples
+        .iter()
+        .enumerate()
+        .map(|(k, smp)| {
+            let (x, y) = cell(smp.2);
+            ((y, x), k as u32)
+        })
+        .collect();
+    grid.sort_unstable();
+    // Close pairs per ordered (i, j): (s_i, s_j). Their order does not matter: each list is sorted below.
     let n = vehicles.len();
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n * n];
     for a in &samples {
         let (cx, cy) = cell(a.2);
         for y in cy - 1..=cy + 1 {
-            for x in cx - 1..=cx + 1 {
-                let Some(bucket) = grid.get(&(x, y)) else {
+            let lo = grid.partition_point(|e| e.0 < (y, cx - 1));
+            let hi = lo + grid[lo..].partition_point(|e| e.0 <= (y, cx + 1));
+            for &(_, kb) in &grid[lo..hi] {
+                let b = &samples[kb as usize];
+                // Each pair of samples of two vehicles once (the test is symmetric), recorded both ways.
+                if b.0 <= a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
                     continue;
-                };
-                for &kb in bucket {
-                    let b = &samples[kb as usize];
-                    if b.0 == a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
-                        continue;
-                    }
-                    let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
-                    if d > std::f64::consts::PI {
-                        d = std::f64::consts::TAU - d;
-                    }
-                    if d > ZONE_MIN_ANGLE_RAD {
-                        pairs[a.0 * n + b.0].push((a.1, b.1));
-                    }
+                }
+                let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
+                if d > std::f64::consts::PI {
+                    d = std::f64::consts::TAU - d;
+                }
+                if d > ZONE_MIN_ANGLE_RAD {
+                    pairs[a.0 * n + b.0].push((a.1, b.1));
+                    pairs[b.0 * n + a.0].push((b.1, a.1));
                 }
             }
         }
@@ -576,9 +635,11 @@ fn priority(id: u32) -> u64 {
 /// If `other`'s footprint intrudes on the corridor of `me`'s path ahead within `look` metres: the gap from
 /// `me`'s front bumper to it along the path and its speed along the path.
 fn vehicle_in_path(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64)> {
-    let (s_o, lateral, path_heading) = me
-        .path
-        .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M);
+    // The footprint's lateral extent is at most its half diagonal, so a centre farther than this is clear.
+    let reach = HALF_WIDTH_M + VEHICLE_CORRIDOR_MARGIN_M + HALF_LENGTH_M.hypot(HALF_WIDTH_M) + 1e-6;
+    let (s_o, lateral, path_heading) =
+        me.path
+            .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M, reach)?;
     if s_o <= me.s_m {
         return None;
     }
@@ -596,6 +657,113 @@ fn vehicle_in_path(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A path of straight runs and arcs, sampled every `PATH_SPACING_M` of arc length like `from_route`.
+    fn winding_path() -> VehiclePath {
+        let mut points = Vec::new();
+        let (mut pos, mut heading) = (DVec2::new(3.0, -7.0), 0.3_f64);
+        for k in 0..400 {
+            points.push(PathPoint {
+                pos,
+                z_m: 0.0,
+                speed_limit_mps: 10.0,
+            });
+            // Straight, left turn of radius 8 m, straight, tight right turn of radius 4 m, straight.
+            let curvature = match k {
+                60..=110 => 1.0 / 8.0,
+                180..=230 => -1.0 / 4.0,
+                _ => 0.0,
+            };
+            let next = heading + curvature * PATH_SPACING_M;
+            // The chord of the arc between two samples.
+            let chord = if curvature == 0.0 {
+                PATH_SPACING_M
+            } else {
+                2.0 / curvature.abs() * (curvature.abs() * PATH_SPACING_M / 2.0).sin()
+            };
+            pos += DVec2::from_angle(0.5 * (heading + next)) * chord;
+            heading = next;
+        }
+        let mut headings_rad: Vec<f64> = points
+            .windows(2)
+            .map(|w| {
+                let d = w[1].pos - w[0].pos;
+                d.y.atan2(d.x)
+            })
+            .collect();
+        headings_rad.push(*headings_rad.last().expect("points"));
+        let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
+        VehiclePath {
+            length_m: (points.len() - 1) as f64 * PATH_SPACING_M,
+            points,
+            headings_rad,
+            dirs,
+        }
+    }
+
+    /// The plain scan over every segment of the window that `project` must reproduce exactly.
+    fn project_by_scan(path: &VehiclePath, p: DVec2, from_s_m: f64, to_s_m: f64) -> (f64, f64, f64) {
+        let last = path.points.len() - 1;
+        let i0 = ((from_s_m.max(0.0) / PATH_SPACING_M) as usize).min(last - 1);
+        let i1 = ((to_s_m.max(0.0) / PATH_SPACING_M).ceil() as usize).min(last);
+        let mut best = (f64::INFINITY, from_s_m, 0.0);
+        for i in i0..i1.max(i0 + 1) {
+            let (a, b) = (path.points[i].pos, path.points[i + 1].pos);
+            let ab = b - a;
+            let len2 = ab.length_squared();
+            let t = if len2 > 0.0 {
+                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d2 = (a + ab * t - p).length_squared();
+            if d2 < best.0 {
+                best = (d2, i as f64 * PATH_SPACING_M + t * len2.sqrt(), path.headings_rad[i]);
+            }
+        }
+        (best.1, best.0.sqrt(), best.2)
+    }
+
+    #[test]
+    fn projection_skipping_segments_matches_the_full_scan() {
+        let path = winding_path();
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let (mut near, mut far) = (0, 0);
+        for _ in 0..20_000 {
+            let s = uniform(0.0, path.length_m());
+            let pose = path.pose_at(s);
+            // Points near the path (on it, beside it, on the inside of bends) and far from it.
+            let offset = DVec2::new(uniform(-3.0, 3.0), uniform(-3.0, 3.0)) * uniform(0.0, 1.0).powi(2) * 12.0;
+            let p = pose.pos + offset;
+            let from = uniform(-5.0, path.length_m());
+            let to = from + uniform(0.0, 90.0);
+            let expected = project_by_scan(&path, p, from, to);
+            assert_eq!(
+                path.project(p, from, to, f64::INFINITY),
+                Some(expected),
+                "p {p} window {from}..{to}"
+            );
+            let reach = uniform(0.5, 6.0);
+            let got = path.project(p, from, to, reach);
+            if expected.1 <= reach {
+                assert_eq!(got, Some(expected), "p {p} window {from}..{to} reach {reach}");
+                near += 1;
+            } else {
+                assert_eq!(got, None, "p {p} window {from}..{to} reach {reach}");
+                far += 1;
+            }
+        }
+        assert!(
+            near > 1000 && far > 1000,
+            "both cases exercised: {near} near, {far} far"
+        );
+    }
 
     #[test]
     fn idm_free_road_accelerates_to_target_and_stops_for_standing_leader() {
