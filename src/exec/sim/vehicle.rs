@@ -22,6 +22,10 @@ const PATH_SPACING_M: f64 = 0.5;
 const VEHICLE_CORRIDOR_MARGIN_M: f64 = 0.4;
 /// Lateral margin of the corridor for pedestrians, metres.
 const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
+/// Largest lateral acceleration in curves, m/s².
+const LATERAL_ACCEL_MPS2: f64 = 2.5;
+/// Deceleration used to slow down before a curve, m/s².
+const CURVE_DECEL_MPS2: f64 = 2.0;
 /// Speed limit used where a lane has none, m/s (30 km/h).
 const DEFAULT_SPEED_LIMIT_MPS: f64 = 30.0 / 3.6;
 /// The ego's IDM time headway (the ego script has none), seconds.
@@ -51,6 +55,9 @@ pub(crate) struct VehiclePath {
     headings_rad: Vec<f64>,
     /// `DVec2::from_angle(headings_rad[i])`, computed once.
     dirs: Vec<DVec2>,
+    /// Advisory speed at each point: what the curvature ahead allows (lateral acceleration at most
+    /// [`LATERAL_ACCEL_MPS2`]) when braking at [`CURVE_DECEL_MPS2`] to meet it, m/s.
+    advisory_mps: Vec<f64>,
     length_m: f64,
 }
 
@@ -133,13 +140,43 @@ impl VehiclePath {
             .collect();
         let last = headings_rad.last().copied().unwrap_or(route.start_heading_rad);
         headings_rad.push(last);
+        // Curvature from the heading change over ±2 m, then a backward pass so that every curve is announced.
+        let k = (2.0 / PATH_SPACING_M) as usize;
+        let n = points.len();
+        let mut advisory_mps: Vec<f64> = (0..n)
+            .map(|i| {
+                let (a, b) = (i.saturating_sub(k), (i + k).min(n - 1));
+                let span = (b - a) as f64 * PATH_SPACING_M;
+                let mut dh = (headings_rad[b.min(n - 1)] - headings_rad[a]).abs() % std::f64::consts::TAU;
+                if dh > std::f64::consts::PI {
+                    dh = std::f64::consts::TAU - dh;
+                }
+                let curvature = if span > 0.0 { dh / span } else { 0.0 };
+                if curvature > 1e-4 {
+                    (LATERAL_ACCEL_MPS2 / curvature).sqrt()
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        for i in (0..n.saturating_sub(1)).rev() {
+            let next = advisory_mps[i + 1];
+            advisory_mps[i] = advisory_mps[i].min((next * next + 2.0 * CURVE_DECEL_MPS2 * PATH_SPACING_M).sqrt());
+        }
         let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
         VehiclePath {
             points,
             headings_rad,
             dirs,
+            advisory_mps,
             length_m: s,
         }
+    }
+
+    /// Advisory (curve) speed at arc length `s_m`, m/s.
+    pub fn advisory_mps(&self, s_m: f64) -> f64 {
+        let i = ((s_m.max(0.0) / PATH_SPACING_M) as usize).min(self.advisory_mps.len().saturating_sub(1));
+        self.advisory_mps[i]
     }
 
     /// Length of the path, metres.
@@ -338,7 +375,7 @@ impl Vehicle {
 
     /// Target (desired) speed at the current position, m/s.
     pub fn target_speed_mps(&self) -> f64 {
-        self.pose.speed_limit_mps * self.speed_factor
+        (self.pose.speed_limit_mps * self.speed_factor).min(self.path.advisory_mps(self.s_m))
     }
 
     /// Advances by `dt_s` with acceleration `accel_mps2` (speed never negative), updating the cached pose.
@@ -429,8 +466,9 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             continue;
         };
         // Mutual intrusion (both in each other's path, e.g. at a junction): the lower id goes first, the ego
-        // before everyone.
-        if vehicle_in_path(other, me, lookahead_m(other.speed_mps, idm)).is_some()
+        // before everyone -- unless the other is right in front (then both wait rather than touch).
+        if gap > 1.0
+            && vehicle_in_path(other, me, lookahead_m(other.speed_mps, idm)).is_some()
             && priority(me.id) < priority(other.id)
         {
             continue;
@@ -695,6 +733,7 @@ mod tests {
         let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
         VehiclePath {
             length_m: (points.len() - 1) as f64 * PATH_SPACING_M,
+            advisory_mps: vec![f64::INFINITY; points.len()],
             points,
             headings_rad,
             dirs,
