@@ -14,7 +14,7 @@ use glam::DVec2;
 use super::{PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Idm;
 use crate::planner::{EgoScript, RouteScript, VehicleScript};
-use crate::world::{RoadNetwork, TravelDirection};
+use crate::world::RoadNetwork;
 
 /// Spacing of the resampled path polyline, metres.
 const PATH_SPACING_M: f64 = 0.5;
@@ -30,9 +30,6 @@ const CURVE_DECEL_MPS2: f64 = 2.0;
 const DEFAULT_SPEED_LIMIT_MPS: f64 = 30.0 / 3.6;
 /// The ego's IDM time headway (the ego script has none), seconds.
 pub const EGO_TIME_HEADWAY_S: f64 = 1.5;
-/// Joining rule of `RoadNetwork::route_from`: the first point of the next lane is skipped when it is this close
-/// to the last point of the previous one, metres.
-const JOIN_SKIP_M: f64 = 1.0;
 
 /// Half the vehicle length, metres.
 pub(crate) const HALF_LENGTH_M: f64 = VEHICLE_LENGTH_M * 0.5;
@@ -76,28 +73,21 @@ impl VehiclePath {
     /// Rebuilds the route polyline of `route` from its lane list, joining lanes exactly as
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
     pub fn from_route(route: &RouteScript, net: &RoadNetwork) -> VehiclePath {
-        let mut raw: Vec<(DVec2, f64, f64, f64)> = Vec::new(); // pos, z, limit, s
-        let mut s = 0.0;
-        for &lane in &route.lanes {
-            let Some(l) = net.lanes.get(lane as usize) else {
-                continue;
-            };
-            let limit = if l.speed_limit_mps > 0.5 {
-                l.speed_limit_mps
-            } else {
-                DEFAULT_SPEED_LIMIT_MPS
-            };
-            for (k, (p, z)) in lane_centre_points(net, lane).into_iter().enumerate() {
-                if let Some(last) = raw.last() {
-                    let d = (p - last.0).length();
-                    if d < 1e-6 || (k == 0 && d < JOIN_SKIP_M) {
-                        continue;
-                    }
-                    s += d;
-                }
-                raw.push((p, z, limit, s));
-            }
-        }
+        // The world joins lanes into a polyline (the same one the planner measured the route on).
+        let lanes: Vec<u32> = route.lanes.iter().copied().filter(|&l| (l as usize) < net.lanes.len()).collect();
+        let mut raw: Vec<(DVec2, f64, f64, f64)> = net // pos, z, limit, s
+            .route_through(&lanes)
+            .map(|r| {
+                r.points
+                    .iter()
+                    .map(|q| {
+                        let limit = if q.speed_limit_mps > 0.5 { q.speed_limit_mps } else { DEFAULT_SPEED_LIMIT_MPS };
+                        (q.pos, q.z_m, limit, q.s_m)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let mut s = raw.last().map_or(0.0, |x| x.3);
         if raw.is_empty() {
             raw.push((route.start, 0.0, DEFAULT_SPEED_LIMIT_MPS, 0.0));
         }
@@ -266,27 +256,6 @@ impl VehiclePath {
     }
 }
 
-/// Centre-line points of a lane with their piece's elevation, in the direction of travel (mirrors the world
-/// module's private helper, from its public data).
-fn lane_centre_points(net: &RoadNetwork, lane: u32) -> Vec<(DVec2, f64)> {
-    let l = &net.lanes[lane as usize];
-    let pieces = &net.pieces[l.pieces.start as usize..l.pieces.end as usize];
-    let mut out: Vec<(DVec2, f64)> = Vec::with_capacity(pieces.len() + 1);
-    for (i, p) in pieces.iter().enumerate() {
-        let c = p.centre();
-        let z = f64::from(p.z_m);
-        if i == 0 {
-            out.push((c[0], z));
-        }
-        if (c[1] - out.last().map_or(c[0], |x| x.0)).length() > 1e-6 {
-            out.push((c[1], z));
-        }
-    }
-    if l.travel == TravelDirection::Backward {
-        out.reverse();
-    }
-    out
-}
 
 /// A simulated vehicle (the ego or traffic).
 #[derive(Clone, Debug)]
