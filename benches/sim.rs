@@ -4,10 +4,8 @@
 
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
-use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::sim;
-use pedsynth::planner;
 
 fn main() {
     divan::main();
@@ -27,16 +25,7 @@ fn simulate_13s_clip_10_peds_10_vehicles(bencher: divan::Bencher, town: &str) {
         ],
         allow_large: true,
     };
-    let loaded = dsl::load_file(&path, &options).expect("valid spec");
-    let towns = load_towns(&loaded).expect("towns load");
-    let plan = planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        None,
-    )
-    .expect("feasible");
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).expect("feasible spec");
     let clip = &plan.clips[0];
     let net = &towns[&clip.town].network;
     let agents = (clip.pedestrians.len() + clip.vehicles.len() + 1) as u64;

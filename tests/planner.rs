@@ -4,7 +4,6 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
 use pedsynth::dsl::{self, LoadOptions};
 use pedsynth::planner::{self, Behaviour, ClipScript, CrosserSource, Plan, Role, SpawnPlace, TownContext, seeds};
 use pedsynth::world::LaneType;
@@ -21,17 +20,7 @@ fn compile(spec: &str, overrides: &[String]) -> (dsl::LoadedSpec, BTreeMap<Strin
         overrides: overrides.to_vec(),
         allow_large: true,
     };
-    let loaded = dsl::load_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{}", e.render_plain(100)));
-    let towns = load_towns(&loaded).unwrap();
-    let plan = planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        None,
-    )
-    .unwrap_or_else(|p| panic!("{p:?}"));
-    (loaded, towns, plan)
+    pedsynth::commands::plan_spec_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{e}"))
 }
 
 const CARLA: &str = "tests/data/specs/carla_town01.yaml";

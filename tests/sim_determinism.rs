@@ -2,10 +2,8 @@
 
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
-use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::sim;
-use pedsynth::planner;
 
 #[test]
 fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,16 +15,7 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
         ],
         allow_large: true,
     };
-    let loaded = dsl::load_file(&path, &options).map_err(|e| format!("{e:?}"))?;
-    let towns = load_towns(&loaded)?;
-    let plan = planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        None,
-    )
-    .map_err(|e| format!("{e:?}"))?;
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options)?;
     assert!(plan.clips.len() >= 8);
     let run = |threads: usize| -> Result<(String, String), Box<dyn std::error::Error>> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;

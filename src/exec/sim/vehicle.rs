@@ -74,14 +74,23 @@ impl VehiclePath {
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
     pub fn from_route(route: &RouteScript, net: &RoadNetwork) -> VehiclePath {
         // The world joins lanes into a polyline (the same one the planner measured the route on).
-        let lanes: Vec<u32> = route.lanes.iter().copied().filter(|&l| (l as usize) < net.lanes.len()).collect();
+        let lanes: Vec<u32> = route
+            .lanes
+            .iter()
+            .copied()
+            .filter(|&l| (l as usize) < net.lanes.len())
+            .collect();
         let mut raw: Vec<(DVec2, f64, f64, f64)> = net // pos, z, limit, s
             .route_through(&lanes)
             .map(|r| {
                 r.points
                     .iter()
                     .map(|q| {
-                        let limit = if q.speed_limit_mps > 0.5 { q.speed_limit_mps } else { DEFAULT_SPEED_LIMIT_MPS };
+                        let limit = if q.speed_limit_mps > 0.5 {
+                            q.speed_limit_mps
+                        } else {
+                            DEFAULT_SPEED_LIMIT_MPS
+                        };
                         (q.pos, q.z_m, limit, q.s_m)
                     })
                     .collect()
@@ -255,7 +264,6 @@ impl VehiclePath {
         (lateral <= max_lateral_m).then_some((best.2, lateral, best.3))
     }
 }
-
 
 /// A simulated vehicle (the ego or traffic).
 #[derive(Clone, Debug)]
