@@ -912,13 +912,7 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
             // Followers keep their leader's progress along their own line.
             let step = line.near_curb + line.dir * (l.fraction * line.width_m) + off * 0.8 - old;
             // Never faster than its own speed in this state (with slack for a wider line than the leader's).
-            let max_step = 1.3 * p.own_speed_mps(m) * dt;
-            let len = step.length();
-            new_pos = if len > max_step && len > 0.0 {
-                old + step * (max_step / len)
-            } else {
-                old + step
-            };
+            new_pos = old + clamp_length(step, 1.3 * p.own_speed_mps(m) * dt);
         } else {
             let speed = match p.state {
                 PedState::PausingMidCross => 0.0,
@@ -934,13 +928,7 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
             // Manual control: along the crossing vector, pulled back onto the line if off it, never faster
             // than the state's speed.
             let step = line.near_curb + line.dir * target_along + off * 0.8 - old;
-            let max_step = speed * dt;
-            let len = step.length();
-            new_pos = if len > max_step && len > 0.0 {
-                old + step * (max_step / len)
-            } else {
-                old + step
-            };
+            new_pos = old + clamp_length(step, speed * dt);
         }
     } else {
         let speed = match p.state {
@@ -1043,6 +1031,16 @@ impl Ped {
             _ if self.on_phone => 0.0,
             _ => 0.15 * (time_s * 0.7 + f64::from(self.id)).sin(),
         };
+    }
+}
+
+/// `v` shortened to at most `max_len` (never lengthened).
+fn clamp_length(v: DVec2, max_len: f64) -> DVec2 {
+    let len = v.length();
+    if len > max_len && len > 0.0 {
+        v * (max_len / len)
+    } else {
+        v
     }
 }
 

@@ -69,6 +69,18 @@ pub(crate) struct PathPose {
     pub speed_limit_mps: f64,
 }
 
+/// Projection of `p` on the segment `a`–`b`: `(t, squared distance, squared segment length)`, `t` in [0, 1].
+fn segment_projection(a: DVec2, b: DVec2, p: DVec2) -> (f64, f64, f64) {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (t, (a + ab * t - p).length_squared(), len2)
+}
+
 impl VehiclePath {
     /// Rebuilds the route polyline of `route` from its lane list, joining lanes exactly as
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
@@ -220,15 +232,8 @@ impl VehiclePath {
         let mut best = (f64::INFINITY, usize::MAX, from_s_m, 0.0);
         // Evaluates segment `i` into `best`; returns |p − a_i|².
         let consider = |i: usize, best: &mut (f64, usize, f64, f64)| -> f64 {
-            let (a, b) = (self.points[i].pos, self.points[i + 1].pos);
-            let ab = b - a;
-            let len2 = ab.length_squared();
-            let t = if len2 > 0.0 {
-                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let d2 = (a + ab * t - p).length_squared();
+            let a = self.points[i].pos;
+            let (t, d2, len2) = segment_projection(a, self.points[i + 1].pos, p);
             if d2 < best.0 || (d2 == best.0 && i < best.1) {
                 *best = (d2, i, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
             }
@@ -724,15 +729,7 @@ mod tests {
         let i1 = ((to_s_m.max(0.0) / PATH_SPACING_M).ceil() as usize).min(last);
         let mut best = (f64::INFINITY, from_s_m, 0.0);
         for i in i0..i1.max(i0 + 1) {
-            let (a, b) = (path.points[i].pos, path.points[i + 1].pos);
-            let ab = b - a;
-            let len2 = ab.length_squared();
-            let t = if len2 > 0.0 {
-                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let d2 = (a + ab * t - p).length_squared();
+            let (t, d2, len2) = segment_projection(path.points[i].pos, path.points[i + 1].pos, p);
             if d2 < best.0 {
                 best = (d2, i as f64 * PATH_SPACING_M + t * len2.sqrt(), path.headings_rad[i]);
             }
