@@ -93,6 +93,13 @@ fn vehicle(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64, pct: f64, i
     }
 }
 
+/// `p` moved to its curb (where a planned crosser starts), facing the road.
+fn at_curb(mut p: PedestrianScript) -> PedestrianScript {
+    let c = p.crossing.as_ref().expect("a crosser");
+    p.spawn = c.near_curb - c.direction * 0.3;
+    p
+}
+
 /// A crosser standing on the south sidewalk at `x`, crossing north.
 fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: CrosserSource) -> PedestrianScript {
     let spawn = DVec2::new(x, -5.0);
@@ -342,15 +349,37 @@ fn a_crosser_facing_another_closing_vehicle_inside_the_window_waits_for_it() {
     let script = clip(
         ego_at(&net, 120.0, 60.0),
         vec![vehicle(&net, 0, false, 162.0, 0.0, false)],
-        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        vec![at_curb(crosser(
+            &net,
+            0,
+            150.0,
+            Behaviour::Normal,
+            CrosserSource::Allocated,
+        ))],
         10,
     );
     let trace = sim::simulate(&script, &params(), &net);
-    let entered = first_in_road(&trace, 0).expect("crosses");
-    let other_x = trace.vehicles[0][entered].pos.x;
+    // Without the wait it would decide at once (it starts at the curb with the ego inside the window).
+    let decision = trace
+        .events
+        .iter()
+        .find_map(|e| {
+            if let Event::CrossingDecision { frame, .. } = e {
+                Some(*frame as usize)
+            } else {
+                None
+            }
+        })
+        .expect("decides to cross");
+    let other_x = trace.vehicles[0][decision].pos.x;
     assert!(
-        other_x < 150.0,
-        "stepped out only after the other vehicle passed (it is at x = {other_x})"
+        other_x < 152.0,
+        "decided only once the other vehicle was (nearly) past: it is at x = {other_x}"
+    );
+    let entered = first_in_road(&trace, 0).expect("crosses");
+    assert!(
+        trace.vehicles[0][entered].pos.x < 150.0,
+        "stepped out after the other vehicle passed"
     );
     assert_no_interpenetration(&trace);
 }
