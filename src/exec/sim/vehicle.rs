@@ -56,6 +56,46 @@ pub(crate) struct VehiclePath {
     /// [`LATERAL_ACCEL_MPS2`]) when braking at [`CURVE_DECEL_MPS2`] to meet it, m/s.
     advisory_mps: Vec<f64>,
     length_m: f64,
+    /// Chord bounds of blocks of [`BLOCK_SEGMENTS`] segments (block `k`: segments `k·B .. (k+1)·B`).
+    blocks: Vec<Chord>,
+    /// Chord bounds of super-blocks of [`SUPER_BLOCK_BLOCKS`] blocks.
+    super_blocks: Vec<Chord>,
+}
+
+/// Segments per block of the projection's two-level bound.
+const BLOCK_SEGMENTS: usize = 8;
+/// Blocks per super-block.
+const SUPER_BLOCK_BLOCKS: usize = 8;
+
+/// A chord `a`–`b` with every point of a stretch of the path within `eps_m` of it, so that every point of the
+/// stretch is at least `dist(p, chord) − eps_m` from any `p` (distance to a segment is 1-Lipschitz, and convex
+/// along each path segment, so its maximum over the stretch is at a sample).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Chord {
+    a: DVec2,
+    b: DVec2,
+    eps_m: f64,
+}
+
+impl Chord {
+    /// The chord over samples `points[first..=last]`.
+    fn over(points: &[PathPoint], first: usize, last: usize) -> Chord {
+        let (a, b) = (points[first].pos, points[last].pos);
+        let eps2 = points[first..=last]
+            .iter()
+            .map(|q| segment_projection(a, b, q.pos).1)
+            .fold(0.0, f64::max);
+        Chord {
+            a,
+            b,
+            eps_m: eps2.sqrt(),
+        }
+    }
+
+    /// A lower bound on the distance from `p` to every point of the stretch, metres.
+    fn lower_bound_m(&self, p: DVec2) -> f64 {
+        segment_projection(self.a, self.b, p).1.sqrt() - self.eps_m
+    }
 }
 
 /// A pose on a path.
@@ -174,13 +214,28 @@ impl VehiclePath {
             let next = advisory_mps[i + 1];
             advisory_mps[i] = advisory_mps[i].min((next * next + 2.0 * CURVE_DECEL_MPS2 * PATH_SPACING_M).sqrt());
         }
+        VehiclePath::assemble(points, headings_rad, advisory_mps, s)
+    }
+
+    /// The path over resampled `points` with their segment headings: unit headings and chord bounds added.
+    fn assemble(points: Vec<PathPoint>, headings_rad: Vec<f64>, advisory_mps: Vec<f64>, length_m: f64) -> VehiclePath {
         let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
+        let segments = points.len().saturating_sub(1);
+        let chords = |per: usize| -> Vec<Chord> {
+            (0..segments.div_ceil(per))
+                .map(|k| Chord::over(&points, k * per, ((k + 1) * per).min(segments)))
+                .collect()
+        };
+        let blocks = chords(BLOCK_SEGMENTS);
+        let super_blocks = chords(BLOCK_SEGMENTS * SUPER_BLOCK_BLOCKS);
         VehiclePath {
             points,
             headings_rad,
             dirs,
             advisory_mps,
-            length_m: s,
+            length_m,
+            blocks,
+            super_blocks,
         }
     }
 
@@ -218,52 +273,58 @@ impl VehiclePath {
     /// `max_lateral_m` of `p` (callers pass the largest lateral distance whose answer they would act on).
     ///
     /// The result is exactly that of scanning every segment of the stretch and keeping the first nearest one,
-    /// but most segments are skipped: samples are at most [`PATH_SPACING_M`] apart along the path, so every
-    /// point of segment `k ≥ i` is within `(k − i + 1)·PATH_SPACING_M` of sample `a_i`, hence at least
-    /// `|p − a_i| − (k − i + 1)·PATH_SPACING_M` from `p`; segments whose bound exceeds both the best distance
-    /// so far and `max_lateral_m` can neither win nor matter. The scan is seeded with the segments around the
-    /// point's arc length as guessed from the heading at `from_s_m`, so the skipping starts at once.
+    /// but most segments are skipped with exact lower bounds on their distance from `p`: whole super-blocks and
+    /// blocks by their [`Chord`], and single segments because samples are at most [`PATH_SPACING_M`] apart
+    /// along the path, so every point of segment `k ≥ i` is within `(k − i + 1)·PATH_SPACING_M` of sample
+    /// `a_i`, hence at least `|p − a_i| − (k − i + 1)·PATH_SPACING_M` from `p`. Anything whose bound exceeds
+    /// both the best distance so far and `max_lateral_m` can neither win nor matter.
     pub fn project(&self, p: DVec2, from_s_m: f64, to_s_m: f64, max_lateral_m: f64) -> Option<(f64, f64, f64)> {
         let last = self.points.len().saturating_sub(1);
-        let i0 = ((from_s_m.max(0.0) / PATH_SPACING_M) as usize).min(last.saturating_sub(1));
+        if last == 0 {
+            return None;
+        }
+        let i0 = ((from_s_m.max(0.0) / PATH_SPACING_M) as usize).min(last - 1);
         let i1 = ((to_s_m.max(0.0) / PATH_SPACING_M).ceil() as usize).min(last);
         let end = i1.max(i0 + 1);
-        // (squared distance, segment, s, heading) of the best segment; ties go to the lower segment index.
-        let mut best = (f64::INFINITY, usize::MAX, from_s_m, 0.0);
-        // Evaluates segment `i` into `best`; returns |p − a_i|².
-        let consider = |i: usize, best: &mut (f64, usize, f64, f64)| -> f64 {
-            let a = self.points[i].pos;
-            let (t, d2, len2) = segment_projection(a, self.points[i + 1].pos, p);
-            if d2 < best.0 || (d2 == best.0 && i < best.1) {
-                *best = (d2, i, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
-            }
-            (p - a).length_squared()
-        };
-        if end - i0 > 8 {
-            let ahead = (p - self.points[i0].pos).dot(self.dirs[i0]);
-            let guess = i0 + ((ahead.max(0.0) / PATH_SPACING_M) as usize).min(end - 1 - i0);
-            for i in guess.saturating_sub(1).max(i0)..(guess + 2).min(end) {
-                consider(i, &mut best);
-            }
-        }
         // A little slack so that rounding never skips a segment that could tie.
         const SLACK_M: f64 = 1e-6;
+        // (squared distance, segment, s, heading) of the best segment; ties go to the lower segment index.
+        let mut best = (f64::INFINITY, usize::MAX, from_s_m, 0.0);
+        // Anything farther than `bound` is skipped; `far2` is the squared |p − a_i| beyond which the next
+        // segment can be skipped too.
+        let mut bound = max_lateral_m + SLACK_M;
+        let mut far2 = (bound + 2.0 * PATH_SPACING_M).powi(2);
+        // The next segment not yet proven too far.
         let mut i = i0;
-        let mut bound_for = f64::NAN;
-        let (mut bound, mut far2) = (0.0, 0.0);
-        while i < end {
-            let da2 = consider(i, &mut best);
-            if best.0 != bound_for {
-                bound_for = best.0;
-                bound = best.0.sqrt().min(max_lateral_m) + SLACK_M;
-                far2 = (bound + 2.0 * PATH_SPACING_M).powi(2);
+        const SUPER: usize = BLOCK_SEGMENTS * SUPER_BLOCK_BLOCKS;
+        for sb in i0 / SUPER..end.div_ceil(SUPER) {
+            if self.super_blocks[sb].lower_bound_m(p) > bound {
+                continue;
             }
-            // Segments k ≥ i with (k − i + 1)·spacing < |p − a_i| − bound are farther than `bound`.
-            i += if da2 > far2 {
-                ((da2.sqrt() - bound) / PATH_SPACING_M) as usize - 1
-            } else {
-                1
-            };
+            let sb_end = ((sb + 1) * SUPER).min(end);
+            for b in (sb * SUPER).max(i0) / BLOCK_SEGMENTS..sb_end.div_ceil(BLOCK_SEGMENTS) {
+                if self.blocks[b].lower_bound_m(p) > bound {
+                    continue;
+                }
+                let b_end = ((b + 1) * BLOCK_SEGMENTS).min(end);
+                i = i.max(b * BLOCK_SEGMENTS);
+                while i < b_end {
+                    let a = self.points[i].pos;
+                    let (t, d2, len2) = segment_projection(a, self.points[i + 1].pos, p);
+                    if d2 < best.0 {
+                        best = (d2, i, i as f64 * PATH_SPACING_M + t * len2.sqrt(), self.headings_rad[i]);
+                        bound = best.0.sqrt().min(max_lateral_m) + SLACK_M;
+                        far2 = (bound + 2.0 * PATH_SPACING_M).powi(2);
+                    }
+                    // Segments k ≥ i with (k − i + 1)·spacing < |p − a_i| − bound are farther than `bound`.
+                    let da2 = (p - a).length_squared();
+                    i += if da2 > far2 {
+                        ((da2.sqrt() - bound) / PATH_SPACING_M) as usize - 1
+                    } else {
+                        1
+                    };
+                }
+            }
         }
         let lateral = best.0.sqrt();
         (lateral <= max_lateral_m).then_some((best.2, lateral, best.3))
@@ -712,14 +773,11 @@ mod tests {
             })
             .collect();
         headings_rad.push(*headings_rad.last().expect("points"));
-        let dirs = headings_rad.iter().map(|&h| DVec2::from_angle(h)).collect();
-        VehiclePath {
-            length_m: (points.len() - 1) as f64 * PATH_SPACING_M,
-            advisory_mps: vec![f64::INFINITY; points.len()],
-            points,
-            headings_rad,
-            dirs,
-        }
+        let (length_m, advisory_mps) = (
+            (points.len() - 1) as f64 * PATH_SPACING_M,
+            vec![f64::INFINITY; points.len()],
+        );
+        VehiclePath::assemble(points, headings_rad, advisory_mps, length_m)
     }
 
     /// The plain scan over every segment of the window that `project` must reproduce exactly.
