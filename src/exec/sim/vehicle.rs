@@ -589,58 +589,70 @@ const ZONE_HORIZON_M: f64 = 260.0;
 /// Samples of one path closer than this along it belong to the same zone, metres.
 const ZONE_GAP_M: f64 = 10.0;
 
-/// The conflict zones of every vehicle with every other, found once at set-up with a 2.5 m grid over the path
-/// samples (1 m apart). Sorted by zone start.
+/// The conflict zones of every vehicle with every other, found once at set-up with a grid of cells at least
+/// [`ZONE_DISTANCE_M`] wide over the path samples (1 m apart). Sorted by zone start.
 pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
-    const CELL_M: f64 = 2.5;
-    let cell = |p: DVec2| ((p.x / CELL_M).floor() as i64, (p.y / CELL_M).floor() as i64);
-    // (vehicle, s, pos, heading)
-    let mut samples: Vec<(usize, f64, DVec2, f64)> = Vec::new();
-    for (i, v) in vehicles.iter().enumerate() {
-        let end = (v.s_m + ZONE_HORIZON_M).min(v.path.length_m());
-        let mut s = (v.s_m - VEHICLE_LENGTH_M).max(0.0);
-        while s <= end {
-            let pose = v.path.pose_at(s);
-            samples.push((i, s, pose.pos, pose.heading_rad));
-            s += 1.0;
-        }
-    }
-    // The grid: sample indices sorted by cell (row, then column), so the three cells of a row next to a
-    // sample are one contiguous run, found by binary search.
-    let mut grid: Vec<((i64, i64), u32)> = samples
-        .iter()
-        .enumerate()
-        .map(|(k, smp)| {
-            let (x, y) = cell(smp.2);
-            ((y, x), k as u32)
-        })
-        .collect();
-    grid.sort_unstable();
-    // Close pairs per ordered (i, j): (s_i, s_j). Their order does not matter: each list is sorted below.
+    let samples = zone_samples(vehicles);
     let n = vehicles.len();
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n * n];
+    let grid = SampleGrid::new(samples.iter().map(|smp| smp.pos));
     for a in &samples {
-        let (cx, cy) = cell(a.2);
-        for y in cy - 1..=cy + 1 {
-            let lo = grid.partition_point(|e| e.0 < (y, cx - 1));
-            let hi = lo + grid[lo..].partition_point(|e| e.0 <= (y, cx + 1));
-            for &(_, kb) in &grid[lo..hi] {
-                let b = &samples[kb as usize];
-                // Each pair of samples of two vehicles once (the test is symmetric), recorded both ways.
-                if b.0 <= a.0 || a.2.distance_squared(b.2) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
-                    continue;
-                }
-                let mut d = (a.3 - b.3).abs() % std::f64::consts::TAU;
-                if d > std::f64::consts::PI {
-                    d = std::f64::consts::TAU - d;
-                }
-                if d > ZONE_MIN_ANGLE_RAD {
-                    pairs[a.0 * n + b.0].push((a.1, b.1));
-                    pairs[b.0 * n + a.0].push((b.1, a.1));
-                }
+        grid.for_neighbours(a.pos, |kb| record_close_pair(a, &samples[kb], n, &mut pairs));
+    }
+    zones_from_pairs(n, pairs)
+}
+
+/// A sample of a vehicle's path for the conflict-zone search.
+#[derive(Clone, Copy, Debug)]
+struct ZoneSample {
+    vehicle: usize,
+    s_m: f64,
+    pos: DVec2,
+    heading_rad: f64,
+}
+
+/// Every vehicle's path from just behind it to [`ZONE_HORIZON_M`] ahead, sampled every metre.
+fn zone_samples(vehicles: &[Vehicle]) -> Vec<ZoneSample> {
+    let mut samples = Vec::new();
+    for (vehicle, v) in vehicles.iter().enumerate() {
+        let end = (v.s_m + ZONE_HORIZON_M).min(v.path.length_m());
+        let mut s_m = (v.s_m - VEHICLE_LENGTH_M).max(0.0);
+        while s_m <= end {
+            let pose = v.path.pose_at(s_m);
+            if pose.pos.is_finite() {
+                samples.push(ZoneSample {
+                    vehicle,
+                    s_m,
+                    pos: pose.pos,
+                    heading_rad: pose.heading_rad,
+                });
             }
+            s_m += 1.0;
         }
     }
+    samples
+}
+
+/// Records `(a, b)` in `pairs[a.vehicle · n + b.vehicle]` (and the reverse) when they are samples of two
+/// vehicles' paths that are close and cross at an angle. Symmetric: only the order with `a.vehicle <
+/// b.vehicle` records, so each unordered pair of samples is recorded once each way.
+fn record_close_pair(a: &ZoneSample, b: &ZoneSample, n: usize, pairs: &mut [Vec<(f64, f64)>]) {
+    if b.vehicle <= a.vehicle || a.pos.distance_squared(b.pos) > ZONE_DISTANCE_M * ZONE_DISTANCE_M {
+        return;
+    }
+    let mut d = (a.heading_rad - b.heading_rad).abs() % std::f64::consts::TAU;
+    if d > std::f64::consts::PI {
+        d = std::f64::consts::TAU - d;
+    }
+    if d > ZONE_MIN_ANGLE_RAD {
+        pairs[a.vehicle * n + b.vehicle].push((a.s_m, b.s_m));
+        pairs[b.vehicle * n + a.vehicle].push((b.s_m, a.s_m));
+    }
+}
+
+/// The zones of each vehicle from the close pairs `(s_i, s_j)` per ordered `(i, j)` (in any order: each list
+/// is sorted here), sorted by zone start.
+fn zones_from_pairs(n: usize, mut pairs: Vec<Vec<(f64, f64)>>) -> Vec<Vec<ConflictZone>> {
     let mut out = vec![Vec::new(); n];
     for i in 0..n {
         for j in 0..n {
@@ -674,6 +686,88 @@ pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
         out[i].sort_by(|a, b| a.me_m.0.total_cmp(&b.me_m.0).then(a.other.cmp(&b.other)));
     }
     out
+}
+
+/// A uniform grid over points in compressed rows: cells at least [`ZONE_DISTANCE_M`] wide (wider when the
+/// points are spread so far that the grid would have more than a few cells per point), the points of each cell
+/// listed by index, so that all points within [`ZONE_DISTANCE_M`] of a point are in its 3 × 3 cells.
+struct SampleGrid {
+    origin: DVec2,
+    cell_m: f64,
+    nx: usize,
+    ny: usize,
+    /// Points of cell `c` are `items[starts[c]..starts[c + 1]]` (cells row by row).
+    starts: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl SampleGrid {
+    /// The grid over finite `points`.
+    fn new(points: impl Iterator<Item = DVec2> + Clone) -> SampleGrid {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        let mut count = 0;
+        for p in points.clone() {
+            lo = lo.min(p);
+            hi = hi.max(p);
+            count += 1;
+        }
+        let extent = if count > 0 { hi - lo } else { DVec2::ZERO };
+        let cap = 4 * count + 64;
+        let mut cell_m = ZONE_DISTANCE_M;
+        let cells = |cell_m: f64| ((extent.x / cell_m) as usize + 1, (extent.y / cell_m) as usize + 1);
+        while cells(cell_m).0.saturating_mul(cells(cell_m).1) > cap {
+            cell_m *= 2.0;
+        }
+        let (nx, ny) = cells(cell_m);
+        let mut grid = SampleGrid {
+            origin: lo,
+            cell_m,
+            nx,
+            ny,
+            starts: vec![0; nx * ny + 1],
+            items: vec![0; count],
+        };
+        for p in points.clone() {
+            let c = grid.cell_of(p);
+            grid.starts[c + 1] += 1;
+        }
+        for c in 0..nx * ny {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        let mut fill = grid.starts.clone();
+        for (k, p) in points.enumerate() {
+            let c = grid.cell_of(p);
+            grid.items[fill[c] as usize] = k as u32;
+            fill[c] += 1;
+        }
+        grid
+    }
+
+    fn cell_xy(&self, p: DVec2) -> (usize, usize) {
+        let d = (p - self.origin) / self.cell_m;
+        (
+            (d.x.max(0.0) as usize).min(self.nx - 1),
+            (d.y.max(0.0) as usize).min(self.ny - 1),
+        )
+    }
+
+    fn cell_of(&self, p: DVec2) -> usize {
+        let (x, y) = self.cell_xy(p);
+        y * self.nx + x
+    }
+
+    /// Calls `f` with the index of every point in the 3 × 3 cells around `p`.
+    fn for_neighbours(&self, p: DVec2, mut f: impl FnMut(usize)) {
+        let (cx, cy) = self.cell_xy(p);
+        let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(self.nx - 1));
+        for y in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {
+            let row = y * self.nx;
+            let run = self.starts[row + x0] as usize..self.starts[row + x1 + 1] as usize;
+            for &k in &self.items[run] {
+                f(k as usize);
+            }
+        }
+    }
 }
 
 /// The standing obstacle (gap from the front bumper, metres) at which vehicle `i` must yield in a conflict zone,
@@ -834,6 +928,63 @@ mod tests {
             near > 1000 && far > 1000,
             "both cases exercised: {near} near, {far} far"
         );
+    }
+
+    /// Vehicles on copies of the winding path, rotated about `pivot` and shifted, crossing each other.
+    fn crossing_vehicles(pivot: DVec2, shifts: &[(f64, DVec2)]) -> Vec<Vehicle> {
+        let base = winding_path();
+        shifts
+            .iter()
+            .enumerate()
+            .map(|(k, &(angle_rad, shift))| {
+                let rot = DVec2::from_angle(angle_rad);
+                let points: Vec<PathPoint> = base
+                    .points
+                    .iter()
+                    .map(|q| PathPoint {
+                        pos: pivot + rot.rotate(q.pos - pivot) + shift,
+                        ..*q
+                    })
+                    .collect();
+                let headings_rad = base.headings_rad.iter().map(|h| h + angle_rad).collect();
+                let path = VehiclePath::assemble(points, headings_rad, base.advisory_mps.clone(), base.length_m);
+                Vehicle::new(k as u32, path, 3.0 * k as f64, 1.0, 2.0, 1.5, false, None)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn conflict_zones_from_the_grid_match_the_all_pairs_search() {
+        let pivot = DVec2::new(40.0, 10.0);
+        let near = [
+            (0.0, DVec2::ZERO),
+            (1.2, DVec2::new(5.0, -3.0)),
+            (-0.9, DVec2::new(-8.0, 4.0)),
+            (0.1, DVec2::new(0.0, 1.0)),
+        ];
+        // One vehicle kilometres away spreads the points so far that the grid's cells are widened.
+        let spread = [
+            (0.0, DVec2::ZERO),
+            (1.5, DVec2::new(2.0, 2.0)),
+            (0.7, DVec2::new(4000.0, -2500.0)),
+        ];
+        for shifts in [&near[..], &spread[..]] {
+            let vehicles = crossing_vehicles(pivot, shifts);
+            let samples = zone_samples(&vehicles);
+            let n = vehicles.len();
+            let mut pairs = vec![Vec::new(); n * n];
+            for a in &samples {
+                for b in &samples {
+                    record_close_pair(a, b, n, &mut pairs);
+                }
+            }
+            let expected = zones_from_pairs(n, pairs);
+            let zones: usize = expected.iter().map(Vec::len).sum();
+            assert!(zones >= 2, "the paths cross: {expected:?}");
+            assert_eq!(conflict_zones(&vehicles), expected);
+        }
+        let grid = SampleGrid::new([DVec2::ZERO, DVec2::new(4000.0, -2500.0)].into_iter());
+        assert!(grid.cell_m > ZONE_DISTANCE_M && grid.nx * grid.ny <= 4 * 2 + 64);
     }
 
     #[test]
