@@ -211,15 +211,8 @@ fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f64) -> bool
         Occluder::Vehicle { centre, .. } => (centre.truncate(), VEHICLE_LENGTH_M.hypot(VEHICLE_WIDTH_M) * 0.5),
         Occluder::Person { ground, radius_m, .. } => (ground.truncate(), radius_m),
     };
-    let ab = target - camera;
-    let len2 = ab.length_squared();
-    let t = if len2 > 0.0 {
-        ((centre - camera).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
     let r = radius_m + reach_m + 1e-6;
-    (camera + ab * t).distance_squared(centre) <= r * r
+    crate::world::segment_projection(camera, target, centre).1 <= r * r
 }
 
 /// The image interval `[lo, hi]` covered by a sphere along one image axis, exactly (perspective included):

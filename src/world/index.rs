@@ -78,24 +78,13 @@ fn in_hull(c: &[DVec2; 4], p: DVec2) -> bool {
         || in_tri(c[1], c[2], c[3], p)
 }
 
-fn seg_dist(a: DVec2, b: DVec2, p: DVec2) -> f64 {
-    let d = b - a;
-    let l2 = d.length_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(d) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + d * t - p).length()
-}
-
 fn quad_dist(c: &[DVec2; 4], p: DVec2) -> f64 {
     if in_quad(c, p) {
         return 0.0;
     }
     let mut d = f64::INFINITY;
     for i in 0..4 {
-        d = d.min(seg_dist(c[i], c[(i + 1) % 4], p));
+        d = d.min(super::segment_projection(c[i], c[(i + 1) % 4], p).1.sqrt());
     }
     d
 }

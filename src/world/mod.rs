@@ -44,6 +44,20 @@ pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSampl
 /// the paper's CARLA towns but are not CARLA's maps, hence the `_like` suffix.
 pub const BUILTIN_TOWN_NAMES: [&str; 4] = ["town01_like", "town02_like", "town03_like", "town05_like"];
 
+/// Projection of `p` on the segment `a`–`b` (plan view): `(t, squared distance, squared segment length)` with
+/// `t` in [0, 1] the fraction along the segment of the nearest point (0 for a degenerate segment).
+#[inline]
+pub fn segment_projection(a: DVec2, b: DVec2, p: DVec2) -> (f64, f64, f64) {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (t, (a + ab * t - p).length_squared(), len2)
+}
+
 /// Converts a point from this crate's right-handed frame to CARLA's left-handed world frame.
 pub fn to_carla(p: DVec3) -> DVec3 {
     DVec3::new(p.x, -p.y, p.z)

@@ -14,7 +14,7 @@ use glam::DVec2;
 use super::{PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Idm;
 use crate::planner::{EgoScript, RouteScript, VehicleScript};
-use crate::world::RoadNetwork;
+use crate::world::{RoadNetwork, segment_projection};
 
 /// Spacing of the resampled path polyline, metres.
 const PATH_SPACING_M: f64 = 0.5;
@@ -109,18 +109,6 @@ pub(crate) struct PathPose {
     pub speed_limit_mps: f64,
 }
 
-/// Projection of `p` on the segment `a`–`b`: `(t, squared distance, squared segment length)`, `t` in [0, 1].
-fn segment_projection(a: DVec2, b: DVec2, p: DVec2) -> (f64, f64, f64) {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (t, (a + ab * t - p).length_squared(), len2)
-}
-
 impl VehiclePath {
     /// Rebuilds the route polyline of `route` from its lane list, joining lanes exactly as
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
@@ -182,15 +170,7 @@ impl VehiclePath {
                 break;
             }
         }
-        let mut headings_rad: Vec<f64> = points
-            .windows(2)
-            .map(|w| {
-                let d = w[1].pos - w[0].pos;
-                d.y.atan2(d.x)
-            })
-            .collect();
-        let last = headings_rad.last().copied().unwrap_or(route.start_heading_rad);
-        headings_rad.push(last);
+        let headings_rad = segment_headings_rad(&points, route.start_heading_rad);
         // Curvature from the heading change over ±2 m, then a backward pass so that every curve is announced.
         let k = (2.0 / PATH_SPACING_M) as usize;
         let n = points.len();
@@ -329,6 +309,20 @@ impl VehiclePath {
         let lateral = best.0.sqrt();
         (lateral <= max_lateral_m).then_some((best.2, lateral, best.3))
     }
+}
+
+/// The heading of each segment `points[i] → points[i + 1]`, the last one repeated for the last point
+/// (`fallback_rad` when there is no segment).
+fn segment_headings_rad(points: &[PathPoint], fallback_rad: f64) -> Vec<f64> {
+    let mut headings_rad: Vec<f64> = points
+        .windows(2)
+        .map(|w| {
+            let d = w[1].pos - w[0].pos;
+            d.y.atan2(d.x)
+        })
+        .collect();
+    headings_rad.push(headings_rad.last().copied().unwrap_or(fallback_rad));
+    headings_rad
 }
 
 /// A simulated vehicle (the ego or traffic).
@@ -859,14 +853,7 @@ mod tests {
             pos += DVec2::from_angle(0.5 * (heading + next)) * chord;
             heading = next;
         }
-        let mut headings_rad: Vec<f64> = points
-            .windows(2)
-            .map(|w| {
-                let d = w[1].pos - w[0].pos;
-                d.y.atan2(d.x)
-            })
-            .collect();
-        headings_rad.push(*headings_rad.last().expect("points"));
+        let headings_rad = segment_headings_rad(&points, 0.0);
         let (length_m, advisory_mps) = (
             (points.len() - 1) as f64 * PATH_SPACING_M,
             vec![f64::INFINITY; points.len()],
