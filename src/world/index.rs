@@ -1,9 +1,10 @@
-//! Spatial index over lane pieces: a uniform grid (4 m cells) in compressed-row layout. Each cell lists the
+//! Spatial index over lane pieces: a uniform grid (4 m cells, [`CellGrid`]) in compressed-row layout. Each cell lists the
 //! pieces whose bounding box touches it, so `lane_at` is one cell lookup plus a handful of point-in-quad
 //! tests, without allocation. Zero-width pieces are left out.
 
 use glam::DVec2;
 
+use crate::world::grid::CellGrid;
 use crate::world::{Lane, LaneHit, LaneType, RoadNetwork, TravelDirection};
 
 const CELL_M: f64 = 4.0;
@@ -13,12 +14,8 @@ pub(crate) const LEVEL_M: f64 = 3.0;
 
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LaneIndex {
-    origin: DVec2,
-    cell_m: f64,
-    nx: usize,
-    ny: usize,
-    cell_start: Vec<u32>,
-    items: Vec<u32>,
+    /// Pieces by the cells their bounding boxes touch.
+    grid: CellGrid,
     /// Per piece: true when the quad is convex (tested with 4 half-planes), else tested by its hull.
     convex: Vec<bool>,
 }
@@ -135,89 +132,29 @@ pub(crate) fn hit_on_piece(net: &RoadNetwork, pi: u32, p: DVec2) -> LaneHit {
 impl LaneIndex {
     pub(crate) fn build(net: &RoadNetwork) -> LaneIndex {
         let (lo, hi) = net.bounds;
-        let ext = (hi - lo).max(DVec2::splat(1.0));
-        let mut cell_m = CELL_M;
-        while (ext.x / cell_m + 1.0) * (ext.y / cell_m + 1.0) > MAX_CELLS {
-            cell_m *= 2.0;
-        }
-        let nx = (ext.x / cell_m).floor() as usize + 1;
-        let ny = (ext.y / cell_m).floor() as usize + 1;
-        let convex = net.pieces.iter().map(|p| is_convex(&p.corners)).collect();
-        let mut idx = LaneIndex {
-            origin: lo,
-            cell_m,
-            nx,
-            ny,
-            cell_start: vec![0; nx * ny + 1],
-            items: Vec::new(),
-            convex,
-        };
         let live = |p: &crate::world::LanePiece| p.width_m[0].max(p.width_m[1]) > 0.01;
-        let range = |idx: &LaneIndex, c: &[DVec2; 4]| {
-            let mut a = c[0];
-            let mut b = c[0];
-            for &q in &c[1..] {
-                a = a.min(q);
-                b = b.max(q);
-            }
-            let (x0, y0) = idx.cell_of(a);
-            let (x1, y1) = idx.cell_of(b);
-            (x0, y0, x1, y1)
-        };
-        for p in net.pieces.iter().filter(|p| live(p)) {
-            let (x0, y0, x1, y1) = range(&idx, &p.corners);
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    idx.cell_start[y * nx + x + 1] += 1;
-                }
-            }
-        }
-        for i in 0..nx * ny {
-            idx.cell_start[i + 1] += idx.cell_start[i];
-        }
-        let mut fill = idx.cell_start.clone();
-        idx.items = vec![0; idx.cell_start[nx * ny] as usize];
-        for (pi, p) in net.pieces.iter().enumerate().filter(|(_, p)| live(p)) {
-            let (x0, y0, x1, y1) = range(&idx, &p.corners);
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    let c = y * nx + x;
-                    idx.items[fill[c] as usize] = pi as u32;
-                    fill[c] += 1;
-                }
-            }
-        }
-        idx
-    }
-
-    /// Cell coordinates of `p`, clamped to the grid.
-    fn cell_of(&self, p: DVec2) -> (usize, usize) {
-        let q = (p - self.origin) / self.cell_m;
-        let x = (q.x.floor().max(0.0) as usize).min(self.nx - 1);
-        let y = (q.y.floor().max(0.0) as usize).min(self.ny - 1);
-        (x, y)
-    }
-
-    fn cell_items(&self, x: usize, y: usize) -> &[u32] {
-        let c = y * self.nx + x;
-        &self.items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize]
+        let grid = CellGrid::build(lo, hi, CELL_M, MAX_CELLS, net.pieces.len(), |k| {
+            let piece = &net.pieces[k];
+            live(piece).then(|| {
+                let c = &piece.corners;
+                c[1..].iter().fold((c[0], c[0]), |(a, b), &q| (a.min(q), b.max(q)))
+            })
+        });
+        let convex = net.pieces.iter().map(|p| is_convex(&p.corners)).collect();
+        LaneIndex { grid, convex }
     }
 
     /// The best piece containing `p`; with `z`, only pieces within [`LEVEL_M`] of it count. Without `z`, where
     /// pieces at different levels overlap (bridges), the lower one wins.
     pub(crate) fn lane_at(&self, net: &RoadNetwork, p: DVec2, z: Option<f64>) -> Option<LaneHit> {
-        if self.nx == 0 {
+        if self.grid.is_empty() {
             return None;
         }
-        let q = (p - self.origin) / self.cell_m;
-        if !(q.x >= 0.0 && q.y >= 0.0 && q.x < self.nx as f64 && q.y < self.ny as f64) {
-            return None;
-        }
-        let (x, y) = (q.x as usize, q.y as usize);
+        let (x, y) = self.grid.cell_containing(p)?;
         let mut best = u32::MAX;
         let mut best_score = f64::INFINITY;
         let mut best_z = 0.0f32;
-        for &pi in self.cell_items(x, y) {
+        for &pi in self.grid.items_in(x, y) {
             let piece = &net.pieces[pi as usize];
             if let Some(z) = z
                 && (piece.z_m as f64 - z).abs() > LEVEL_M
@@ -263,24 +200,25 @@ impl LaneIndex {
         max_d: f64,
         filter: impl Fn(&Lane) -> bool,
     ) -> Option<LaneHit> {
-        if self.nx == 0 || !p.is_finite() {
+        if self.grid.is_empty() || !p.is_finite() {
             return None;
         }
-        let q = ((p - self.origin) / self.cell_m).floor();
-        let (cx, cy) = (q.x as i64, q.y as i64);
-        let rings = (max_d / self.cell_m).ceil() as i64 + 1;
+        let (cx, cy) = self.grid.cell_coords(p);
+        let (nx, ny) = self.grid.size();
+        let cell_m = self.grid.cell_m();
+        let rings = (max_d / cell_m).ceil() as i64 + 1;
         let mut best = u32::MAX;
         let mut best_d = max_d;
         for r in 0..=rings {
             for y in cy - r..=cy + r {
-                if y < 0 || y >= self.ny as i64 {
+                if y < 0 || y >= ny as i64 {
                     continue;
                 }
                 let on_edge_row = y == cy - r || y == cy + r;
                 let mut x = cx - r;
                 while x <= cx + r {
-                    if x >= 0 && x < self.nx as i64 {
-                        for &pi in self.cell_items(x as usize, y as usize) {
+                    if x >= 0 && x < nx as i64 {
+                        for &pi in self.grid.items_in(x as usize, y as usize) {
                             let piece = &net.pieces[pi as usize];
                             if !filter(&net.lanes[piece.lane as usize]) {
                                 continue;
@@ -304,7 +242,7 @@ impl LaneIndex {
                     x += if on_edge_row || r == 0 { 1 } else { 2 * r };
                 }
             }
-            if best != u32::MAX && best_d <= r as f64 * self.cell_m {
+            if best != u32::MAX && best_d <= r as f64 * cell_m {
                 break;
             }
         }

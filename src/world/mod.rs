@@ -25,6 +25,7 @@
 
 mod builtin;
 pub mod cli;
+pub(crate) mod grid;
 mod index;
 mod obstacles;
 pub mod opendrive;

@@ -14,6 +14,7 @@ use glam::DVec2;
 use super::{PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Idm;
 use crate::planner::{EgoScript, RouteScript, VehicleScript};
+use crate::world::grid::CellGrid;
 use crate::world::{RoadNetwork, segment_projection};
 
 /// Spacing of the resampled path polyline, metres.
@@ -589,11 +590,30 @@ pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
     let samples = zone_samples(vehicles);
     let n = vehicles.len();
     let mut pairs: Vec<Vec<(f64, f64)>> = vec![Vec::new(); n * n];
-    let grid = SampleGrid::new(samples.iter().map(|smp| smp.pos));
+    let grid = sample_grid(&samples);
     for a in &samples {
-        grid.for_neighbours(a.pos, |kb| record_close_pair(a, &samples[kb], n, &mut pairs));
+        grid.for_items_around(a.pos, |kb| record_close_pair(a, &samples[kb], n, &mut pairs));
     }
     zones_from_pairs(n, pairs)
+}
+
+/// The samples by grid cell: cells at least [`ZONE_DISTANCE_M`] wide, so that every sample within that
+/// distance of another is in its 3 × 3 cells (wider when the samples are spread so far that the grid would
+/// have more than a few cells per sample).
+fn sample_grid(samples: &[ZoneSample]) -> CellGrid {
+    let (lo, hi) = samples.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), smp| (lo.min(smp.pos), hi.max(smp.pos)),
+    );
+    let (lo, hi) = if samples.is_empty() {
+        (DVec2::ZERO, DVec2::ZERO)
+    } else {
+        (lo, hi)
+    };
+    let max_cells = (4 * samples.len() + 64) as f64;
+    CellGrid::build(lo, hi, ZONE_DISTANCE_M, max_cells, samples.len(), |k| {
+        Some((samples[k].pos, samples[k].pos))
+    })
 }
 
 /// A sample of a vehicle's path for the conflict-zone search.
@@ -680,88 +700,6 @@ fn zones_from_pairs(n: usize, mut pairs: Vec<Vec<(f64, f64)>>) -> Vec<Vec<Confli
         out[i].sort_by(|a, b| a.me_m.0.total_cmp(&b.me_m.0).then(a.other.cmp(&b.other)));
     }
     out
-}
-
-/// A uniform grid over points in compressed rows: cells at least [`ZONE_DISTANCE_M`] wide (wider when the
-/// points are spread so far that the grid would have more than a few cells per point), the points of each cell
-/// listed by index, so that all points within [`ZONE_DISTANCE_M`] of a point are in its 3 × 3 cells.
-struct SampleGrid {
-    origin: DVec2,
-    cell_m: f64,
-    nx: usize,
-    ny: usize,
-    /// Points of cell `c` are `items[starts[c]..starts[c + 1]]` (cells row by row).
-    starts: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl SampleGrid {
-    /// The grid over finite `points`.
-    fn new(points: impl Iterator<Item = DVec2> + Clone) -> SampleGrid {
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        let mut count = 0;
-        for p in points.clone() {
-            lo = lo.min(p);
-            hi = hi.max(p);
-            count += 1;
-        }
-        let extent = if count > 0 { hi - lo } else { DVec2::ZERO };
-        let cap = 4 * count + 64;
-        let mut cell_m = ZONE_DISTANCE_M;
-        let cells = |cell_m: f64| ((extent.x / cell_m) as usize + 1, (extent.y / cell_m) as usize + 1);
-        while cells(cell_m).0.saturating_mul(cells(cell_m).1) > cap {
-            cell_m *= 2.0;
-        }
-        let (nx, ny) = cells(cell_m);
-        let mut grid = SampleGrid {
-            origin: lo,
-            cell_m,
-            nx,
-            ny,
-            starts: vec![0; nx * ny + 1],
-            items: vec![0; count],
-        };
-        for p in points.clone() {
-            let c = grid.cell_of(p);
-            grid.starts[c + 1] += 1;
-        }
-        for c in 0..nx * ny {
-            grid.starts[c + 1] += grid.starts[c];
-        }
-        let mut fill = grid.starts.clone();
-        for (k, p) in points.enumerate() {
-            let c = grid.cell_of(p);
-            grid.items[fill[c] as usize] = k as u32;
-            fill[c] += 1;
-        }
-        grid
-    }
-
-    fn cell_xy(&self, p: DVec2) -> (usize, usize) {
-        let d = (p - self.origin) / self.cell_m;
-        (
-            (d.x.max(0.0) as usize).min(self.nx - 1),
-            (d.y.max(0.0) as usize).min(self.ny - 1),
-        )
-    }
-
-    fn cell_of(&self, p: DVec2) -> usize {
-        let (x, y) = self.cell_xy(p);
-        y * self.nx + x
-    }
-
-    /// Calls `f` with the index of every point in the 3 × 3 cells around `p`.
-    fn for_neighbours(&self, p: DVec2, mut f: impl FnMut(usize)) {
-        let (cx, cy) = self.cell_xy(p);
-        let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(self.nx - 1));
-        for y in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {
-            let row = y * self.nx;
-            let run = self.starts[row + x0] as usize..self.starts[row + x1 + 1] as usize;
-            for &k in &self.items[run] {
-                f(k as usize);
-            }
-        }
-    }
 }
 
 /// The standing obstacle (gap from the front bumper, metres) at which vehicle `i` must yield in a conflict zone,
@@ -970,8 +908,9 @@ mod tests {
             assert!(zones >= 2, "the paths cross: {expected:?}");
             assert_eq!(conflict_zones(&vehicles), expected);
         }
-        let grid = SampleGrid::new([DVec2::ZERO, DVec2::new(4000.0, -2500.0)].into_iter());
-        assert!(grid.cell_m > ZONE_DISTANCE_M && grid.nx * grid.ny <= 4 * 2 + 64);
+        let spread = crossing_vehicles(pivot, &spread);
+        let grid = sample_grid(&zone_samples(&spread));
+        assert!(grid.cell_m() > ZONE_DISTANCE_M, "the spread case widens the cells");
     }
 
     #[test]
