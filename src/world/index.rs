@@ -1,6 +1,6 @@
-//! Spatial index over lane pieces: a uniform grid (4 m cells, [`CellGrid`]) in compressed-row layout. Each cell lists the
-//! pieces whose bounding box touches it, so `lane_at` is one cell lookup plus a handful of point-in-quad
-//! tests, without allocation. Zero-width pieces are left out.
+//! Spatial index over lane pieces: a uniform grid (4 m cells, [`CellGrid`]) in compressed-row layout. Each
+//! cell lists the pieces whose bounding box touches it, so `lane_at` is one cell lookup plus a handful of
+//! point-in-quad tests, without allocation. Zero-width pieces are left out.
 
 use glam::DVec2;
 

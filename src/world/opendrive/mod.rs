@@ -1,5 +1,5 @@
-//! OpenDRIVE (.xodr 1.4–1.7) import: [`parse`] turns XML into raw records with line numbers, [`geometry`]
-//! evaluates reference lines and cubic profiles, and [`build`] turns raw records into the road-network model.
+//! OpenDRIVE (.xodr 1.4–1.7) import: `parse` turns XML into raw records with line numbers, `geometry`
+//! evaluates reference lines and cubic profiles, and `build` turns raw records into the road-network model.
 //! The caps below protect against hostile input (OOM, absurd values).
 
 pub(crate) mod build;
