@@ -135,10 +135,7 @@ impl LaneIndex {
         let live = |p: &crate::world::LanePiece| p.width_m[0].max(p.width_m[1]) > 0.01;
         let grid = CellGrid::build(lo, hi, CELL_M, MAX_CELLS, net.pieces.len(), |k| {
             let piece = &net.pieces[k];
-            live(piece).then(|| {
-                let c = &piece.corners;
-                c[1..].iter().fold((c[0], c[0]), |(a, b), &q| (a.min(q), b.max(q)))
-            })
+            live(piece).then(|| super::bounding_box(piece.corners)).flatten()
         });
         let convex = net.pieces.iter().map(|p| is_convex(&p.corners)).collect();
         LaneIndex { grid, convex }

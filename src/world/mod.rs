@@ -59,6 +59,13 @@ pub fn segment_projection(a: DVec2, b: DVec2, p: DVec2) -> (f64, f64, f64) {
     (t, (a + ab * t - p).length_squared(), len2)
 }
 
+/// The axis-aligned bounding box `(lo, hi)` of `points`, or `None` when there are none.
+pub fn bounding_box(points: impl IntoIterator<Item = DVec2>) -> Option<(DVec2, DVec2)> {
+    let mut points = points.into_iter();
+    let first = points.next()?;
+    Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
 /// Converts a point from this crate's right-handed frame to CARLA's left-handed world frame.
 pub fn to_carla(p: DVec3) -> DVec3 {
     DVec3::new(p.x, -p.y, p.z)
@@ -290,6 +297,11 @@ impl Obstacle {
             self.centre + ax + ay,
             self.centre - ax + ay,
         ]
+    }
+
+    /// The axis-aligned bounding box `(lo, hi)` of the footprint.
+    pub fn footprint_box(&self) -> (DVec2, DVec2) {
+        bounding_box(self.footprint()).expect("four corners")
     }
 }
 

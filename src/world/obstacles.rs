@@ -23,13 +23,7 @@ impl std::fmt::Debug for ObstacleIndex {
 }
 
 fn aabb(o: &Obstacle) -> Aabb {
-    let fp = o.footprint();
-    let mut lo = fp[0];
-    let mut hi = fp[0];
-    for &c in &fp[1..] {
-        lo = lo.min(c);
-        hi = hi.max(c);
-    }
+    let (lo, hi) = o.footprint_box();
     Aabb::new(
         Vec3::new(lo.x as f32 - 0.01, lo.y as f32 - 0.01, o.base_z_m as f32 - 0.01),
         Vec3::new(
@@ -155,13 +149,7 @@ pub(crate) fn synthesize_buildings(net: &RoadNetwork) -> Vec<Obstacle> {
                 base_z_m: first.z_m as f64,
                 height_m: height,
             };
-            let fp = o.footprint();
-            let mut lo = fp[0];
-            let mut hi = fp[0];
-            for &c in &fp[1..] {
-                lo = lo.min(c);
-                hi = hi.max(c);
-            }
+            let (lo, hi) = o.footprint_box();
             if boxes
                 .iter()
                 .any(|(l, h)| l.x < hi.x && h.x > lo.x && l.y < hi.y && h.y > lo.y)

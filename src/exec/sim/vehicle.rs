@@ -15,7 +15,7 @@ use super::{PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Idm;
 use crate::planner::{EgoScript, RouteScript, VehicleScript};
 use crate::world::grid::CellGrid;
-use crate::world::{RoadNetwork, segment_projection};
+use crate::world::{RoadNetwork, bounding_box, segment_projection};
 
 /// Spacing of the resampled path polyline, metres.
 const PATH_SPACING_M: f64 = 0.5;
@@ -601,15 +601,7 @@ pub(crate) fn conflict_zones(vehicles: &[Vehicle]) -> Vec<Vec<ConflictZone>> {
 /// distance of another is in its 3 × 3 cells (wider when the samples are spread so far that the grid would
 /// have more than a few cells per sample).
 fn sample_grid(samples: &[ZoneSample]) -> CellGrid {
-    let (lo, hi) = samples.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), smp| (lo.min(smp.pos), hi.max(smp.pos)),
-    );
-    let (lo, hi) = if samples.is_empty() {
-        (DVec2::ZERO, DVec2::ZERO)
-    } else {
-        (lo, hi)
-    };
+    let (lo, hi) = bounding_box(samples.iter().map(|smp| smp.pos)).unwrap_or_default();
     let max_cells = (4 * samples.len() + 64) as f64;
     CellGrid::build(lo, hi, ZONE_DISTANCE_M, max_cells, samples.len(), |k| {
         Some((samples[k].pos, samples[k].pos))

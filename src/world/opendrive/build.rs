@@ -271,21 +271,15 @@ pub(crate) fn build_with(
         });
     }
     let live = pieces.iter().filter(|p| p.width_m[0].max(p.width_m[1]) > 0.01);
-    let mut lo = DVec2::splat(f64::INFINITY);
-    let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for p in live {
-        for c in p.corners {
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
-    }
-    if !lo.is_finite() || !hi.is_finite() {
+    let Some((lo, hi)) =
+        crate::world::bounding_box(live.flat_map(|p| p.corners)).filter(|(lo, hi)| lo.is_finite() && hi.is_finite())
+    else {
         return Err(WorldError::XodrInvalid {
             path: path.into(),
             line: raw.roads.first().map_or(1, |r| line_of(xml, r.pos)),
             message: "no lane of any road has a positive width".into(),
         });
-    }
+    };
     let mut junctions: Vec<Junction> = raw
         .junctions
         .iter()
