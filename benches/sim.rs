@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::sim;
+use pedsynth::exec::simulate;
 
 fn main() {
     divan::main();
@@ -47,7 +47,7 @@ fn simulate_13s_clip_10_peds_10_vehicles(bencher: divan::Bencher, town: &str) {
     let agents = (clip.pedestrians.len() + clip.vehicles.len() + 1) as u64;
     bencher
         .counter(divan::counter::ItemsCount::new(agents * u64::from(clip.frame_count)))
-        .bench(|| sim::simulate(divan::black_box(clip), &plan.sim, net));
+        .bench(|| simulate::simulate(divan::black_box(clip), &plan.sim, net));
 }
 
 #[divan::bench(args = TOWNS, sample_count = 10)]
@@ -61,7 +61,7 @@ fn simulate_8_clips_13s_10_peds_10_vehicles(bencher: divan::Bencher, town: &str)
         .sum();
     bencher.counter(divan::counter::ItemsCount::new(steps)).bench(|| {
         for clip in &plan.clips {
-            divan::black_box(sim::simulate(divan::black_box(clip), &plan.sim, net));
+            divan::black_box(simulate::simulate(divan::black_box(clip), &plan.sim, net));
         }
     });
 }

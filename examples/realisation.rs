@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::{annotate, camera::Camera, sim};
+use pedsynth::exec::observe::{annotate, rig::Camera};
+use pedsynth::exec::simulate;
 use pedsynth::planner::{CrosserSource, Role};
 use pedsynth::world::LaneType;
 use rayon::prelude::*;
@@ -27,7 +28,7 @@ fn main() {
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
-                let trace = sim::simulate(clip, &plan.sim, net);
+                let trace = simulate::simulate(clip, &plan.sim, net);
                 let ann = annotate::annotate(clip, &trace, &plan.spec.annotations, &camera, net);
                 let mut c = [0usize; 6];
                 for (i, p) in clip.pedestrians.iter().enumerate() {

@@ -367,12 +367,12 @@ pub fn generate(
 
 /// `pedsynth stats DIR [--json]`: statistics computed from the written tables.
 pub fn stats(dir: &std::path::Path, json: bool, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
-    match crate::exec::stats::compute(dir) {
+    match crate::exec::read::stats::compute(dir) {
         Ok(stats) => {
             let text = if json {
                 serde_json::to_string_pretty(&stats).unwrap_or_default() + "\n"
             } else {
-                crate::exec::stats::render_text(&stats)
+                crate::exec::read::stats::render_text(&stats)
             };
             match out.write_all(text.as_bytes()) {
                 Ok(()) => exit::OK,

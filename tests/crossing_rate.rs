@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use pedsynth::commands::{self, GenerateArgs};
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::stats;
+use pedsynth::exec::read::stats;
 
 fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
     let out = std::env::temp_dir().join(format!("pedsynth-crossing-rate-{}-{target}", std::process::id()));

@@ -18,7 +18,8 @@ use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 
 use pedsynth::commands::{self, GenerateArgs, PlanArgs};
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::{body, camera::Camera, sim};
+use pedsynth::exec::observe::{body, rig::Camera};
+use pedsynth::exec::simulate;
 
 const TABLES: [&str; 6] = ["clips", "frames", "pedestrians", "annotations", "vehicles", "events"];
 const CROSSING_STATES: [&str; 5] = [
@@ -679,7 +680,7 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
     let mut checked_boxes = 0usize;
     let mut worst = 0f64;
     for script in &plan.clips {
-        let trace = sim::simulate(script, &plan.sim, &towns[&script.town].network);
+        let trace = simulate::simulate(script, &plan.sim, &towns[&script.town].network);
         // The re-simulation is the one that was written: the ego's trajectory matches exactly.
         for (f, ego) in trace.ego.iter().enumerate() {
             let row = d.frames[&(script.clip_id.clone(), f as u32)];

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::sim;
+use pedsynth::exec::simulate;
 
 #[test]
 fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn std::error::Error>> {
@@ -19,7 +19,7 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     assert!(plan.clips.len() >= 8);
     let run = |threads: usize| -> Result<(String, String), Box<dyn std::error::Error>> {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-        let traces = pool.install(|| sim::simulate_all(&plan, &towns))?;
+        let traces = pool.install(|| simulate::simulate_all(&plan, &towns))?;
         Ok((serde_json::to_string(&traces)?, serde_json::to_string(&traces[3])?))
     };
     let one = run(1)?;
@@ -28,7 +28,7 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     assert!(one == two, "1 vs 2 threads differ");
     assert!(two == again, "two runs differ");
     // A single clip alone gives the same trace as within the batch.
-    let alone = serde_json::to_string(&sim::simulate(
+    let alone = serde_json::to_string(&simulate::simulate(
         &plan.clips[3],
         &plan.sim,
         &towns[&plan.clips[3].town].network,

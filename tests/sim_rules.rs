@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 use pedsynth::dsl::types::{Body, Spec, WeatherParams};
-use pedsynth::exec::sim::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
+use pedsynth::exec::simulate::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
 use pedsynth::exec::trace::{ClipTrace, EGO_ID, Event, PedState};
 use pedsynth::planner::{
     Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef, PedestrianScript,
@@ -236,7 +236,7 @@ fn a_closing_vehicle_below_the_threshold_makes_the_pedestrian_wait() {
         vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         5,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     assert_eq!(first_in_road(&trace, 0), None, "states: {:?}", states(&trace, 0));
     assert!(
@@ -257,7 +257,7 @@ fn a_gap_above_the_threshold_is_accepted() {
         vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         14,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     let entered = first_in_road(&trace, 0).expect("crosses");
     let s = states(&trace, 0);
@@ -296,7 +296,7 @@ fn a_vehicle_that_is_not_closing_does_not_block() {
         vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         8,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert!(first_in_road(&trace, 0).is_some(), "states: {:?}", states(&trace, 0));
     assert_no_interpenetration(&trace);
 }
@@ -313,7 +313,7 @@ fn an_allocated_crosser_commits_when_the_ego_enters_the_decision_window() {
         vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
         14,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     let decision = trace
         .events
@@ -358,7 +358,7 @@ fn a_crosser_facing_another_closing_vehicle_inside_the_window_waits_for_it() {
         ))],
         10,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     // Without the wait it would decide at once (it starts at the curb with the ego inside the window).
     let decision = trace
         .events
@@ -399,7 +399,7 @@ fn the_lookahead_stops_a_crosser_before_a_vehicle_in_its_path() {
         vec![p],
         8,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     let s = states(&trace, 0);
     assert_eq!(s[0], PedState::Jaywalking);
@@ -432,7 +432,7 @@ fn the_ego_brakes_for_a_pedestrian_crossing_in_its_path() {
     p.spawn_place = SpawnPlace::DrivingLane;
     p.base_speed_mps = 0.6;
     let script = clip(ego_at(&net, 40.0, 0.0), vec![], vec![p], 8);
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     let min_speed = trace.ego.iter().map(|f| f.speed_mps).fold(f64::INFINITY, f64::min);
     assert!(min_speed < 2.0, "ego never slowed down: {min_speed}");
     assert!(trace.ego.iter().any(|f| f.accel_mps2 < -2.0));
@@ -451,7 +451,7 @@ fn groups_cross_together() {
     follower.group = Some(GroupRef { group_id: 0, leader: 0 });
     // The ego has already passed.
     let script = clip(ego_at(&net, 170.0, 0.0), vec![], vec![leader, follower], 12);
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert_events_match_trace(&trace);
     for f in 1..trace.frame_count as usize {
         assert_eq!(
@@ -497,7 +497,7 @@ fn patience_clip(net: &RoadNetwork, sudden_probability: f64) -> (ClipTrace, Clip
     );
     let mut params = params();
     params.patience.sudden_crossing_probability = sudden_probability;
-    (sim::simulate(&script, &params, net), script)
+    (simulate::simulate(&script, &params, net), script)
 }
 
 #[test]
@@ -554,7 +554,7 @@ fn a_baseline_crosser_stops_and_checks_like_carla() {
         vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Baseline)],
         10,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     let entered = first_in_road(&trace, 0).expect("crosses");
     assert!(trace.ego[entered].pos.x < 150.0, "crossed in front of the ego");
     assert_no_interpenetration(&trace);
@@ -569,7 +569,7 @@ fn non_crossers_stay_on_the_sidewalk_and_sudden_crossers_go_without_checking() {
     walker.spawn_heading_rad = 0.0;
     let sudden = crosser(&net, 1, 150.0, Behaviour::Sudden, CrosserSource::Allocated);
     let script = clip(ego_at(&net, 80.0, 0.0), vec![], vec![walker, sudden], 10);
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     assert!(
         trace.pedestrians[0]
             .iter()
@@ -605,7 +605,7 @@ fn vehicles_follow_without_passing_through_each_other() {
         vec![],
         15,
     );
-    let trace = sim::simulate(&script, &params(), &net);
+    let trace = simulate::simulate(&script, &params(), &net);
     for f in 0..trace.frame_count as usize {
         let gap = trace.vehicles[0][f].pos.x - trace.ego[f].pos.x - VEHICLE_LENGTH_M;
         assert!(gap > 1.0, "gap {gap} at frame {f}");

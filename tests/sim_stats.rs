@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::sim::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
+use pedsynth::exec::simulate::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
 use pedsynth::exec::trace::{ClipTrace, Event, PedState};
 use pedsynth::planner::{CrosserSource, Plan, Role};
 use pedsynth::world::LaneType;
@@ -21,7 +21,7 @@ fn plan_and_simulate(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
         allow_large: true,
     };
     let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
-    let traces = sim::simulate_all(&plan, &towns).expect("towns present");
+    let traces = simulate::simulate_all(&plan, &towns).expect("towns present");
     (plan, traces)
 }
 
@@ -88,7 +88,7 @@ fn measure(plan: &Plan, traces: &[ClipTrace]) -> Stats {
             let follower = ps.group.is_some_and(|g| g.leader != ps.id);
             for (k, f) in frames.iter().enumerate().skip(1) {
                 let v = f.velocity.length();
-                let (lo, hi) = sim::allowed_speed_range_mps(f.state, ps, &plan.sim);
+                let (lo, hi) = simulate::allowed_speed_range_mps(f.state, ps, &plan.sim);
                 let prev = frames[k - 1].state;
                 // A contact push-out is not walking.
                 let tol = if follower { 0.35 } else { 1e-6 };

@@ -1,18 +1,18 @@
-//! The executor: simulates clip scripts and writes the dataset.
+//! The executor: turns each clip script of a plan into files of the dataset, in three stages per clip:
 //!
-//! - `sim` — the simulation engine (vehicles, pedestrians and their 12-state behaviour machine).
-//! - `trace` — the simulation's output (per-frame agent states and events).
-//! - `camera` — the ego's pinhole camera: mount, intrinsics, projection.
-//! - `body` — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
-//! - `annotate` — visibility gate, boxes, keypoints, occlusion and crossing labels of a simulated clip.
-//! - `tables` — the Parquet tables: schemas, record batches, atomic writes.
-//! - `generate` — `pedsynth generate`: plan → simulate → annotate → write, resumable and parallel.
-//! - `stats` — `pedsynth stats`: statistics computed from the written tables.
-pub mod annotate;
-pub mod body;
-pub mod camera;
+//! ```text
+//! ClipScript ──simulate──▶ ClipTrace ──observe──▶ observations ──write──▶ files under --out
+//! ```
+//!
+//! - [`simulate`] — everything that moves: vehicles, the ego, pedestrians and their 12-state behaviour machine.
+//! - [`trace`] — what the simulation produces (per-frame agent states and events).
+//! - [`observe`] — pure functions of (script, trace, frame): sensor rig, bodies, annotations.
+//! - [`write`] — the only code that touches the output directory: layout, tables, manifest.
+//! - [`generate`] — orchestration of `pedsynth generate`: clips in parallel, resume, progress.
+//! - [`read`] — code that reads a written dataset (`pedsynth stats`).
 pub mod generate;
-pub mod sim;
-pub mod stats;
-pub mod tables;
+pub mod observe;
+pub mod read;
+pub mod simulate;
 pub mod trace;
+pub mod write;

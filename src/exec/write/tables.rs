@@ -19,9 +19,9 @@ use parquet::basic::{Compression as ParquetCompression, ZstdLevel};
 use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
-use super::annotate::ClipAnnotations;
-use super::trace::{ClipTrace, EGO_ID, Event};
 use crate::dsl::types::{Compression, Output};
+use crate::exec::observe::annotate::ClipAnnotations;
+use crate::exec::trace::{ClipTrace, EGO_ID, Event};
 use crate::planner::ClipScript;
 use crate::world::LaneType;
 
@@ -150,7 +150,7 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     let timestamps: Vec<i64> = (0..n as i64)
         .map(|f| f * ns_per_frame + f * rem / i64::from(trace.fps.max(1)))
         .collect();
-    let col = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef {
+    let col = |get: fn(&crate::exec::trace::VehicleFrame) -> f64| -> ArrayRef {
         Arc::new(Float64Array::from_iter_values(trace.ego.iter().map(get)))
     };
     batch(
@@ -231,7 +231,7 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             f32c(&|p| p.ttc_threshold_s),
             f32c(&|p| p.safety_margin_s),
             f32c(&|p| p.patience_s),
-            f32c(&|p| super::body::heights_m(p.body, script.seed, p.id).0),
+            f32c(&|p| crate::exec::observe::body::heights_m(p.body, script.seed, p.id).0),
             Arc::new(BooleanArray::from_iter((0..n).map(|i| Some(label(i).crosser)))),
             Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).first_crossing_frame))),
             Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).intention_frame))),
@@ -241,8 +241,8 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
 }
 
 fn fixed_list(
-    rows: &[super::annotate::AnnotationRow],
-    get: fn(&super::annotate::AnnotationRow) -> &[f32; 51],
+    rows: &[crate::exec::observe::annotate::AnnotationRow],
+    get: fn(&crate::exec::observe::annotate::AnnotationRow) -> &[f32; 51],
 ) -> ArrayRef {
     let mut builder =
         FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(rows.len() * 51), 51, rows.len())
@@ -258,7 +258,7 @@ fn fixed_list(
 pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
     let rows = &ann.rows;
     let n = rows.len();
-    let f32c = |get: fn(&super::annotate::AnnotationRow) -> f32| -> ArrayRef {
+    let f32c = |get: fn(&crate::exec::observe::annotate::AnnotationRow) -> f32| -> ArrayRef {
         Arc::new(Float32Array::from_iter_values(rows.iter().map(get)))
     };
     let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), 51);
@@ -326,7 +326,7 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
 
 /// The `vehicles` table: one row per traffic vehicle and frame (the ego is in `frames`).
 pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
-    let rows: Vec<(u32, u32, &super::trace::VehicleFrame)> = (0..trace.ego.len())
+    let rows: Vec<(u32, u32, &crate::exec::trace::VehicleFrame)> = (0..trace.ego.len())
         .flat_map(|f| {
             trace
                 .vehicles
@@ -336,7 +336,7 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         })
         .collect();
     let n = rows.len();
-    let f32c = |get: fn(&super::trace::VehicleFrame) -> f64| -> ArrayRef {
+    let f32c = |get: fn(&crate::exec::trace::VehicleFrame) -> f64| -> ArrayRef {
         Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32)))
     };
     let profile = |v: u32| {

@@ -11,10 +11,10 @@
 use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M};
-use super::camera::{Camera, CameraPose};
-use super::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
-use super::trace::{ClipTrace, Event, PedFrame, PedState};
+use super::rig::{Camera, CameraPose};
 use crate::dsl::types::Annotations;
+use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
+use crate::exec::trace::{ClipTrace, Event, PedFrame, PedState};
 use crate::planner::ClipScript;
 use crate::world::{LaneType, RoadNetwork};
 

@@ -10,8 +10,8 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3};
 
-use super::trace::PedFrame;
 use crate::dsl::types::Body;
+use crate::exec::trace::PedFrame;
 
 /// COCO-17 keypoint names, in COCO order.
 pub const COCO17: [&str; 17] = [

@@ -19,10 +19,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::annotate;
-use super::camera::Camera;
-use super::sim;
-use super::tables::{self, FileMeta, TABLES};
+use crate::exec::observe::annotate;
+use crate::exec::observe::rig::Camera;
+use crate::exec::simulate as sim;
+use crate::exec::write::tables::{self, FileMeta, TABLES};
 use crate::planner::{ClipScript, Plan, TownContext};
 
 /// Marker and version of the dataset format (`manifest.json`'s `pedsynth_dataset`).
