@@ -6,7 +6,7 @@
 use glam::DVec2;
 use pedsynth::dsl::types::{Body, Spec, WeatherParams};
 use pedsynth::exec::simulate::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
-use pedsynth::exec::trace::{ClipTrace, EGO_ID, Event, PedState};
+use pedsynth::exec::trace::{ClipTrace, Event, PedState, PedestrianId, VehicleId};
 use pedsynth::planner::{
     Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef, PedestrianScript,
     Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
@@ -218,7 +218,7 @@ fn assert_events_match_trace(trace: &ClipTrace) {
             to,
         } = e
         {
-            let p = &trace.pedestrians[*pedestrian as usize];
+            let p = &trace.pedestrians[pedestrian.index()];
             assert_eq!(p[*frame as usize].state, *to);
             assert_eq!(p[*frame as usize - 1].state, *from);
         }
@@ -407,17 +407,18 @@ fn the_lookahead_stops_a_crosser_before_a_vehicle_in_its_path() {
         s.contains(&PedState::PausingMidCross) || s.contains(&PedState::Retreat),
         "states: {s:?}"
     );
-    assert!(
-        trace
-            .events
-            .iter()
-            .any(|e| matches!(e, Event::Conflict { vehicle: 0, .. }))
-    );
+    assert!(trace.events.iter().any(|e| matches!(
+        e,
+        Event::Conflict {
+            vehicle: VehicleId::Traffic(0),
+            ..
+        }
+    )));
     assert!(matches!(
         trace.events[0],
         Event::CrossingDecision {
             frame: 0,
-            pedestrian: 0
+            pedestrian: PedestrianId(0)
         }
     ));
     assert_no_interpenetration(&trace);
@@ -586,7 +587,10 @@ fn non_crossers_stay_on_the_sidewalk_and_sudden_crossers_go_without_checking() {
         .events
         .iter()
         .find_map(|e| match e {
-            Event::CrossingDecision { frame, pedestrian: 1 } => Some(*frame as usize),
+            Event::CrossingDecision {
+                frame,
+                pedestrian: PedestrianId(1),
+            } => Some(*frame as usize),
             _ => None,
         })
         .expect("decision");
@@ -610,12 +614,13 @@ fn vehicles_follow_without_passing_through_each_other() {
         let gap = trace.vehicles[0][f].pos.x - trace.ego[f].pos.x - VEHICLE_LENGTH_M;
         assert!(gap > 1.0, "gap {gap} at frame {f}");
     }
-    assert!(
-        !trace
-            .events
-            .iter()
-            .any(|e| matches!(e, Event::Contact { vehicle: EGO_ID, .. }))
-    );
+    assert!(!trace.events.iter().any(|e| matches!(
+        e,
+        Event::Contact {
+            vehicle: VehicleId::Ego,
+            ..
+        }
+    )));
     // It ends up following at about the leader's speed.
     let last = trace.ego.last().expect("frames");
     assert!((last.speed_mps - trace.vehicles[0].last().expect("frames").speed_mps).abs() < 0.5);

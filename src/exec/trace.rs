@@ -125,8 +125,8 @@ pub enum Event {
     StateChange {
         /// Frame of the change.
         frame: u32,
-        /// Pedestrian id.
-        pedestrian: u32,
+        /// The pedestrian.
+        pedestrian: PedestrianId,
         /// Previous state.
         from: PedState,
         /// New state.
@@ -136,17 +136,17 @@ pub enum Event {
     CrossingDecision {
         /// Frame of the decision.
         frame: u32,
-        /// Pedestrian id.
-        pedestrian: u32,
+        /// The pedestrian.
+        pedestrian: PedestrianId,
     },
     /// An in-road conflict: a vehicle within the lookahead radius of a crossing pedestrian.
     Conflict {
         /// Frame.
         frame: u32,
-        /// Pedestrian id.
-        pedestrian: u32,
-        /// Vehicle id (`u32::MAX` for the ego).
-        vehicle: u32,
+        /// The pedestrian.
+        pedestrian: PedestrianId,
+        /// The vehicle.
+        vehicle: VehicleId,
         /// Whether the conflict happened in the retreat window (the first part of the crossing).
         in_retreat_window: bool,
         /// Whether the once-per-conflict retreat draw said retreat.
@@ -156,8 +156,8 @@ pub enum Event {
     PatienceExpired {
         /// Frame.
         frame: u32,
-        /// Pedestrian id.
-        pedestrian: u32,
+        /// The pedestrian.
+        pedestrian: PedestrianId,
         /// Whether it then crossed suddenly (otherwise it abandoned the attempt).
         sudden_crossing: bool,
     },
@@ -165,17 +165,48 @@ pub enum Event {
     Contact {
         /// Frame.
         frame: u32,
-        /// Vehicle id (`u32::MAX` for the ego).
-        vehicle: u32,
-        /// Pedestrian id, if a pedestrian was touched.
-        pedestrian: Option<u32>,
-        /// Other vehicle id, if a vehicle was touched.
-        other_vehicle: Option<u32>,
+        /// The vehicle.
+        vehicle: VehicleId,
+        /// The pedestrian, if a pedestrian was touched.
+        pedestrian: Option<PedestrianId>,
+        /// The other vehicle, if a vehicle was touched.
+        other_vehicle: Option<VehicleId>,
     },
 }
 
-/// Vehicle id used for the ego in events.
-pub const EGO_ID: u32 = u32::MAX;
+/// A vehicle of a clip: the ego, or traffic vehicle `n` of the clip script (`ClipScript::vehicles[n]`).
+///
+/// Ordered with the ego first, then traffic by number: the order of right of way when two vehicles tie.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VehicleId {
+    /// The ego vehicle (the one carrying the sensors).
+    Ego,
+    /// A traffic vehicle, by its id in the clip script.
+    Traffic(u32),
+}
+
+impl VehicleId {
+    /// The traffic vehicle's id, `None` for the ego (the tables' nullable `vehicle` column).
+    pub fn traffic(self) -> Option<u32> {
+        match self {
+            VehicleId::Ego => None,
+            VehicleId::Traffic(n) => Some(n),
+        }
+    }
+}
+
+/// A pedestrian of a clip, by its id in the clip script (`PedestrianScript::id`, also its index there).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct PedestrianId(pub u32);
+
+impl PedestrianId {
+    /// The pedestrian's index in the clip script and the trace.
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
 
 /// The trace of one simulated clip.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -516,7 +516,7 @@ const ROUTE_ATTEMPTS: usize = 8;
 /// their whole crossing would be too small in the image to be annotated.
 const MIDROAD_MAX_AHEAD_M: f64 = 30.0;
 /// How far from the curb a crosser starts, metres.
-const CURB_STANDOFF_M: f64 = 0.3;
+pub const CURB_STANDOFF_M: f64 = 0.3;
 /// Minimum distance between two pedestrians' spawn points, metres.
 const PED_SPACING_M: f64 = 1.0;
 /// Attempts to place one pedestrian before the clip is declared infeasible.

@@ -288,7 +288,7 @@ pub fn annotate(
     }
     for e in &trace.events {
         if let Event::CrossingDecision { frame, pedestrian } = e
-            && let Some(p) = out.pedestrians.get_mut(*pedestrian as usize)
+            && let Some(p) = out.pedestrians.get_mut(pedestrian.index())
             && p.intention_frame.is_none()
         {
             p.intention_frame = Some(*frame);

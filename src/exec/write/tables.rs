@@ -21,7 +21,7 @@ use parquet::file::properties::WriterProperties;
 
 use crate::dsl::types::{Compression, Output};
 use crate::exec::observe::annotate::ClipAnnotations;
-use crate::exec::trace::{ClipTrace, EGO_ID, Event};
+use crate::exec::trace::{ClipTrace, Event, PedestrianId, VehicleId};
 use crate::planner::ClipScript;
 use crate::world::LaneType;
 
@@ -379,7 +379,7 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     struct Row {
         frame: u32,
         kind: &'static str,
-        pedestrian: Option<u32>,
+        pedestrian: Option<PedestrianId>,
         vehicle: Option<u32>,
         from: Option<&'static str>,
         to: Option<&'static str>,
@@ -388,7 +388,6 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         sudden: Option<bool>,
         other: Option<u32>,
     }
-    let vehicle_id = |v: u32| if v == EGO_ID { None } else { Some(v) };
     let rows: Vec<Row> = trace
         .events
         .iter()
@@ -422,7 +421,7 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 frame,
                 kind: "conflict",
                 pedestrian: Some(pedestrian),
-                vehicle: vehicle_id(vehicle),
+                vehicle: vehicle.traffic(),
                 in_window: Some(in_retreat_window),
                 retreated: Some(retreated),
                 ..Row::default()
@@ -447,8 +446,8 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 frame,
                 kind: "contact",
                 pedestrian,
-                vehicle: vehicle_id(vehicle),
-                other: other_vehicle.and_then(vehicle_id),
+                vehicle: vehicle.traffic(),
+                other: other_vehicle.and_then(VehicleId::traffic),
                 ..Row::default()
             },
         })
@@ -473,17 +472,21 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             utf8(n, &script.clip_id),
             Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.frame))),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.kind))),
-            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.pedestrian))),
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.pedestrian.map(|p| p.0)))),
             Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.vehicle))),
             Arc::new(BooleanArray::from_iter(trace.events.iter().map(|e| {
                 Some(matches!(
                     e,
-                    Event::Conflict { vehicle: EGO_ID, .. }
-                        | Event::Contact { vehicle: EGO_ID, .. }
-                        | Event::Contact {
-                            other_vehicle: Some(EGO_ID),
-                            ..
-                        }
+                    Event::Conflict {
+                        vehicle: VehicleId::Ego,
+                        ..
+                    } | Event::Contact {
+                        vehicle: VehicleId::Ego,
+                        ..
+                    } | Event::Contact {
+                        other_vehicle: Some(VehicleId::Ego),
+                        ..
+                    }
                 ))
             }))),
             Arc::new(StringArray::from_iter(rows.iter().map(|r| r.from))),

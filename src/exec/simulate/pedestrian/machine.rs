@@ -1,0 +1,433 @@
+//! The behaviour machine: one transition per step for each pedestrian that decides for itself (a single or a
+//! group leader), as one explicit `match` on its [`Activity`]; group followers copy their leader's.
+//!
+//! Triggers follow the paper's table of states: a timer or the crossing trigger ends WALKING_SIDEWALK, the
+//! attention threshold drives LOOKING_AROUND, the TTC gap-acceptance rule ends CHECKING_TRAFFIC, hesitation
+//! ends at the archetype's hesitation time, the in-road lookahead pauses or (once per conflict, with the
+//! retreat probability, in the first part of the crossing) turns back a crosser, vehicle proximity makes it
+//! run, the patience cap makes a waiting crosser give up or cross suddenly, phone use comes at its planned time.
+
+use glam::DVec2;
+use rand::RngExt;
+
+use super::params::{
+    BASELINE_CLEAR_M, BLOCKED_RETREAT_S, CHECK_MIN_S, COMMIT_MIN_TTC_S, CONFLICT_CLEAR_S, CURB_STANDOFF_M,
+    DISTRACTION_PAUSE_S, FINISH_BEYOND_CURB_M, FINISHED_ARRIVAL_M, FINISHED_MAX_S, HESITATION_CUTOFF_M,
+    JAYWALK_MIN_TTC_S, RUN_TTC_FRACTION, RUSHED_GAP_FACTOR,
+};
+use super::state::{Activity, AfterPhone, Attempt, CrossMode, Distraction, PauseCause};
+use super::walker::SidewalkWalker;
+use super::{Ped, StepCtx, motion};
+use crate::exec::simulate::ttc;
+use crate::exec::trace::{Event, PedState, VehicleId};
+use crate::planner::{Behaviour, CrosserSource, SimParams, SpeedProfile};
+
+/// Enters `to`: a state change (event, timer reset) when its label differs from the current one.
+fn enter(p: &mut Ped, to: Activity, frame: u32, events: &mut Vec<Event>) {
+    let (from, label) = (p.state(), to.label());
+    if from != label {
+        events.push(Event::StateChange {
+            frame,
+            pedestrian: p.traits.id,
+            from,
+            to: label,
+        });
+        p.state_time_s = 0.0;
+    }
+    p.activity = to;
+}
+
+/// Takes the decision to cross (the intention onset), once.
+fn decide_to_cross(p: &mut Ped, frame: u32, events: &mut Vec<Event>) {
+    if p.attempt.decide() {
+        events.push(Event::CrossingDecision {
+            frame,
+            pedestrian: p.traits.id,
+        });
+    }
+}
+
+fn switch_profile(p: &mut Ped, params: &SimParams, to: SpeedProfile) {
+    if params.speed_profiles.switching {
+        p.profile = to;
+    }
+}
+
+/// Gives up the crossing attempt and walks off along the sidewalk, either way.
+fn abandon(p: &mut Ped, ctx: &StepCtx) {
+    p.attempt.end();
+    let dir = p.traits.line.map_or(DVec2::X, |l| l.dir.perp());
+    let side = if p.rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    p.walker = SidewalkWalker::start(ctx.net, p.body.pos, dir * side);
+}
+
+/// The gap-acceptance threshold of `p` for its crossing, seconds.
+fn gap_threshold_s(p: &Ped, params: &SimParams) -> f64 {
+    let width = p.traits.line.map_or(0.0, |l| l.width_m);
+    let speed = p.traits.base_speed_mps * p.multiplier(&params.speed_profiles.multipliers);
+    ttc::gap_threshold_s(p.traits.ttc_threshold_s, p.traits.safety_margin_s, width, speed)
+}
+
+/// Whether the ego's position allows an allocated crosser to commit: inside the decision window while
+/// approaching, or already past.
+fn ego_in_window_or_past(p: &Ped, params: &SimParams) -> bool {
+    let w = params.decision_window_m;
+    let d = p.percept.ego_dist_m;
+    !p.percept.ego_ahead || (d >= w.min() && d <= w.max())
+}
+
+/// Whether the ego approaches inside the decision window.
+fn ego_in_window(p: &Ped, params: &SimParams) -> bool {
+    let w = params.decision_window_m;
+    let d = p.percept.ego_dist_m;
+    p.percept.ego_ahead && d >= w.min() && d <= w.max()
+}
+
+/// Whether an allocated crosser may go now. The paper's crosser "commits to entering the road as soon as the
+/// ego-vehicle is within the 10–40 m decision window" (the ego then brakes for it): inside the window it only
+/// waits for another vehicle about to arrive (TTC below `COMMIT_MIN_TTC_S`); otherwise the full gap-acceptance
+/// rule min TTC > τ_ttc + Δ_safety + w_road / s_cross applies to every vehicle in range.
+fn gap_ok(p: &Ped, params: &SimParams) -> bool {
+    if ego_in_window(p, params) {
+        p.percept.min_ttc_others_s > COMMIT_MIN_TTC_S
+    } else {
+        ttc::gap_accepted(p.percept.min_ttc_s, gap_threshold_s(p, params))
+    }
+}
+
+/// Whether the ego has reached the decision window (or passed): the sudden crosser's trigger.
+fn ego_reached_window(p: &Ped, params: &SimParams) -> bool {
+    !p.percept.ego_ahead || p.percept.ego_dist_m <= params.decision_window_m.max()
+}
+
+/// Whether a baseline (CARLA-like) crosser sees the road clear: no vehicle within a few metres, none about to
+/// arrive (CARLA's stop-and-check).
+fn baseline_clear(p: &Ped) -> bool {
+    p.percept.nearest_vehicle_m > BASELINE_CLEAR_M && p.percept.min_ttc_s > JAYWALK_MIN_TTC_S
+}
+
+/// Whether a vehicle approaches a crosser on the road so fast that it runs.
+fn must_run(p: &Ped) -> bool {
+    p.percept.min_ttc_s < RUN_TTC_FRACTION * p.traits.ttc_threshold_s
+}
+
+/// The behaviour machine of a pedestrian that decides for itself (a single or a group leader). `group_ready`
+/// says whether every group member has reached its curb point; `group_conflict` is the lookahead conflict of
+/// the whole group (any member's), if any.
+pub(crate) fn transition(
+    p: &mut Ped,
+    ctx: &StepCtx,
+    group_ready: bool,
+    group_conflict: Option<VehicleId>,
+    events: &mut Vec<Event>,
+) {
+    let params = ctx.params;
+    let frame = ctx.next_frame;
+    let t = p.state_time_s;
+
+    // Distraction (phone use) starts at its planned time, whatever the pedestrian is doing. A crosser waiting
+    // for the ego's decision window does not pick up its phone before the attempt is over (it would miss the
+    // window); the phone comes out afterwards.
+    if let Distraction::At(at_s) = p.distraction
+        && ctx.time_s >= at_s
+        && (p.traits.source != CrosserSource::Allocated || p.attempt.over())
+    {
+        match p.activity {
+            Activity::WalkingSidewalk | Activity::LookingAround | Activity::CheckingTraffic | Activity::Hesitating => {
+                p.distraction = Distraction::Done;
+                let resume = if matches!(p.attempt, Attempt::Undecided { at_curb: true, .. }) {
+                    AfterPhone::LookingAround
+                } else {
+                    AfterPhone::WalkingSidewalk
+                };
+                switch_profile(p, params, SpeedProfile::Distracted);
+                enter(p, Activity::DistractedBehavior { resume }, frame, events);
+                return;
+            }
+            Activity::Crossing(mode) => {
+                p.distraction = Distraction::Done;
+                let pause = Activity::PausingMidCross {
+                    cause: PauseCause::Phone,
+                    resume: mode,
+                };
+                enter(p, pause, frame, events);
+                return;
+            }
+            _ => {}
+        }
+    }
+
+    // Patience cap while waiting at the curb.
+    if let Attempt::Undecided {
+        at_curb: true,
+        waited_s,
+    } = p.attempt
+        && waited_s >= p.traits.patience_s
+        && matches!(
+            p.activity,
+            Activity::LookingAround | Activity::CheckingTraffic | Activity::Hesitating
+        )
+    {
+        let sudden = p
+            .rng
+            .random_bool(params.patience.sudden_crossing_probability.clamp(0.0, 1.0));
+        events.push(Event::PatienceExpired {
+            frame,
+            pedestrian: p.traits.id,
+            sudden_crossing: sudden,
+        });
+        if sudden {
+            decide_to_cross(p, frame, events);
+            switch_profile(p, params, SpeedProfile::Rushed);
+            enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
+        } else {
+            abandon(p, ctx);
+            enter(p, Activity::WalkingSidewalk, frame, events);
+        }
+        return;
+    }
+
+    match p.activity {
+        Activity::WalkingSidewalk => {
+            if !p.attempt.over() {
+                if p.attempt.at_curb() && group_ready {
+                    if p.traits.behaviour == Behaviour::Sudden {
+                        if ego_reached_window(p, params) {
+                            decide_to_cross(p, frame, events);
+                            switch_profile(p, params, SpeedProfile::Rushed);
+                            enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
+                        }
+                    } else {
+                        enter(p, Activity::LookingAround, frame, events);
+                    }
+                }
+            } else if ctx.time_s >= p.next_scan_s {
+                p.next_scan_s = ctx.time_s + motion::scan_interval_s(&mut p.rng, p.traits.attention);
+                enter(p, Activity::LookingAround, frame, events);
+            }
+        }
+        Activity::LookingAround => {
+            let over = p.attempt.over();
+            // A jaywalker, or any crosser with the ego already inside the decision window, only glances.
+            let brief = p.traits.behaviour == Behaviour::Jaywalk || (!over && ego_in_window(p, params));
+            if t < motion::scan_duration_s(p.traits.attention, brief || over) {
+                return;
+            }
+            if over {
+                enter(p, Activity::WalkingSidewalk, frame, events);
+            } else if p.traits.behaviour == Behaviour::Jaywalk {
+                // Mid-block crossing after a brief check: only a vehicle about to arrive holds it back.
+                let ttc = if ego_in_window(p, params) {
+                    p.percept.min_ttc_others_s
+                } else {
+                    p.percept.min_ttc_s
+                };
+                if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S {
+                    decide_to_cross(p, frame, events);
+                    enter(p, Activity::Crossing(CrossMode::Jaywalking), frame, events);
+                }
+            } else {
+                enter(p, Activity::CheckingTraffic, frame, events);
+            }
+        }
+        Activity::CheckingTraffic => {
+            if t < CHECK_MIN_S {
+                return;
+            }
+            let baseline = p.traits.source == CrosserSource::Baseline;
+            let go = if baseline {
+                baseline_clear(p)
+            } else {
+                ego_in_window_or_past(p, params) && gap_ok(p, params)
+            };
+            if go {
+                let window_commit = !baseline && ego_in_window(p, params);
+                decide_to_cross(p, frame, events);
+                if let Attempt::Committed { window_commit: w, .. } = &mut p.attempt {
+                    *w = window_commit;
+                }
+                enter(p, Activity::Hesitating, frame, events);
+            }
+        }
+        Activity::Hesitating => {
+            let threshold = gap_threshold_s(p, params);
+            let window_commit = matches!(
+                p.attempt,
+                Attempt::Committed {
+                    window_commit: true,
+                    ..
+                }
+            );
+            let lost = if p.traits.source == CrosserSource::Baseline {
+                !baseline_clear(p)
+            } else if window_commit {
+                // Committed with the ego in the window: only another vehicle about to arrive holds it back.
+                p.percept.min_ttc_others_s <= COMMIT_MIN_TTC_S
+            } else {
+                !gap_ok(p, params)
+            };
+            // Committed inside the window, a crosser cuts its hesitation short rather than let the ego come so
+            // close that stepping out would be unsafe.
+            let ego_closing_in = window_commit
+                && p.percept.ego_ahead
+                && p.percept.ego_dist_m <= params.decision_window_m.min() + HESITATION_CUTOFF_M;
+            if lost {
+                enter(p, Activity::CheckingTraffic, frame, events);
+            } else if t >= p.traits.hesitation_s || ego_closing_in {
+                // Closing a tight gap: rushed.
+                if p.percept.min_ttc_s < RUSHED_GAP_FACTOR * threshold {
+                    switch_profile(p, params, SpeedProfile::Rushed);
+                }
+                enter(p, Activity::Crossing(CrossMode::CrossingRoad), frame, events);
+            }
+        }
+        Activity::Crossing(mode) => {
+            let Some(line) = p.traits.line else {
+                return;
+            };
+            let along = line.along_m(p.body.pos);
+            if along >= line.width_m + FINISH_BEYOND_CURB_M {
+                p.attempt.end();
+                enter(p, Activity::FinishedCrossing, frame, events);
+            } else if let Some(vehicle) = group_conflict {
+                // A new conflict (a crossing mode is never entered with one open): one retreat draw.
+                let in_window = along / line.width_m < params.retreat.window_fraction;
+                let retreated = in_window && p.rng.random_bool(params.retreat.probability.clamp(0.0, 1.0));
+                events.push(Event::Conflict {
+                    frame,
+                    pedestrian: p.traits.id,
+                    vehicle,
+                    in_retreat_window: in_window,
+                    retreated,
+                });
+                if retreated {
+                    enter(p, Activity::Retreat, frame, events);
+                } else {
+                    let pause = Activity::PausingMidCross {
+                        cause: PauseCause::Conflict { clear_s: 0.0 },
+                        resume: mode,
+                    };
+                    enter(p, pause, frame, events);
+                }
+            } else if along > 0.0 && mode != CrossMode::RunningAcross && must_run(p) {
+                // A vehicle is approaching while on the road: run.
+                switch_profile(p, params, SpeedProfile::Rushed);
+                enter(p, Activity::Crossing(CrossMode::RunningAcross), frame, events);
+            }
+        }
+        Activity::PausingMidCross {
+            cause: PauseCause::Phone,
+            resume,
+        } => {
+            if t >= DISTRACTION_PAUSE_S {
+                enter(p, Activity::Crossing(resume), frame, events);
+            }
+        }
+        Activity::PausingMidCross {
+            cause: PauseCause::Conflict { clear_s },
+            resume,
+        } => {
+            if group_conflict.is_some() {
+                p.activity = Activity::PausingMidCross {
+                    cause: PauseCause::Conflict { clear_s: 0.0 },
+                    resume,
+                };
+                if p.percept.blocked_by_standing && t >= BLOCKED_RETREAT_S {
+                    // Blocked by a vehicle that waits for us: step back to the curb and let it go.
+                    enter(p, Activity::Retreat, frame, events);
+                }
+            } else {
+                let clear_s = clear_s + ctx.dt_s;
+                p.activity = Activity::PausingMidCross {
+                    cause: PauseCause::Conflict { clear_s },
+                    resume,
+                };
+                if clear_s >= CONFLICT_CLEAR_S {
+                    let next = if must_run(p) { CrossMode::RunningAcross } else { resume };
+                    if next == CrossMode::RunningAcross {
+                        switch_profile(p, params, SpeedProfile::Rushed);
+                    }
+                    enter(p, Activity::Crossing(next), frame, events);
+                }
+            }
+        }
+        Activity::Retreat => {
+            let Some(line) = p.traits.line else {
+                return;
+            };
+            if line.along_m(p.body.pos) <= -CURB_STANDOFF_M + 1e-6 {
+                p.attempt.reach_curb();
+                switch_profile(p, params, p.traits.initial_profile);
+                enter(p, Activity::CheckingTraffic, frame, events);
+            }
+        }
+        Activity::FinishedCrossing => {
+            let Some(line) = p.traits.line else {
+                return;
+            };
+            if line.along_m(p.body.pos) >= line.end_along_m() - FINISHED_ARRIVAL_M || t > FINISHED_MAX_S {
+                switch_profile(p, params, p.traits.initial_profile);
+                let side = if p.rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                p.walker = SidewalkWalker::start(ctx.net, p.body.pos, line.dir.perp() * side);
+                enter(p, Activity::WalkingSidewalk, frame, events);
+            }
+        }
+        Activity::DistractedBehavior { resume } => {
+            if t >= p.traits.distraction_len_s {
+                if p.traits.initial_profile != SpeedProfile::Distracted {
+                    switch_profile(p, params, p.traits.initial_profile);
+                }
+                let to = match resume {
+                    AfterPhone::WalkingSidewalk => Activity::WalkingSidewalk,
+                    AfterPhone::LookingAround => Activity::LookingAround,
+                };
+                enter(p, to, frame, events);
+            }
+        }
+    }
+}
+
+/// What followers need of their leader.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LeaderFacts {
+    pub activity: Activity,
+    pub decided: bool,
+    pub attempt_over: bool,
+    pub profile: SpeedProfile,
+    /// Progress along the leader's crossing, as a fraction of its width.
+    pub fraction: f64,
+    pub walker_heading: DVec2,
+}
+
+impl LeaderFacts {
+    /// The facts of leader `p`, with its progress `fraction` along its crossing.
+    pub fn of(p: &Ped, fraction: f64) -> LeaderFacts {
+        LeaderFacts {
+            activity: p.activity,
+            decided: p.attempt.decided(),
+            attempt_over: p.attempt.over(),
+            profile: p.profile,
+            fraction,
+            walker_heading: DVec2::from_angle(p.body.yaw_rad),
+        }
+    }
+}
+
+/// A follower copies its leader's activity in the same frame (and its decision, phone use and speed profile).
+pub(crate) fn follow(p: &mut Ped, leader: &LeaderFacts, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let frame = ctx.next_frame;
+    if leader.decided && !p.attempt.decided() {
+        decide_to_cross(p, frame, events);
+    }
+    if leader.attempt_over && !p.attempt.over() {
+        p.attempt.end();
+    }
+    if p.attempt.over() && leader.activity == Activity::WalkingSidewalk && !p.walker.active {
+        p.walker = SidewalkWalker::start(ctx.net, p.body.pos, leader.walker_heading);
+    }
+    if leader.activity.label() == PedState::CheckingTraffic && p.activity == Activity::Retreat {
+        p.attempt.reach_curb();
+    }
+    p.profile = leader.profile;
+    enter(p, leader.activity, frame, events);
+}

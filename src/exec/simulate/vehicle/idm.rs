@@ -1,0 +1,166 @@
+//! Car following: the Intelligent Driver Model with vehicles **and** pedestrians in the path ahead as leaders,
+//! junction conflict zones, the end of the route, and the ego's braking rule for crossing pedestrians.
+
+use super::conflict_zones::{ConflictZone, zone_yield_gap_m};
+use super::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
+use crate::dsl::types::Idm;
+use crate::exec::simulate::{PED_RADIUS_M, VEHICLE_LENGTH_M};
+
+/// Lateral margin of the vehicle corridor beyond half the vehicle width, metres.
+const VEHICLE_CORRIDOR_MARGIN_M: f64 = 0.4;
+/// Lateral margin of the corridor for pedestrians, metres.
+const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
+
+/// IDM acceleration towards a leader `gap_m` ahead moving at `lead_speed_mps` (`None`: free road).
+pub(crate) fn idm_accel_mps2(
+    idm: &Idm,
+    speed_mps: f64,
+    target_speed_mps: f64,
+    min_gap_m: f64,
+    time_headway_s: f64,
+    leader: Option<(f64, f64)>,
+) -> f64 {
+    let a = idm.max_accel_mps2.max(0.01);
+    let b = idm.comfortable_decel_mps2.max(0.01);
+    let v0 = target_speed_mps.max(0.1);
+    let free = 1.0 - (speed_mps / v0).powf(idm.exponent);
+    let interaction = match leader {
+        Some((gap_m, lead_speed_mps)) => {
+            let dv = speed_mps - lead_speed_mps;
+            let s_star = min_gap_m + (speed_mps * time_headway_s + speed_mps * dv / (2.0 * (a * b).sqrt())).max(0.0);
+            let s = gap_m.max(0.05);
+            (s_star / s).powi(2)
+        }
+        None => 0.0,
+    };
+    (a * (free - interaction)).clamp(-idm.max_decel_mps2, a)
+}
+
+/// Look-ahead distance for leaders at speed `v`, metres.
+fn lookahead_m(v: f64, idm: &Idm) -> f64 {
+    (15.0 + 2.0 * v + v * v / (2.0 * idm.comfortable_decel_mps2.max(0.5))).clamp(25.0, 80.0)
+}
+
+/// The longitudinal acceleration of vehicle `i` this step: IDM towards the most constraining leader among the
+/// other vehicles, the pedestrians in its path (walkers are ignored by vehicles that ignore them until an
+/// emergency stop is needed), the ego's braking rule and the end of its route.
+pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], peds: &[PedView], idm: &Idm) -> f64 {
+    let me = &vehicles[i];
+    let v = me.speed_mps;
+    let look = lookahead_m(v, idm);
+    let fwd = me.pose.dir;
+    let target = me.target_speed_mps();
+    let idm_to =
+        |gap: f64, lead: f64| idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, Some((gap, lead)));
+    let mut accel = idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, None);
+
+    // End of route: a standing obstacle.
+    let end_gap = me.path.length_m() - me.s_m - HALF_LENGTH_M;
+    if end_gap < look {
+        accel = accel.min(idm_to(end_gap + me.min_gap_m, 0.0));
+    }
+
+    for (j, other) in vehicles.iter().enumerate() {
+        if j == i {
+            continue;
+        }
+        let d = other.pose.pos - me.pose.pos;
+        if d.length_squared() > (look + VEHICLE_LENGTH_M).powi(2) || d.dot(fwd) <= 0.0 {
+            continue;
+        }
+        let Some((gap, lead_speed)) = vehicle_in_path(me, other, look) else {
+            continue;
+        };
+        // Mutual intrusion (both in each other's path, e.g. at a junction): the lower id goes first, the ego
+        // before everyone -- unless the other is right in front (then both wait rather than touch).
+        if gap > 1.0 && vehicle_in_path(other, me, lookahead_m(other.speed_mps, idm)).is_some() && me.id < other.id {
+            continue;
+        }
+        accel = accel.min(idm_to(gap, lead_speed));
+    }
+
+    for zone in zones {
+        if let Some(gap) = zone_yield_gap_m(me, vehicles, zone, look) {
+            accel = accel.min(idm_to(gap, 0.0));
+        }
+    }
+
+    let emergency_gap = v * v / (2.0 * idm.max_decel_mps2.max(0.5)) + me.min_gap_m;
+    for p in peds {
+        let d = p.pos - me.pose.pos;
+        if d.length_squared() > (look + HALF_LENGTH_M).powi(2) || d.dot(fwd) <= 0.0 {
+            continue;
+        }
+        let mut corridor = HALF_WIDTH_M + PED_RADIUS_M + PED_CORRIDOR_MARGIN_M;
+        if p.crossing {
+            // A crosser walking towards the path counts a second early.
+            corridor += p.velocity.length();
+        }
+        // Farther from the path than this, the pedestrian matters neither as a leader nor to the ego's rule.
+        let reach = match me.ego_brake_m {
+            Some((_, side)) if p.crossing => corridor.max(side),
+            _ => corridor,
+        };
+        let Some((s_p, lateral, _)) = me.path.project(p.pos, me.s_m, me.s_m + look + HALF_LENGTH_M, reach) else {
+            continue;
+        };
+        if s_p <= me.s_m {
+            continue;
+        }
+        let gap = s_p - me.s_m - HALF_LENGTH_M - PED_RADIUS_M;
+        let in_path = lateral < corridor;
+        let ego_rule = me
+            .ego_brake_m
+            .is_some_and(|(ahead, side)| p.crossing && gap < ahead && lateral < side);
+        if (in_path && (!me.ignores_walkers || gap < emergency_gap)) || ego_rule {
+            accel = accel.min(idm_to(gap, 0.0));
+            // Never plan to run into a pedestrian: brake at least as hard as a stop before it needs.
+            if in_path && gap > 0.0 {
+                let need = v * v / (2.0 * (gap - 0.3).max(0.05));
+                if need > idm.comfortable_decel_mps2 {
+                    accel = accel.min(-need.min(idm.max_decel_mps2));
+                }
+            } else if in_path {
+                accel = -idm.max_decel_mps2;
+            }
+        }
+    }
+    accel
+}
+
+/// If `other`'s footprint intrudes on the corridor of `me`'s path ahead within `look` metres: the gap from
+/// `me`'s front bumper to it along the path and its speed along the path.
+fn vehicle_in_path(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64)> {
+    // The footprint's lateral extent is at most its half diagonal, so a centre farther than this is clear.
+    let reach = HALF_WIDTH_M + VEHICLE_CORRIDOR_MARGIN_M + HALF_LENGTH_M.hypot(HALF_WIDTH_M) + 1e-6;
+    let (s_o, lateral, path_heading) =
+        me.path
+            .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M, reach)?;
+    if s_o <= me.s_m {
+        return None;
+    }
+    let delta = other.pose.heading_rad - path_heading;
+    let (sd, cd) = (delta.sin().abs(), delta.cos().abs());
+    let extent_lat = HALF_LENGTH_M * sd + HALF_WIDTH_M * cd;
+    let extent_long = HALF_LENGTH_M * cd + HALF_WIDTH_M * sd;
+    if lateral - extent_lat >= HALF_WIDTH_M + VEHICLE_CORRIDOR_MARGIN_M {
+        return None;
+    }
+    let gap = s_o - me.s_m - HALF_LENGTH_M - extent_long;
+    Some((gap, (other.speed_mps * delta.cos()).max(0.0)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn idm_free_road_accelerates_to_target_and_stops_for_standing_leader() {
+        let idm = Idm::default();
+        assert!(idm_accel_mps2(&idm, 0.0, 10.0, 2.0, 1.5, None) > 1.4);
+        assert!(idm_accel_mps2(&idm, 10.0, 10.0, 2.0, 1.5, None).abs() < 1e-9);
+        assert!(idm_accel_mps2(&idm, 10.0, 10.0, 2.0, 1.5, Some((10.0, 0.0))) < -3.0);
+        // A leader far ahead at the same speed barely matters.
+        assert!(idm_accel_mps2(&idm, 10.0, 10.0, 2.0, 1.5, Some((200.0, 10.0))).abs() < 0.05);
+    }
+}
