@@ -36,7 +36,7 @@ fn spec(
 #[divan::bench(args = ["town01_like", "town03_like", "town05_like"], sample_count = 5)]
 fn plan_10k_clips(bencher: divan::Bencher, town: &str) {
     let (loaded, towns) = spec(&format!("dataset.towns=[{town}]"), 834);
-    let hash = loaded.hash();
+    let hash = loaded.hash().expect("hash");
     bencher.bench(|| {
         let plan = planner::plan(divan::black_box(&loaded.spec), &hash, "specs", &towns, None).expect("feasible");
         assert_eq!(plan.clips.len(), 10_008);

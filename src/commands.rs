@@ -1,12 +1,14 @@
-//! The command implementations behind the CLI: each takes parsed arguments and output streams and returns a
-//! process exit code (0 ok, 1 other failure, 2 invalid input).
+//! The command implementations behind the CLI: each takes parsed arguments and an output stream, writes its
+//! result there and returns `Ok(())` or an [`Error`]; [`finish`] renders an error and turns it into the process
+//! exit code (0 ok, 1 environment failure, 2 invalid input).
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use crate::dsl::types::TownRef;
 use crate::dsl::{self, LoadOptions, LoadedSpec, validate};
+use crate::error::{Error, code};
 use crate::planner::{self, Plan, TownContext};
 use crate::world::RoadNetwork;
 
@@ -14,48 +16,60 @@ use crate::world::RoadNetwork;
 pub mod exit {
     /// Success.
     pub const OK: i32 = 0;
-    /// A failure that is not the input's fault (I/O, internal).
+    /// A failure that is not the input's fault (I/O, disk, permissions, internal).
     pub const FAILURE: i32 = 1;
-    /// Invalid input: a spec, map or argument.
+    /// Invalid input: a spec, plan, map, argument or dataset.
     pub const INVALID: i32 = 2;
 }
 
 /// Width diagnostics are rendered at.
 pub const DIAGNOSTIC_WIDTH: usize = 100;
 
-/// `pedsynth validate SPEC...`: validates each spec, prints a summary line per valid one (or the fully
-/// defaulted spec with `resolved`), and every problem of the invalid ones to `err`.
-pub fn validate(
-    paths: &[PathBuf],
-    options: &LoadOptions,
-    resolved: bool,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> i32 {
-    let mut code = exit::OK;
+/// Renders `result`'s error (if any) to `err` and returns the process exit code.
+pub fn finish(result: Result<(), Error>, err: &mut dyn Write) -> i32 {
+    match result {
+        Ok(()) => exit::OK,
+        Err(e) => {
+            // Nothing more can be reported if stderr itself is closed; the exit code still tells.
+            if err.write_all(e.render().as_bytes()).is_err() {
+                return exit::FAILURE;
+            }
+            e.kind().exit_code()
+        }
+    }
+}
+
+/// Writes `text` to `out`.
+fn emit(out: &mut dyn Write, text: &str) -> Result<(), Error> {
+    out.write_all(text.as_bytes()).map_err(Error::output)
+}
+
+/// `pedsynth validate SPEC...`: validates each spec and prints a summary line per valid one (or the fully
+/// defaulted spec with `resolved`); every problem of the invalid ones is the error.
+pub fn validate(paths: &[PathBuf], options: &LoadOptions, resolved: bool, out: &mut dyn Write) -> Result<(), Error> {
+    let mut errors = Vec::new();
     for path in paths {
         match dsl::load_file(path, options) {
             Ok(loaded) => {
                 let text = if resolved {
-                    dsl::to_yaml(&loaded.spec)
+                    dsl::to_yaml(&loaded.spec)?
                 } else {
-                    format!("{}\n", summary_line(&loaded))
+                    format!("{}\n", summary_line(&loaded)?)
                 };
-                if out.write_all(text.as_bytes()).is_err() {
-                    return exit::FAILURE;
-                }
+                emit(out, &text)?;
             }
-            Err(errors) => {
-                let _ = err.write_all(errors.render_plain(DIAGNOSTIC_WIDTH).as_bytes());
-                code = exit::INVALID;
-            }
+            Err(e) => errors.push(Error::Spec(e)),
         }
     }
-    code
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(errors.remove(0)),
+        _ => Err(Error::Many(errors)),
+    }
 }
 
 /// One line describing a valid spec.
-pub fn summary_line(loaded: &LoadedSpec) -> String {
+pub fn summary_line(loaded: &LoadedSpec) -> Result<String, Error> {
     let spec = &loaded.spec;
     let d = &spec.dataset;
     let towns = d.towns.len();
@@ -68,7 +82,7 @@ pub fn summary_line(loaded: &LoadedSpec) -> String {
     .into_iter()
     .filter_map(|(n, on)| on.then_some(n))
     .collect();
-    format!(
+    Ok(format!(
         "{}: valid — dataset `{}`: {} clips ({} town{}, {} weather{}), {}–{} s at {} fps, {}–{} pedestrians/clip, target crossing ratio {:.2}, sensors: {}, spec hash {}",
         loaded.name,
         d.name,
@@ -88,16 +102,13 @@ pub fn summary_line(loaded: &LoadedSpec) -> String {
         } else {
             sensors.join("+")
         },
-        &loaded.hash()[..12],
-    )
+        &loaded.hash()?[..12],
+    ))
 }
 
 /// `pedsynth schema`: prints the spec's JSON Schema.
-pub fn schema(out: &mut dyn Write) -> i32 {
-    match out.write_all(dsl::schema::spec_schema_text().as_bytes()) {
-        Ok(()) => exit::OK,
-        Err(_) => exit::FAILURE,
-    }
+pub fn schema(out: &mut dyn Write) -> Result<(), Error> {
+    emit(out, &dsl::schema::spec_schema_text()?)
 }
 
 /// Renders any diagnostic without colour at the fixed width.
@@ -106,28 +117,31 @@ pub fn render_diagnostic(diagnostic: &dyn miette::Diagnostic) -> String {
         .with_width(DIAGNOSTIC_WIDTH)
         .with_links(false);
     let mut out = String::new();
-    let _ = handler.render_report(&mut out, diagnostic);
+    if handler.render_report(&mut out, diagnostic).is_err() {
+        // The handler failed half-way (it writes to a String, so only a formatting bug can do this): fall back
+        // to the plain message rather than lose the error.
+        out = format!("{diagnostic}\n");
+    }
     out
 }
 
 /// Loads every town a spec names (built-in towns are generated, OpenDRIVE maps read relative to the spec).
-pub fn load_towns(loaded: &LoadedSpec) -> Result<BTreeMap<String, TownContext>, String> {
+pub fn load_towns(loaded: &LoadedSpec) -> Result<BTreeMap<String, TownContext>, Error> {
     load_spec_towns(&loaded.spec, &loaded.base_dir)
 }
 
 /// Loads the towns of `spec`, resolving OpenDRIVE paths against `base_dir`.
-pub fn load_spec_towns(
-    spec: &crate::dsl::Spec,
-    base_dir: &std::path::Path,
-) -> Result<BTreeMap<String, TownContext>, String> {
+pub fn load_spec_towns(spec: &crate::dsl::Spec, base_dir: &Path) -> Result<BTreeMap<String, TownContext>, Error> {
     let mut towns = BTreeMap::new();
     for town in &spec.dataset.towns {
         let network = match town {
-            TownRef::Builtin(t) => RoadNetwork::builtin(t.name())
-                .ok_or_else(|| format!("built-in town `{}` is not available", t.name()))?,
+            TownRef::Builtin(t) => RoadNetwork::builtin(t.name()).ok_or_else(|| {
+                Error::World(crate::world::WorldError::UnknownTown {
+                    name: t.name().to_owned(),
+                })
+            })?,
             TownRef::OpenDrive(t) => {
-                let mut network =
-                    RoadNetwork::from_xodr_file(&base_dir.join(&t.opendrive)).map_err(|e| render_diagnostic(&e))?;
+                let mut network = RoadNetwork::from_xodr_file(&base_dir.join(&t.opendrive))?;
                 network.name = t.name.clone();
                 network
             }
@@ -148,119 +162,64 @@ pub struct PlanArgs {
     pub only: Option<String>,
 }
 
-/// Loads a spec and its towns and compiles the plan; problems are rendered to `err` and become the exit code.
-pub fn compile_plan(
-    spec_path: &std::path::Path,
-    options: &LoadOptions,
-    only: Option<&str>,
-    err: &mut dyn Write,
-) -> Result<(LoadedSpec, Plan), i32> {
-    let loaded = match dsl::load_file(spec_path, options) {
-        Ok(loaded) => loaded,
-        Err(errors) => {
-            let _ = err.write_all(errors.render_plain(DIAGNOSTIC_WIDTH).as_bytes());
-            return Err(exit::INVALID);
+/// Compiles the plan of a loaded spec and its towns (`only`: just that clip).
+fn compile(loaded: &LoadedSpec, towns: &BTreeMap<String, TownContext>, only: Option<&str>) -> Result<Plan, Error> {
+    let spec_dir = loaded.base_dir.display().to_string();
+    planner::plan(&loaded.spec, &loaded.hash()?, &spec_dir, towns, only).map_err(|problems| {
+        let unknown_clip = problems.len() == 1 && problems[0].reason == planner::NO_SUCH_CLIP;
+        if unknown_clip {
+            return Error::new(code::PLAN_UNKNOWN_CLIP, problems[0].to_string())
+                .help("`pedsynth plan SPEC --json` lists the clip ids");
         }
-    };
-    let towns = match load_towns(&loaded) {
-        Ok(towns) => towns,
-        Err(message) => {
-            let _ = writeln!(err, "{message}");
-            return Err(exit::INVALID);
-        }
-    };
-    match planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        only,
-    ) {
-        Ok(plan) => Ok((loaded, plan)),
-        Err(problems) => {
-            let _ = writeln!(
-                err,
-                "{}: the spec cannot be planned ({} problem{}):",
+        let list: Vec<String> = problems.iter().map(|p| format!("    {p}")).collect();
+        Error::new(
+            code::PLAN_INFEASIBLE,
+            format!(
+                "{}: the spec cannot be planned ({} problem{}):\n{}",
                 loaded.name,
                 problems.len(),
-                if problems.len() == 1 { "" } else { "s" }
-            );
-            for p in &problems {
-                let _ = writeln!(err, "  × pedsynth::plan::infeasible: {p}");
-            }
-            let _ = writeln!(
-                err,
-                "  help: widen the spawn distances, lower the pedestrian or vehicle counts, or use a larger town"
-            );
-            Err(exit::INVALID)
-        }
-    }
+                if problems.len() == 1 { "" } else { "s" },
+                list.join("\n")
+            ),
+        )
+        .help("widen the spawn distances, lower the pedestrian or vehicle counts, or use a larger town")
+    })
+}
+
+/// Loads a spec and its towns and compiles the plan.
+pub fn compile_plan(spec_path: &Path, options: &LoadOptions, only: Option<&str>) -> Result<(LoadedSpec, Plan), Error> {
+    let loaded = dsl::load_file(spec_path, options)?;
+    let towns = load_towns(&loaded)?;
+    let plan = compile(&loaded, &towns, only)?;
+    Ok((loaded, plan))
 }
 
 /// `pedsynth plan SPEC`: prints dry-run statistics, and writes the plan with `--emit`.
-pub fn plan(
-    spec_path: &std::path::Path,
-    options: &LoadOptions,
-    args: &PlanArgs,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> i32 {
-    let (loaded, plan) = match compile_plan(spec_path, options, args.only.as_deref(), err) {
-        Ok(x) => x,
-        Err(code) => return code,
-    };
+pub fn plan(spec_path: &Path, options: &LoadOptions, args: &PlanArgs, out: &mut dyn Write) -> Result<(), Error> {
+    let (loaded, plan) = compile_plan(spec_path, options, args.only.as_deref())?;
     if let Some(path) = &args.emit {
-        let mut json = serde_json::to_string_pretty(&plan).unwrap_or_default();
+        let mut json = crate::error::to_json(&plan, true)?;
         json.push('\n');
-        if let Err(e) = crate::fsutil::write_atomically(path, json.as_bytes()) {
-            let _ = writeln!(err, "cannot write plan to {}: {e}", path.display());
-            return exit::FAILURE;
-        }
+        crate::fsutil::write_atomically(path, json.as_bytes()).map_err(|e| Error::write(path, e))?;
     }
     let stats = planner::stats::compute(&plan, &loaded.spec);
     let text = if args.json {
-        let mut t = serde_json::to_string_pretty(&stats).unwrap_or_default();
-        t.push('\n');
-        t
+        crate::error::to_json(&stats, true)? + "\n"
     } else {
         planner::stats::render_text(&stats)
     };
-    match out.write_all(text.as_bytes()) {
-        Ok(()) => exit::OK,
-        Err(_) => exit::FAILURE,
-    }
+    emit(out, &text)
 }
 
 /// `pedsynth town list`.
-pub fn town_list(out: &mut dyn Write) -> i32 {
-    match out.write_all(crate::world::town_list_text().as_bytes()) {
-        Ok(()) => exit::OK,
-        Err(_) => exit::FAILURE,
-    }
+pub fn town_list(out: &mut dyn Write) -> Result<(), Error> {
+    emit(out, &crate::world::town_list_text())
 }
 
 /// `pedsynth town show NAME_OR_XODR [--png OUT] [--json]`.
-pub fn town_show(
-    town: &str,
-    png: Option<&std::path::Path>,
-    json: bool,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> i32 {
-    match crate::world::town_show(town, png, json) {
-        Ok(text) => match out.write_all(text.as_bytes()) {
-            Ok(()) => exit::OK,
-            Err(_) => exit::FAILURE,
-        },
-        Err(e) => {
-            let _ = err.write_all(render_diagnostic(&e).as_bytes());
-            if matches!(e, crate::world::WorldError::Io { .. }) {
-                exit::FAILURE
-            } else {
-                exit::INVALID
-            }
-        }
-    }
+pub fn town_show(town: &str, png: Option<&Path>, json: bool, out: &mut dyn Write) -> Result<(), Error> {
+    let text = crate::world::town_show(town, png, json)?;
+    emit(out, &text)
 }
 
 /// Options of `pedsynth generate`.
@@ -276,131 +235,90 @@ pub struct GenerateArgs {
     pub quiet: bool,
 }
 
+/// Reads a plan file (`pedsynth plan --emit`) and the towns it names (relative paths resolve against the
+/// directory the plan was made in, as recorded in the plan).
+pub fn read_plan(path: &Path) -> Result<(Plan, BTreeMap<String, TownContext>), Error> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let plan: Plan = serde_json::from_str(&text).map_err(|e| {
+        Error::new(
+            code::PLAN_INVALID,
+            format!("{}: not a pedsynth plan: {e}", path.display()),
+        )
+        .help("make a plan with `pedsynth plan SPEC --emit PLAN.json`")
+    })?;
+    if plan.format_version != planner::PLAN_FORMAT_VERSION {
+        return Err(Error::new(
+            code::PLAN_UNSUPPORTED_VERSION,
+            format!(
+                "{}: plan format {} is not supported (this pedsynth reads {})",
+                path.display(),
+                plan.format_version,
+                planner::PLAN_FORMAT_VERSION
+            ),
+        )
+        .help("re-plan the spec with this pedsynth"));
+    }
+    let towns = load_spec_towns(&plan.spec, Path::new(&plan.spec_dir))?;
+    Ok((plan, towns))
+}
+
 /// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.
-pub fn generate(
-    input: &std::path::Path,
-    options: &LoadOptions,
-    args: &GenerateArgs,
-    out: &mut dyn Write,
-    err: &mut dyn Write,
-) -> i32 {
+pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &mut dyn Write) -> Result<(), Error> {
     let is_plan = input.extension().is_some_and(|e| e == "json");
     let (plan, towns) = if is_plan {
         if !options.overrides.is_empty() {
-            let _ = writeln!(
-                err,
-                "--set applies to specs, not to a plan file: re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"
+            return Err(
+                Error::new(code::PLAN_OVERRIDE, "--set applies to specs, not to a plan file")
+                    .help("re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"),
             );
-            return exit::INVALID;
         }
-        let plan: Plan = match std::fs::read_to_string(input)
-            .map_err(|e| e.to_string())
-            .and_then(|t| serde_json::from_str(&t).map_err(|e| e.to_string()))
-        {
-            Ok(plan) => plan,
-            Err(e) => {
-                let _ = writeln!(err, "{}: not a pedsynth plan: {e}", input.display());
-                return exit::INVALID;
-            }
-        };
-        if plan.format_version != planner::PLAN_FORMAT_VERSION {
-            let _ = writeln!(
-                err,
-                "{}: plan format {} is not supported (this pedsynth reads {})",
-                input.display(),
-                plan.format_version,
-                planner::PLAN_FORMAT_VERSION
-            );
-            return exit::INVALID;
-        }
-        match load_spec_towns(&plan.spec, std::path::Path::new(&plan.spec_dir)) {
-            Ok(towns) => (plan, towns),
-            Err(message) => {
-                let _ = writeln!(err, "{message}");
-                return exit::INVALID;
-            }
-        }
+        read_plan(input)?
     } else {
-        let (loaded, plan) = match compile_plan(input, options, None, err) {
-            Ok(x) => x,
-            Err(code) => return code,
-        };
-        match load_towns(&loaded) {
-            Ok(towns) => (plan, towns),
-            Err(message) => {
-                let _ = writeln!(err, "{message}");
-                return exit::INVALID;
-            }
-        }
+        let loaded = dsl::load_file(input, options)?;
+        let towns = load_towns(&loaded)?;
+        (compile(&loaded, &towns, None)?, towns)
     };
     let gen_options = crate::exec::generate::GenerateOptions {
         out_dir: args.out.clone(),
         jobs: args.jobs,
         only: args.only.clone(),
+        quiet: args.quiet,
     };
-    match crate::exec::generate::generate(&plan, &towns, &gen_options, args.quiet) {
-        Ok(report) => {
-            let _ = writeln!(
-                out,
-                "{}: generated {} clip{} ({} already done): {} frames, {} pedestrian-frames, {} annotated samples\nnext: pedsynth stats {}",
-                args.out.display(),
-                report.generated,
-                if report.generated == 1 { "" } else { "s" },
-                report.skipped,
-                report.frames,
-                report.pedestrian_frames,
-                report.samples,
-                args.out.display()
-            );
-            exit::OK
-        }
-        Err(e @ crate::exec::generate::GenerateError::Refused(_)) => {
-            let _ = writeln!(err, "{e}");
-            exit::INVALID
-        }
-        Err(e) => {
-            let _ = writeln!(err, "{e}");
-            exit::FAILURE
-        }
-    }
+    let report = crate::exec::generate::generate(&plan, &towns, &gen_options)?;
+    emit(
+        out,
+        &format!(
+            "{}: generated {} clip{} ({} already done): {} frames, {} pedestrian-frames, {} annotated samples\nnext: pedsynth stats {}\n",
+            args.out.display(),
+            report.generated,
+            if report.generated == 1 { "" } else { "s" },
+            report.skipped,
+            report.frames,
+            report.pedestrian_frames,
+            report.samples,
+            args.out.display()
+        ),
+    )
 }
 
 /// `pedsynth stats DIR [--json]`: statistics computed from the written tables.
-pub fn stats(dir: &std::path::Path, json: bool, out: &mut dyn Write, err: &mut dyn Write) -> i32 {
-    match crate::exec::read::stats::compute(dir) {
-        Ok(stats) => {
-            let text = if json {
-                serde_json::to_string_pretty(&stats).unwrap_or_default() + "\n"
-            } else {
-                crate::exec::read::stats::render_text(&stats)
-            };
-            match out.write_all(text.as_bytes()) {
-                Ok(()) => exit::OK,
-                Err(_) => exit::FAILURE,
-            }
-        }
-        Err(e) => {
-            let _ = writeln!(err, "cannot read the dataset: {e}");
-            exit::INVALID
-        }
-    }
+pub fn stats(dir: &Path, json: bool, out: &mut dyn Write) -> Result<(), Error> {
+    let stats = crate::exec::read::stats::compute(dir)?;
+    let text = if json {
+        crate::error::to_json(&stats, true)? + "\n"
+    } else {
+        stats.to_string()
+    };
+    emit(out, &text)
 }
 
 /// Loads a spec file, its towns and its full plan: the programmatic path to a plan (tests, benchmarks, tools).
-/// Problems come back as rendered text.
 pub fn plan_spec_file(
-    path: &std::path::Path,
+    path: &Path,
     options: &LoadOptions,
-) -> Result<(LoadedSpec, BTreeMap<String, TownContext>, Plan), String> {
-    let loaded = dsl::load_file(path, options).map_err(|e| e.render_plain(DIAGNOSTIC_WIDTH))?;
+) -> Result<(LoadedSpec, BTreeMap<String, TownContext>, Plan), Error> {
+    let loaded = dsl::load_file(path, options)?;
     let towns = load_towns(&loaded)?;
-    let plan = planner::plan(
-        &loaded.spec,
-        &loaded.hash(),
-        &loaded.base_dir.display().to_string(),
-        &towns,
-        None,
-    )
-    .map_err(|problems| problems.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("\n"))?;
+    let plan = compile(&loaded, &towns, None)?;
     Ok((loaded, towns, plan))
 }

@@ -4,6 +4,7 @@
 pub mod calibration;
 pub mod commands;
 pub mod dsl;
+pub mod error;
 pub mod exec;
 pub mod fsutil;
 pub mod planner;

@@ -112,7 +112,9 @@ fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(err) => {
-            let _ = err.print();
+            // clap prints usage errors to stderr and --help/--version to stdout; if that fails, the exit code
+            // still tells.
+            err.print().ok();
             let code = if err.use_stderr() {
                 commands::exit::INVALID
             } else {
@@ -124,37 +126,28 @@ fn main() -> ExitCode {
     // Unlocked handles: worker threads print progress to stderr while a command runs.
     let mut out = std::io::stdout();
     let mut err = std::io::stderr();
-    let code = match cli.command {
+    let load_options = |spec_args: SpecArgs| LoadOptions {
+        overrides: spec_args.overrides,
+        allow_large: spec_args.allow_large,
+    };
+    let result = match cli.command {
         Command::Validate {
             specs,
             resolved,
             spec_args,
-        } => {
-            let options = LoadOptions {
-                overrides: spec_args.overrides,
-                allow_large: spec_args.allow_large,
-            };
-            commands::validate(&specs, &options, resolved, &mut out, &mut err)
-        }
+        } => commands::validate(&specs, &load_options(spec_args), resolved, &mut out),
         Command::Plan {
             spec,
             json,
             emit,
             only,
             spec_args,
-        } => {
-            let options = LoadOptions {
-                overrides: spec_args.overrides,
-                allow_large: spec_args.allow_large,
-            };
-            commands::plan(
-                &spec,
-                &options,
-                &commands::PlanArgs { json, emit, only },
-                &mut out,
-                &mut err,
-            )
-        }
+        } => commands::plan(
+            &spec,
+            &load_options(spec_args),
+            &commands::PlanArgs { json, emit, only },
+            &mut out,
+        ),
         Command::Generate {
             input,
             out: dir,
@@ -163,26 +156,23 @@ fn main() -> ExitCode {
             quiet,
             spec_args,
         } => {
-            let options = LoadOptions {
-                overrides: spec_args.overrides,
-                allow_large: spec_args.allow_large,
-            };
             let args = commands::GenerateArgs {
                 out: dir,
                 jobs,
                 only,
                 quiet,
             };
-            commands::generate(&input, &options, &args, &mut out, &mut err)
+            commands::generate(&input, &load_options(spec_args), &args, &mut out)
         }
-        Command::Stats { dir, json } => commands::stats(&dir, json, &mut out, &mut err),
+        Command::Stats { dir, json } => commands::stats(&dir, json, &mut out),
         Command::Schema => commands::schema(&mut out),
         Command::Town {
             command: TownCommand::List,
         } => commands::town_list(&mut out),
         Command::Town {
             command: TownCommand::Show { town, png, json },
-        } => commands::town_show(&town, png.as_deref(), json, &mut out, &mut err),
+        } => commands::town_show(&town, png.as_deref(), json, &mut out),
     };
+    let code = commands::finish(result, &mut err);
     ExitCode::from(code as u8)
 }

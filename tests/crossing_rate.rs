@@ -26,13 +26,13 @@ fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
         quiet: true,
     };
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let code = commands::generate(
+    let result = commands::generate(
         std::path::Path::new("specs/balanced_50.yaml"),
         &options,
         &args,
         &mut stdout,
-        &mut stderr,
     );
+    let code = commands::finish(result, &mut stderr);
     assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
     let stats = stats::compute(&out).expect("the tables read back");
     (out, stats)

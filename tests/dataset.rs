@@ -74,7 +74,7 @@ fn generate(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> (i32, 
         quiet: true,
     };
     let (mut o, mut e) = (Vec::new(), Vec::new());
-    let code = commands::generate(input, &options(overrides), &args, &mut o, &mut e);
+    let code = commands::finish(commands::generate(input, &options(overrides), &args, &mut o), &mut e);
     (
         code,
         String::from_utf8_lossy(&o).into_owned(),
@@ -670,9 +670,8 @@ fn lane_name(l: pedsynth::world::LaneType) -> String {
 
 /// Re-simulates every clip of the dataset and checks the boxes, the trace columns and the labels.
 fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str]) {
-    let mut err = Vec::new();
-    let (loaded, plan) = commands::compile_plan(spec_path, &options(overrides), None, &mut err)
-        .unwrap_or_else(|_| panic!("plan: {}", String::from_utf8_lossy(&err)));
+    let (loaded, plan) =
+        commands::compile_plan(spec_path, &options(overrides), None).unwrap_or_else(|e| panic!("plan: {}", e.render()));
     let towns = commands::load_towns(&loaded).expect("towns");
     let camera = Camera::from_spec(&plan.spec.sensors.rgb);
     let smoothing = plan.spec.annotations.crossing_label_smoothing_frames;
@@ -836,7 +835,7 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
     // A plan file generates the same dataset as its spec.
     let plan_path = tmp.join("plan.json");
     let (mut o, mut e) = (Vec::new(), Vec::new());
-    let code = commands::plan(
+    let result = commands::plan(
         &qs,
         &options(&overrides),
         &PlanArgs {
@@ -845,8 +844,8 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
             only: None,
         },
         &mut o,
-        &mut e,
     );
+    let code = commands::finish(result, &mut e);
     assert_eq!(code, 0, "{}", String::from_utf8_lossy(&e));
     let from_plan = tmp.join("from_plan");
     generate_ok(&plan_path, &[], &from_plan, 2);

@@ -191,7 +191,7 @@ fn carla_map_plan_has_exact_quotas_and_valid_spawns() {
     assert_valid_spawns(&towns, &plan);
     let again = planner::plan(
         &loaded.spec,
-        &loaded.hash(),
+        &loaded.hash().expect("hash"),
         &loaded.base_dir.display().to_string(),
         &towns,
         None,
@@ -225,7 +225,7 @@ fn adding_a_weather_leaves_existing_clips_identical_and_only_reproduces_a_clip()
     for clip in &more.clips {
         let only = planner::plan(
             &loaded.spec,
-            &loaded.hash(),
+            &loaded.hash().expect("hash"),
             &loaded.base_dir.display().to_string(),
             &towns,
             Some(&clip.clip_id),
@@ -240,7 +240,7 @@ fn adding_a_weather_leaves_existing_clips_identical_and_only_reproduces_a_clip()
     assert!(
         planner::plan(
             &loaded.spec,
-            &loaded.hash(),
+            &loaded.hash().expect("hash"),
             &loaded.base_dir.display().to_string(),
             &towns,
             Some("nope-clear_noon-0000")

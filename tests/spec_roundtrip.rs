@@ -23,10 +23,10 @@ fn load_text(text: &[u8], overrides: Vec<String>) -> Result<dsl::LoadedSpec, dsl
 }
 
 fn assert_round_trips(loaded: &dsl::LoadedSpec) {
-    let yaml = dsl::to_yaml(&loaded.spec);
+    let yaml = dsl::to_yaml(&loaded.spec).expect("yaml");
     let again = load_text(yaml.as_bytes(), Vec::new()).unwrap_or_else(|e| panic!("{}\n{yaml}", e.render_plain(100)));
     assert_eq!(again.spec, loaded.spec, "{yaml}");
-    assert_eq!(again.hash(), loaded.hash());
+    assert_eq!(again.hash().expect("hash"), loaded.hash().expect("hash"));
 }
 
 #[test]

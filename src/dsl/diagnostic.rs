@@ -8,7 +8,8 @@ use miette::{Diagnostic, GraphicalReportHandler, GraphicalTheme, LabeledSpan, Na
 
 use super::tree::Span;
 
-/// Stable diagnostic codes. Each is documented in README.md; tests pin them.
+/// Stable diagnostic codes of the spec language. Each is registered in [`crate::error::CODES`], from which
+/// README.md's table is generated; tests pin them.
 pub mod code {
     /// The YAML could not be parsed.
     pub const YAML_SYNTAX: &str = "pedsynth::spec::yaml_syntax";
@@ -48,6 +49,9 @@ pub mod code {
     pub const MISSING_FILE: &str = "pedsynth::spec::missing_file";
     /// A malformed `--set` override.
     pub const BAD_OVERRIDE: &str = "pedsynth::spec::bad_override";
+    /// A key whose feature this pedsynth version does not implement yet (accepted by the schema so that specs
+    /// written for a later version get a clear message rather than "unknown key").
+    pub const NOT_IMPLEMENTED: &str = "pedsynth::spec::not_implemented";
     /// The spec file cannot be read.
     pub const IO: &str = "pedsynth::spec::io";
 }

@@ -32,7 +32,7 @@ pub struct LoadedSpec {
 
 impl LoadedSpec {
     /// blake3 of the canonical JSON of the resolved spec: identifies the spec's content.
-    pub fn hash(&self) -> String {
+    pub fn hash(&self) -> Result<String, crate::error::Error> {
         spec_hash(&self.spec)
     }
 
@@ -43,9 +43,9 @@ impl LoadedSpec {
 }
 
 /// blake3 of the canonical JSON of a spec.
-pub fn spec_hash(spec: &Spec) -> String {
-    let json = serde_json::to_string(spec).unwrap_or_default();
-    blake3::hash(json.as_bytes()).to_hex().to_string()
+pub fn spec_hash(spec: &Spec) -> Result<String, crate::error::Error> {
+    let json = crate::error::to_json(spec, false)?;
+    Ok(blake3::hash(json.as_bytes()).to_hex().to_string())
 }
 
 /// Loads and validates the spec file at `path`.
@@ -169,8 +169,13 @@ pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptio
 }
 
 /// Serialises a spec as YAML (the fully defaulted form when given a loaded spec).
-pub fn to_yaml(spec: &Spec) -> String {
-    serde_saphyr::to_string(spec).unwrap_or_default()
+pub fn to_yaml(spec: &Spec) -> Result<String, crate::error::Error> {
+    serde_saphyr::to_string(spec).map_err(|e| {
+        crate::error::Error::new(
+            crate::error::code::INTERNAL_SERIALIZE,
+            format!("cannot serialise the spec as YAML: {e}"),
+        )
+    })
 }
 
 /// Deep-merges `user` onto `base`. Mappings merge key by key, except mixes (a key `mix` or `*_mix`), which,

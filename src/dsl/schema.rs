@@ -12,8 +12,8 @@ pub fn spec_schema() -> serde_json::Value {
 }
 
 /// The spec's JSON Schema as pretty-printed text with a trailing newline (the committed file's content).
-pub fn spec_schema_text() -> String {
-    let mut text = serde_json::to_string_pretty(&spec_schema()).unwrap_or_default();
+pub fn spec_schema_text() -> Result<String, crate::error::Error> {
+    let mut text = crate::error::to_json(&spec_schema(), true)?;
     text.push('\n');
-    text
+    Ok(text)
 }

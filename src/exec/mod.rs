@@ -1,7 +1,7 @@
 //! The executor: turns each clip script of a plan into files of the dataset, in three stages per clip:
 //!
 //! ```text
-//! ClipScript ──simulate──▶ ClipTrace ──observe──▶ observations ──write──▶ files under --out
+//! ClipScript ──simulate──▶ ClipTrace ──observe──▶ Observations ──write──▶ files under --out
 //! ```
 //!
 //! - [`simulate`] — everything that moves: vehicles, the ego, pedestrians and their 12-state behaviour machine.
@@ -9,10 +9,43 @@
 //! - [`observe`] — pure functions of (script, trace, frame): sensor rig, bodies, annotations.
 //! - [`write`] — the only code that touches the output directory: layout, tables, manifest.
 //! - [`generate`] — orchestration of `pedsynth generate`: clips in parallel, resume, progress.
-//! - [`read`] — code that reads a written dataset (`pedsynth stats`).
+//! - [`read`] — code that reads a written dataset (`pedsynth stats`), never re-simulating.
+
 pub mod generate;
 pub mod observe;
 pub mod read;
 pub mod simulate;
 pub mod trace;
 pub mod write;
+
+use crate::error::Error;
+use crate::planner::{ClipScript, Plan, TownContext};
+
+/// What one clip produced, for the run's report.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ClipCounts {
+    /// Frames simulated.
+    pub frames: u64,
+    /// Pedestrian-frames simulated.
+    pub pedestrian_frames: u64,
+    /// Annotated samples written.
+    pub samples: u64,
+}
+
+/// Generates one clip: simulate, observe, write. Every file it writes is a pure function of (plan, clip).
+pub fn run_clip(
+    plan: &Plan,
+    script: &ClipScript,
+    town: &TownContext,
+    rig: &observe::rig::Rig,
+    out: &write::DatasetWriter,
+) -> Result<ClipCounts, Error> {
+    let trace = simulate::simulate(script, &plan.sim, &town.network);
+    let observations = observe::observe(script, &trace, &plan.spec, rig, &town.network);
+    out.write_clip(plan, script, &trace, &observations)?;
+    Ok(ClipCounts {
+        frames: u64::from(script.frame_count),
+        pedestrian_frames: u64::from(script.frame_count) * script.pedestrians.len() as u64,
+        samples: observations.annotations.rows.len() as u64,
+    })
+}

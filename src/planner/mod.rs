@@ -43,6 +43,9 @@ impl TownContext {
     }
 }
 
+/// The reason given when `--only` names a clip the spec does not have.
+pub const NO_SUCH_CLIP: &str = "no such clip in this spec";
+
 /// Why a clip could not be planned.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PlanProblem {
@@ -123,7 +126,7 @@ pub fn plan(
     {
         return Err(vec![PlanProblem {
             clip_id: id.to_owned(),
-            reason: "no such clip in this spec".to_owned(),
+            reason: NO_SUCH_CLIP.to_owned(),
         }]);
     }
     for stratum in &all {

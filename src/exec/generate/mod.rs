@@ -1,68 +1,21 @@
-//! `pedsynth generate`: plan → simulate → annotate → write, clips in parallel, resumable, atomic per file.
-//!
-//! Dataset layout:
-//! - `manifest.json` — what the dataset is (spec and plan hashes) and each clip's status and file hashes;
-//! - `spec.resolved.yaml` — the fully defaulted spec;
-//! - `tables/<table>/<clip_id>.parquet` — the annotation tables (see `tables`);
-//! - `sensors/<sensor>/<clip_id>/…` — sensor blobs (reserved: rendering arrives with the sensor issue).
-//!
-//! A clip is finished when all of its table files exist; `clips` is written last, so its presence marks
-//! completion. Re-running on a partly generated dataset of the same spec and plan skips finished clips, and
-//! the result is byte-identical to an uninterrupted run for any number of jobs.
+//! `pedsynth generate`: orchestration. Opens the output directory for the plan ([`DatasetWriter`]), runs the
+//! clips that are not finished yet in parallel (rayon; each clip is [`crate::exec::run_clip`]), shows progress,
+//! and writes the manifest. Re-running on a partly generated dataset of the same spec and plan skips finished
+//! clips, and the result is byte-identical to an uninterrupted run for any number of jobs.
+
+mod progress;
 
 use std::collections::BTreeMap;
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
-use std::time::Instant;
+use std::path::PathBuf;
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
-use crate::exec::observe::annotate;
-use crate::exec::observe::rig::Camera;
-use crate::exec::simulate as sim;
-use crate::exec::write::tables::{self, FileMeta, TABLES};
+use crate::error::{Error, code};
+use crate::exec::observe::rig::Rig;
+use crate::exec::write::DatasetWriter;
+use crate::exec::{ClipCounts, run_clip};
 use crate::planner::{ClipScript, Plan, TownContext};
-
-/// Marker and version of the dataset format (`manifest.json`'s `pedsynth_dataset`).
-pub const DATASET_FORMAT: u32 = 1;
-
-/// A clip's entry in the manifest.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ManifestClip {
-    /// Clip id.
-    pub clip_id: String,
-    /// `done` or `pending`.
-    pub status: String,
-    /// blake3 of each table file, by table.
-    pub files: BTreeMap<String, String>,
-}
-
-/// `manifest.json`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Manifest {
-    /// Dataset format version; its presence marks a pedsynth dataset.
-    pub pedsynth_dataset: u32,
-    /// pedsynth version that wrote the dataset.
-    pub pedsynth_version: String,
-    /// Table schema version.
-    pub schema_version: u32,
-    /// Dataset name.
-    pub dataset: String,
-    /// blake3 of the resolved spec.
-    pub spec_hash: String,
-    /// blake3 of the plan's canonical JSON.
-    pub plan_hash: String,
-    /// Target sequence-level crossing ratio.
-    pub target_crossing_ratio: f64,
-    /// The tables.
-    pub tables: Vec<String>,
-    /// Sensors and what was written for each.
-    pub sensors: BTreeMap<String, String>,
-    /// Every planned clip.
-    pub clips: Vec<ManifestClip>,
-}
+use progress::Progress;
 
 /// Options of `pedsynth generate`.
 #[derive(Clone, Debug, Default)]
@@ -73,17 +26,8 @@ pub struct GenerateOptions {
     pub jobs: Option<usize>,
     /// Generate only this clip.
     pub only: Option<String>,
-}
-
-/// Why generation stopped.
-#[derive(Debug, thiserror::Error)]
-pub enum GenerateError {
-    /// The output directory cannot be used (exit 2).
-    #[error("{0}")]
-    Refused(String),
-    /// An I/O or internal failure (exit 1).
-    #[error("{0}")]
-    Failed(String),
+    /// No progress output.
+    pub quiet: bool,
 }
 
 /// What a run did.
@@ -101,337 +45,78 @@ pub struct GenerateReport {
     pub samples: u64,
 }
 
-/// blake3 of a plan's canonical JSON, without `spec_dir`: where the spec file lies (and how its path was
-/// spelled) does not change the dataset, so the same spec run from another directory, or its
-/// `spec.resolved.yaml`, resumes the same dataset and writes the same manifest.
-pub fn plan_hash(plan: &Plan) -> String {
-    let mut plan = plan.clone();
-    plan.spec_dir = String::new();
-    blake3::hash(serde_json::to_string(&plan).unwrap_or_default().as_bytes())
-        .to_hex()
-        .to_string()
-}
-
-fn manifest_path(out: &Path) -> PathBuf {
-    out.join("manifest.json")
-}
-
-/// Checks that `out` is empty, missing, or a dataset of the same spec and plan; returns the existing manifest.
-fn check_out_dir(out: &Path, spec_hash: &str, plan_hash: &str) -> Result<Option<Manifest>, GenerateError> {
-    let entries = match std::fs::read_dir(out) {
-        Ok(entries) => entries.count(),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(GenerateError::Failed(format!("cannot read {}: {e}", out.display()))),
-    };
-    if entries == 0 {
-        return Ok(None);
-    }
-    let refuse = |why: String| GenerateError::Refused(format!("refusing to write into {}: {why}", out.display()));
-    let text = std::fs::read_to_string(manifest_path(out))
-        .map_err(|_| refuse("the directory is not empty and is not a pedsynth dataset (no manifest.json)".into()))?;
-    let manifest: Manifest =
-        serde_json::from_str(&text).map_err(|e| refuse(format!("manifest.json is not a pedsynth manifest ({e})")))?;
-    if manifest.spec_hash != spec_hash {
-        return Err(refuse(format!(
-            "it holds a dataset of another spec ({}…); use a new --out directory",
-            &manifest.spec_hash[..12.min(manifest.spec_hash.len())]
-        )));
-    }
-    if manifest.plan_hash != plan_hash {
-        return Err(refuse(
-            "it holds a dataset of another plan of this spec (another pedsynth version?); use a new --out directory"
-                .into(),
-        ));
-    }
-    Ok(Some(manifest))
-}
-
-/// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
-/// `fsutil::write_atomically`) or another `*.tmp` file.
-fn is_temporary(name: &str) -> bool {
-    let pid_suffix = name
-        .rsplit_once(".tmp-")
-        .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
-    (name.starts_with('.') && pid_suffix) || name.ends_with(".tmp")
-}
-
-/// Removes the temporary files an interrupted run left in the dataset's own directories (the root and
-/// `tables/<table>/`), so that a resumed dataset holds exactly the files of an uninterrupted run.
-fn remove_temporaries(out: &Path) -> Result<(), GenerateError> {
-    let dirs = std::iter::once(out.to_path_buf()).chain(TABLES.iter().map(|t| out.join("tables").join(t)));
-    for dir in dirs {
-        let Ok(entries) = std::fs::read_dir(&dir) else { continue };
-        for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if is_temporary(&name) && entry.file_type().is_ok_and(|t| t.is_file()) {
-                std::fs::remove_file(entry.path())
-                    .map_err(|e| GenerateError::Failed(format!("cannot remove {}: {e}", entry.path().display())))?;
-            }
-        }
-    }
-    Ok(())
-}
-
-fn clip_done(out: &Path, clip_id: &str) -> bool {
-    TABLES.iter().all(|t| tables::table_path(out, t, clip_id).is_file())
-}
-
-fn file_hashes(out: &Path, clip_id: &str) -> std::io::Result<BTreeMap<String, String>> {
-    TABLES
-        .iter()
-        .map(|t| {
-            Ok((
-                t.to_string(),
-                blake3::hash(&std::fs::read(tables::table_path(out, t, clip_id))?)
-                    .to_hex()
-                    .to_string(),
-            ))
-        })
-        .collect()
-}
-
-fn write_manifest(out: &Path, manifest: &Manifest) -> Result<(), GenerateError> {
-    let mut text = serde_json::to_string_pretty(manifest).unwrap_or_default();
-    text.push('\n');
-    crate::fsutil::write_atomically(&manifest_path(out), text.as_bytes())
-        .map_err(|e| GenerateError::Failed(format!("cannot write manifest.json: {e}")))
-}
-
-/// Simulates, annotates and writes one clip; returns its file hashes and counts.
-fn generate_clip(
-    plan: &Plan,
-    script: &ClipScript,
-    town: &TownContext,
-    camera: &Camera,
-    out: &Path,
-) -> std::io::Result<(BTreeMap<String, String>, u64, u64)> {
-    let trace = sim::simulate(script, &plan.sim, &town.network);
-    let ann = annotate::annotate(script, &trace, &plan.spec.annotations, camera, &town.network);
-    let meta = FileMeta {
-        spec_hash: plan.spec_hash.clone(),
-    };
-    let batches = [
-        ("frames", tables::frames_batch(script, &trace)),
-        ("pedestrians", tables::pedestrians_batch(script, &ann)),
-        ("annotations", tables::annotations_batch(script, &ann)),
-        ("vehicles", tables::vehicles_batch(script, &trace)),
-        ("events", tables::events_batch(script, &trace)),
-        ("clips", tables::clips_batch(script, &trace, &ann)),
-    ];
-    let mut hashes = BTreeMap::new();
-    for (table, batch) in &batches {
-        let hash = tables::write_parquet(
-            &tables::table_path(out, table, &script.clip_id),
-            batch,
-            &plan.spec.output,
-            &meta,
-            table,
-            &script.clip_id,
-        )?;
-        hashes.insert(table.to_string(), hash);
-    }
-    let ped_frames = u64::from(script.frame_count) * script.pedestrians.len() as u64;
-    Ok((hashes, ped_frames, ann.rows.len() as u64))
-}
-
-/// Progress on stderr: a bar on a terminal, plain lines otherwise.
-struct Progress {
-    bar: Option<indicatif::ProgressBar>,
-    total: usize,
-    done: AtomicUsize,
-    frames: AtomicU64,
-    started: Instant,
-    /// Print a line every this many clips (plain output); None when quiet.
-    every: Option<usize>,
-}
-
-impl Progress {
-    fn new(total: usize, quiet: bool) -> Self {
-        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-            let bar = indicatif::ProgressBar::new(total as u64);
-            bar.set_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} clips  {msg}  ETA {eta}")
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            bar
-        });
-        Progress {
-            bar,
-            total,
-            done: AtomicUsize::new(0),
-            frames: AtomicU64::new(0),
-            started: Instant::now(),
-            every: (!quiet).then_some((total / 20).max(1)),
-        }
-    }
-
-    fn clip_done(&self, clip_id: &str, frames: u64) {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        let frames = self.frames.fetch_add(frames, Ordering::Relaxed) + frames;
-        let secs = self.started.elapsed().as_secs_f64().max(1e-6);
-        let rate = frames as f64 / secs;
-        match &self.bar {
-            Some(bar) => {
-                bar.set_message(format!("{rate:.0} frames/s"));
-                bar.inc(1);
-            }
-            None if self
-                .every
-                .is_some_and(|every| done.is_multiple_of(every) || done == self.total) =>
-            {
-                let eta = secs / done as f64 * (self.total - done) as f64;
-                eprintln!(
-                    "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
-                    self.total
-                );
-            }
-            None => {}
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_and_clear();
-        }
-    }
-}
-
 /// Generates the dataset of `plan` into `options.out_dir`.
 pub fn generate(
     plan: &Plan,
     towns: &BTreeMap<String, TownContext>,
     options: &GenerateOptions,
-    quiet: bool,
-) -> Result<GenerateReport, GenerateError> {
-    let out = &options.out_dir;
-    let hash = plan_hash(plan);
-    let existing = check_out_dir(out, &plan.spec_hash, &hash)?;
+) -> Result<GenerateReport, Error> {
     if let Some(id) = &options.only
         && !plan.clips.iter().any(|c| &c.clip_id == id)
     {
-        return Err(GenerateError::Refused(format!("no clip `{id}` in this plan")));
+        return Err(
+            Error::new(code::PLAN_UNKNOWN_CLIP, format!("no clip `{id}` in this plan"))
+                .help("`pedsynth plan SPEC --json` lists the clip ids"),
+        );
     }
-    std::fs::create_dir_all(out).map_err(|e| GenerateError::Failed(format!("cannot create {}: {e}", out.display())))?;
-    let spec_yaml = crate::dsl::to_yaml(&plan.spec);
-    crate::fsutil::write_atomically(&out.join("spec.resolved.yaml"), spec_yaml.as_bytes())
-        .map_err(|e| GenerateError::Failed(format!("cannot write spec.resolved.yaml: {e}")))?;
-    let s = &plan.spec.sensors;
-    let sensors: BTreeMap<String, String> = [
-        ("rgb", s.rgb.enabled),
-        ("lidar", s.lidar.enabled),
-        ("dvs", s.dvs.enabled),
-    ]
-    .into_iter()
-    .map(|(name, on)| {
-        (
-            name.to_owned(),
-            if on {
-                "enabled in the spec; not rendered by this pedsynth version (annotations only)".to_owned()
-            } else {
-                "disabled".to_owned()
-            },
-        )
-    })
-    .collect();
-    let mut manifest = Manifest {
-        pedsynth_dataset: DATASET_FORMAT,
-        pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
-        schema_version: tables::SCHEMA_VERSION,
-        dataset: plan.dataset.clone(),
-        spec_hash: plan.spec_hash.clone(),
-        plan_hash: hash,
-        target_crossing_ratio: plan.target_crossing_ratio,
-        tables: TABLES.iter().map(|t| t.to_string()).collect(),
-        sensors,
-        clips: plan
-            .clips
-            .iter()
-            .map(|c| ManifestClip {
-                clip_id: c.clip_id.clone(),
-                status: "pending".into(),
-                files: BTreeMap::new(),
-            })
-            .collect(),
-    };
-    if existing.is_none() {
-        write_manifest(out, &manifest)?;
-    } else {
-        remove_temporaries(out)?;
+    for clip in &plan.clips {
+        if !towns.contains_key(&clip.town) {
+            return Err(Error::new(
+                code::PLAN_INVALID,
+                format!(
+                    "clip {} names town `{}`, which the plan's spec does not load",
+                    clip.clip_id, clip.town
+                ),
+            ));
+        }
     }
-
-    let todo: Vec<&ClipScript> = plan
+    let writer = DatasetWriter::open(&options.out_dir, plan)?;
+    let selected: Vec<&ClipScript> = plan
         .clips
         .iter()
         .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
-        .filter(|c| !clip_done(out, &c.clip_id))
         .collect();
-    let selected = plan
-        .clips
+    let todo: Vec<&ClipScript> = selected
         .iter()
-        .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
-        .count();
-    let camera = Camera::from_spec(&plan.spec.sensors.rgb);
-    let progress = Progress::new(todo.len(), quiet);
+        .copied()
+        .filter(|c| !writer.is_clip_done(&c.clip_id))
+        .collect();
+    let rig = Rig::from_spec(&plan.spec.sensors);
+    let progress = Progress::new(todo.len(), options.quiet);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs.unwrap_or(0))
         .build()
-        .map_err(|e| GenerateError::Failed(format!("cannot start workers: {e}")))?;
-    let results: Vec<Result<(u64, u64, u64), String>> = pool.install(|| {
+        .map_err(|e| Error::new(code::IO_THREADS, format!("cannot start worker threads: {e}")))?;
+    let results: Vec<Result<ClipCounts, Error>> = pool.install(|| {
         todo.par_iter()
             .map(|script| {
-                let town = towns
-                    .get(&script.town)
-                    .ok_or_else(|| format!("town `{}` is not loaded", script.town))?;
-                let (_, ped_frames, samples) = generate_clip(plan, script, town, &camera, out)
-                    .map_err(|e| format!("clip {}: {e}", script.clip_id))?;
-                progress.clip_done(&script.clip_id, u64::from(script.frame_count));
-                Ok((u64::from(script.frame_count), ped_frames, samples))
+                let counts = run_clip(plan, script, &towns[&script.town], &rig, &writer)?;
+                progress.clip_done(&script.clip_id, counts.frames);
+                Ok(counts)
             })
             .collect()
     });
     progress.finish();
     let mut report = GenerateReport {
-        skipped: selected - todo.len(),
+        skipped: selected.len() - todo.len(),
         ..GenerateReport::default()
     };
     let mut failures = Vec::new();
     for r in results {
         match r {
-            Ok((frames, ped_frames, samples)) => {
+            Ok(c) => {
                 report.generated += 1;
-                report.frames += frames;
-                report.pedestrian_frames += ped_frames;
-                report.samples += samples;
+                report.frames += c.frames;
+                report.pedestrian_frames += c.pedestrian_frames;
+                report.samples += c.samples;
             }
             Err(e) => failures.push(e),
         }
     }
-    for clip in &mut manifest.clips {
-        if clip_done(out, &clip.clip_id) {
-            clip.status = "done".into();
-            clip.files = file_hashes(out, &clip.clip_id)
-                .map_err(|e| GenerateError::Failed(format!("cannot hash clip {}: {e}", clip.clip_id)))?;
-        }
-    }
-    write_manifest(out, &manifest)?;
-    if !failures.is_empty() {
-        return Err(GenerateError::Failed(failures.join("\n")));
-    }
-    Ok(report)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn temporaries_are_recognised_and_tables_are_not() {
-        assert!(is_temporary(".town01_like-clear_noon-0001.parquet.tmp-4242"));
-        assert!(is_temporary(".manifest.json.tmp-1"));
-        assert!(is_temporary("leftover.tmp"));
-        assert!(!is_temporary("town01_like-clear_noon-0001.parquet"));
-        assert!(!is_temporary("manifest.json"));
-        assert!(!is_temporary(".x.tmp-"));
-        assert!(!is_temporary(".x.tmp-12a"));
+    writer.finish()?;
+    match failures.len() {
+        0 => Ok(report),
+        1 => Err(failures.remove(0)),
+        _ => Err(Error::Many(failures)),
     }
 }

@@ -1,4 +1,4 @@
-//! Pinhole camera on the ego vehicle: mount, intrinsics and projection.
+//! The ego's sensor rig: the pinhole camera (mount, intrinsics, projection) from the spec.
 //!
 //! Frames: *world* (right-handed, x east, y north, z up), *vehicle* (x forward, y left, z up; origin on the
 //! ground under the vehicle's centre), *sensor* (the vehicle frame moved and turned by the mount) and
@@ -7,7 +7,23 @@
 
 use glam::{DAffine3, DMat3, DVec2, DVec3};
 
-use crate::dsl::types::{Mount, Rgb};
+use crate::dsl::types::{Mount, Rgb, Sensors};
+
+/// The sensors on the ego vehicle, placed and configured from the spec.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rig {
+    /// The RGB camera (the annotations' camera: boxes and keypoints are in its image).
+    pub camera: Camera,
+}
+
+impl Rig {
+    /// The rig of a spec's sensors.
+    pub fn from_spec(sensors: &Sensors) -> Rig {
+        Rig {
+            camera: Camera::from_spec(&sensors.rgb),
+        }
+    }
+}
 
 /// Intrinsics and mount of a pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -2,7 +2,6 @@
 //! target vs achieved crossing ratio, state shares, per-archetype crossing rates and speeds, per-split counts).
 
 use std::collections::BTreeMap;
-use std::fmt::Write;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
@@ -11,6 +10,9 @@ use arrow_array::types::{Float32Type, UInt32Type, UInt64Type};
 use arrow_array::{Array, RecordBatch};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde::Serialize;
+
+use crate::error::{Error, code};
+use crate::exec::write::Layout;
 
 /// Counts of one split.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -91,9 +93,10 @@ pub struct DatasetStats {
     pub contacts: u64,
 }
 
-fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, String> {
-    let file = File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| format!("{}: {e}", path.display()))?;
+fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, Error> {
+    let invalid = |e: &dyn std::fmt::Display| Error::new(code::DATASET_INVALID, format!("{}: {e}", path.display()));
+    let file = File::open(path).map_err(|e| Error::read(path, e))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| invalid(&e))?;
     let schema = builder.parquet_schema();
     let indices: Vec<usize> = columns
         .iter()
@@ -102,23 +105,23 @@ fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, String>
                 .columns()
                 .iter()
                 .position(|col| col.path().parts()[0] == *c)
-                .ok_or_else(|| format!("{}: no column `{c}`", path.display()))
+                .ok_or_else(|| invalid(&format!("no column `{c}`")))
         })
         .collect::<Result<_, _>>()?;
     let mask = parquet::arrow::ProjectionMask::roots(schema, indices);
-    let reader = builder
-        .with_projection(mask)
-        .build()
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    reader
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("{}: {e}", path.display()))
+    let reader = builder.with_projection(mask).build().map_err(|e| invalid(&e))?;
+    reader.collect::<Result<Vec<_>, _>>().map_err(|e| invalid(&e))
 }
 
-fn files(dir: &Path, table: &str) -> Result<Vec<PathBuf>, String> {
-    let d = dir.join("tables").join(table);
+fn files(layout: &Layout, table: &str) -> Result<Vec<PathBuf>, Error> {
+    let d = layout.table_dir(table);
     let mut out: Vec<PathBuf> = std::fs::read_dir(&d)
-        .map_err(|e| format!("{}: {e} (is this a pedsynth dataset?)", d.display()))?
+        .map_err(|e| {
+            Error::new(
+                code::DATASET_INVALID,
+                format!("{}: {e} (is this a pedsynth dataset?)", d.display()),
+            )
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
         .collect();
@@ -134,9 +137,10 @@ fn col<'a>(batch: &'a RecordBatch, name: &str) -> &'a dyn Array {
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
-pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
+pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
+    let layout = Layout::new(dir);
     let mut s = DatasetStats::default();
-    let manifest: Option<serde_json::Value> = std::fs::read_to_string(dir.join("manifest.json"))
+    let manifest: Option<serde_json::Value> = std::fs::read_to_string(layout.manifest())
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok());
     s.target_crossing_ratio = manifest.as_ref().and_then(|m| m["target_crossing_ratio"].as_f64());
@@ -145,7 +149,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
     let mut duration_s = 0.0;
     let mut states: BTreeMap<String, u64> = BTreeMap::new();
     let mut speed_sums: BTreeMap<String, (f64, u64)> = BTreeMap::new();
-    for path in files(dir, "clips")? {
+    for path in files(&layout, "clips")? {
         let mut split = String::new();
         for b in read_table(
             &path,
@@ -197,7 +201,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
         // Pedestrians of this clip: sequence labels and archetypes.
         let mut archetype_of: Vec<String> = Vec::new();
         for b in read_table(
-            &dir.join("tables/pedestrians").join(format!("{clip_id}.parquet")),
+            &layout.table("pedestrians", &clip_id),
             &["pedestrian", "archetype", "crosser"],
         )? {
             for i in 0..b.num_rows() {
@@ -219,7 +223,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
             }
         }
         for b in read_table(
-            &dir.join("tables/annotations").join(format!("{clip_id}.parquet")),
+            &layout.table("annotations", &clip_id),
             &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"],
         )? {
             let ped = col(&b, "pedestrian").as_primitive::<UInt32Type>();
@@ -264,86 +268,88 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, String> {
     Ok(s)
 }
 
-/// Renders the statistics as text (the paper's Table 5 first).
-pub fn render_text(s: &DatasetStats) -> String {
-    let mut o = String::new();
-    let _ = writeln!(o, "Dataset statistics (from the tables)");
-    let _ = writeln!(o, "  clips                      {}", s.clips);
-    let _ = writeln!(o, "  frames                     {}", s.frames);
-    let _ = writeln!(o, "  avg frames per clip        {:.1}", s.mean_frames_per_clip);
-    let _ = writeln!(o, "  avg clip duration          {:.1} s", s.mean_duration_s);
-    let _ = writeln!(o, "  unique pedestrians         {}", s.pedestrians);
-    let _ = writeln!(
-        o,
-        "    crossing (C)             {} ({:.1}%)",
-        s.crossing,
-        100.0 * s.crossing_share
-    );
-    let _ = writeln!(
-        o,
-        "    non-crossing (NC)        {} ({:.1}%)",
-        s.non_crossing,
-        100.0 * s.non_crossing_share
-    );
-    let _ = writeln!(o, "  C/NC ratio                 {:.2}:1", s.c_nc_ratio);
-    let _ = writeln!(o, "  annotated samples          {}", s.annotated_samples);
-    let _ = writeln!(o, "  avg samples per clip       {:.0}", s.samples_per_clip);
-    let _ = writeln!(
-        o,
-        "  weathers                   {} ({})",
-        s.weathers.len(),
-        s.weathers.join(", ")
-    );
-    let _ = writeln!(
-        o,
-        "  towns                      {} ({})",
-        s.towns.len(),
-        s.towns.join(", ")
-    );
-    match s.target_crossing_ratio {
-        Some(t) => {
-            let _ = writeln!(
+/// The statistics as text (the paper's Table 5 first).
+impl std::fmt::Display for DatasetStats {
+    fn fmt(&self, o: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = self;
+        writeln!(o, "Dataset statistics (from the tables)")?;
+        writeln!(o, "  clips                      {}", s.clips)?;
+        writeln!(o, "  frames                     {}", s.frames)?;
+        writeln!(o, "  avg frames per clip        {:.1}", s.mean_frames_per_clip)?;
+        writeln!(o, "  avg clip duration          {:.1} s", s.mean_duration_s)?;
+        writeln!(o, "  unique pedestrians         {}", s.pedestrians)?;
+        writeln!(
+            o,
+            "    crossing (C)             {} ({:.1}%)",
+            s.crossing,
+            100.0 * s.crossing_share
+        )?;
+        writeln!(
+            o,
+            "    non-crossing (NC)        {} ({:.1}%)",
+            s.non_crossing,
+            100.0 * s.non_crossing_share
+        )?;
+        writeln!(o, "  C/NC ratio                 {:.2}:1", s.c_nc_ratio)?;
+        writeln!(o, "  annotated samples          {}", s.annotated_samples)?;
+        writeln!(o, "  avg samples per clip       {:.0}", s.samples_per_clip)?;
+        writeln!(
+            o,
+            "  weathers                   {} ({})",
+            s.weathers.len(),
+            s.weathers.join(", ")
+        )?;
+        writeln!(
+            o,
+            "  towns                      {} ({})",
+            s.towns.len(),
+            s.towns.join(", ")
+        )?;
+        match s.target_crossing_ratio {
+            Some(t) => {
+                writeln!(
+                    o,
+                    "\ncrossing ratio: target {:.3}, achieved {:.3} ({:+.1} pp)",
+                    t,
+                    s.achieved_crossing_ratio,
+                    100.0 * (s.achieved_crossing_ratio - t)
+                )?;
+            }
+            None => {
+                writeln!(o, "\ncrossing ratio: achieved {:.3}", s.achieved_crossing_ratio)?;
+            }
+        }
+        writeln!(o, "\nshare of annotated samples per state")?;
+        for (k, v) in &s.state_shares {
+            writeln!(o, "  {k:<20} {:6.2}%", 100.0 * v)?;
+        }
+        writeln!(
+            o,
+            "\nper archetype                pedestrians crossers  rate   moving speed"
+        )?;
+        for (k, a) in &s.archetypes {
+            writeln!(
                 o,
-                "\ncrossing ratio: target {:.3}, achieved {:.3} ({:+.1} pp)",
-                t,
-                s.achieved_crossing_ratio,
-                100.0 * (s.achieved_crossing_ratio - t)
-            );
+                "  {k:<26} {:>9} {:>8} {:5.1}%  {:.2} m/s",
+                a.pedestrians,
+                a.crossers,
+                100.0 * a.crossing_rate,
+                a.mean_moving_speed_mps
+            )?;
         }
-        None => {
-            let _ = writeln!(o, "\ncrossing ratio: achieved {:.3}", s.achieved_crossing_ratio);
+        writeln!(o, "\nper split")?;
+        for (k, sp) in &s.splits {
+            writeln!(
+                o,
+                "  {k:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers {:>9} samples",
+                sp.clips, sp.frames, sp.pedestrians, sp.crossers, sp.samples
+            )?;
         }
+        writeln!(o, "\nvisibility gate rejections (pedestrian-frames)")?;
+        for (k, v) in &s.rejected {
+            writeln!(o, "  {k:<14} {v}")?;
+        }
+        writeln!(o, "vehicle contacts             {}", s.contacts)?;
+        Ok(())
     }
-    let _ = writeln!(o, "\nshare of annotated samples per state");
-    for (k, v) in &s.state_shares {
-        let _ = writeln!(o, "  {k:<20} {:6.2}%", 100.0 * v);
-    }
-    let _ = writeln!(
-        o,
-        "\nper archetype                pedestrians crossers  rate   moving speed"
-    );
-    for (k, a) in &s.archetypes {
-        let _ = writeln!(
-            o,
-            "  {k:<26} {:>9} {:>8} {:5.1}%  {:.2} m/s",
-            a.pedestrians,
-            a.crossers,
-            100.0 * a.crossing_rate,
-            a.mean_moving_speed_mps
-        );
-    }
-    let _ = writeln!(o, "\nper split");
-    for (k, sp) in &s.splits {
-        let _ = writeln!(
-            o,
-            "  {k:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers {:>9} samples",
-            sp.clips, sp.frames, sp.pedestrians, sp.crossers, sp.samples
-        );
-    }
-    let _ = writeln!(o, "\nvisibility gate rejections (pedestrian-frames)");
-    for (k, v) in &s.rejected {
-        let _ = writeln!(o, "  {k:<14} {v}");
-    }
-    let _ = writeln!(o, "vehicle contacts             {}", s.contacts);
-    o
 }

@@ -1,4 +1,246 @@
 //! Writing the dataset: the only code that touches the output directory.
 //!
-//! - [`tables`] — the Parquet tables: schemas, record batches, atomic writes.
+//! - [`layout`] — every path of the dataset, in one place.
+//! - [`manifest`] — `manifest.json`.
+//! - [`tables`] — the Parquet tables: schemas and record batches.
+//!
+//! A [`DatasetWriter`] opens `--out` for a plan (refusing a directory that holds anything else), writes each
+//! clip's files atomically (`fsutil::write_atomically`: a complete file or none), and derives the manifest from
+//! the files on disk. A clip is finished when all of its table files exist (`clips` is written last), which is
+//! what a resumed run skips.
+
+pub mod layout;
+pub mod manifest;
 pub mod tables;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::error::{Error, code};
+use crate::exec::observe::Observations;
+use crate::exec::trace::ClipTrace;
+use crate::fsutil::write_atomically;
+use crate::planner::{ClipScript, Plan};
+pub use layout::Layout;
+pub use manifest::{DATASET_FORMAT, Manifest, ManifestClip, plan_hash};
+use tables::{FileMeta, TABLES};
+
+/// An output directory opened for the dataset of one plan.
+#[derive(Debug)]
+pub struct DatasetWriter {
+    layout: Layout,
+    /// The manifest as it was at opening (every clip pending, or the resumed dataset's manifest).
+    manifest: Manifest,
+    meta: FileMeta,
+}
+
+impl DatasetWriter {
+    /// Opens `out` for `plan`: `out` must be missing, empty, or a dataset of the same spec and plan (which is
+    /// then resumed, after removing the temporary files an interrupted run left). Writes `spec.resolved.yaml`
+    /// and, for a new dataset, a manifest with every clip pending.
+    pub fn open(out: &Path, plan: &Plan) -> Result<DatasetWriter, Error> {
+        let layout = Layout::new(out);
+        let plan_hash = plan_hash(plan)?;
+        let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
+        std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+        let spec_yaml = crate::dsl::to_yaml(&plan.spec)?;
+        let spec_path = layout.spec_resolved();
+        write_atomically(&spec_path, spec_yaml.as_bytes()).map_err(|e| Error::write(&spec_path, e))?;
+        let manifest = Manifest {
+            pedsynth_dataset: DATASET_FORMAT,
+            pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
+            schema_version: tables::SCHEMA_VERSION,
+            dataset: plan.dataset.clone(),
+            spec_hash: plan.spec_hash.clone(),
+            plan_hash,
+            target_crossing_ratio: plan.target_crossing_ratio,
+            tables: TABLES.iter().map(|t| t.to_string()).collect(),
+            sensors: sensor_status(plan),
+            clips: plan
+                .clips
+                .iter()
+                .map(|c| ManifestClip {
+                    clip_id: c.clip_id.clone(),
+                    status: "pending".into(),
+                    files: BTreeMap::new(),
+                })
+                .collect(),
+        };
+        let writer = DatasetWriter {
+            layout,
+            manifest,
+            meta: FileMeta {
+                spec_hash: plan.spec_hash.clone(),
+            },
+        };
+        if existing {
+            writer.remove_temporaries()?;
+        } else {
+            writer.write_manifest(&writer.manifest)?;
+        }
+        Ok(writer)
+    }
+
+    /// The dataset's layout.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// Whether every file of a clip exists (a finished clip, which a resumed run skips).
+    pub fn is_clip_done(&self, clip_id: &str) -> bool {
+        TABLES.iter().all(|t| self.layout.table(t, clip_id).is_file())
+    }
+
+    /// Writes the files of one clip (each atomically; `clips` last, so its presence marks completion).
+    pub fn write_clip(
+        &self,
+        plan: &Plan,
+        script: &ClipScript,
+        trace: &ClipTrace,
+        obs: &Observations,
+    ) -> Result<(), Error> {
+        let ann = &obs.annotations;
+        let batches = [
+            ("frames", tables::frames_batch(script, trace)),
+            ("pedestrians", tables::pedestrians_batch(script, ann)),
+            ("annotations", tables::annotations_batch(script, ann)),
+            ("vehicles", tables::vehicles_batch(script, trace)),
+            ("events", tables::events_batch(script, trace)),
+            ("clips", tables::clips_batch(script, trace, ann)),
+        ];
+        debug_assert!(batches.iter().map(|b| b.0).eq(TABLES));
+        for (table, batch) in &batches {
+            let path = self.layout.table(table, &script.clip_id);
+            let bytes = tables::parquet_bytes(batch, &plan.spec.output, &self.meta, table, &script.clip_id)?;
+            write_atomically(&path, &bytes).map_err(|e| Error::write(&path, e))?;
+        }
+        Ok(())
+    }
+
+    /// Writes the final manifest: every finished clip `done` with its files' hashes, the others `pending`.
+    pub fn finish(&self) -> Result<Manifest, Error> {
+        let mut manifest = self.manifest.clone();
+        for clip in &mut manifest.clips {
+            if self.is_clip_done(&clip.clip_id) {
+                clip.status = "done".into();
+                clip.files = self.file_hashes(&clip.clip_id)?;
+            }
+        }
+        self.write_manifest(&manifest)?;
+        Ok(manifest)
+    }
+
+    fn file_hashes(&self, clip_id: &str) -> Result<BTreeMap<String, String>, Error> {
+        TABLES
+            .iter()
+            .map(|t| {
+                let path = self.layout.table(t, clip_id);
+                let bytes = std::fs::read(&path).map_err(|e| Error::read(&path, e))?;
+                Ok((t.to_string(), blake3::hash(&bytes).to_hex().to_string()))
+            })
+            .collect()
+    }
+
+    fn write_manifest(&self, manifest: &Manifest) -> Result<(), Error> {
+        let path = self.layout.manifest();
+        write_atomically(&path, manifest.to_json()?.as_bytes()).map_err(|e| Error::write(&path, e))
+    }
+
+    /// Removes the temporary files an interrupted run left in the dataset's own directories (the root and
+    /// `tables/<table>/`), so that a resumed dataset holds exactly the files of an uninterrupted run.
+    fn remove_temporaries(&self) -> Result<(), Error> {
+        let dirs =
+            std::iter::once(self.layout.root().to_path_buf()).chain(TABLES.iter().map(|t| self.layout.table_dir(t)));
+        for dir in dirs {
+            let Ok(entries) = std::fs::read_dir(&dir) else { continue };
+            for entry in entries.flatten() {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if is_temporary(&name) && entry.file_type().is_ok_and(|t| t.is_file()) {
+                    std::fs::remove_file(entry.path()).map_err(|e| Error::write(&entry.path(), e))?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the manifest records for each sensor of the spec.
+fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
+    let s = &plan.spec.sensors;
+    [
+        ("rgb", s.rgb.enabled),
+        ("lidar", s.lidar.enabled),
+        ("dvs", s.dvs.enabled),
+    ]
+    .into_iter()
+    .map(|(name, on)| {
+        let status = if on {
+            "enabled in the spec; not rendered by this pedsynth version (annotations only)"
+        } else {
+            "disabled"
+        };
+        (name.to_owned(), status.to_owned())
+    })
+    .collect()
+}
+
+/// Checks that `out` is missing, empty, or a dataset of the same spec and plan; returns whether it holds one.
+fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bool, Error> {
+    let out = layout.root();
+    let entries = match std::fs::read_dir(out) {
+        Ok(entries) => entries.count(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
+        Err(e) => return Err(Error::read(out, e)),
+    };
+    if entries == 0 {
+        return Ok(false);
+    }
+    let refuse = |why: &str| {
+        Error::new(
+            code::DATASET_REFUSED,
+            format!("refusing to write into {}: {why}", out.display()),
+        )
+        .help("use a new --out directory, or the one this spec's dataset was generated into")
+    };
+    let text = std::fs::read_to_string(layout.manifest())
+        .map_err(|_| refuse("the directory is not empty and is not a pedsynth dataset (no manifest.json)"))?;
+    let manifest = Manifest::parse(&text, "manifest.json")
+        .map_err(|e| refuse(&format!("its manifest.json is not a pedsynth manifest ({e})")))?;
+    if manifest.spec_hash != spec_hash {
+        return Err(refuse(&format!(
+            "it holds a dataset of another spec ({}…)",
+            &manifest.spec_hash[..12.min(manifest.spec_hash.len())]
+        )));
+    }
+    if manifest.plan_hash != plan_hash {
+        return Err(refuse(
+            "it holds a dataset of another plan of this spec (another pedsynth version?)",
+        ));
+    }
+    Ok(true)
+}
+
+/// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
+/// `fsutil::write_atomically`) or another `*.tmp` file.
+fn is_temporary(name: &str) -> bool {
+    let pid_suffix = name
+        .rsplit_once(".tmp-")
+        .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+    (name.starts_with('.') && pid_suffix) || name.ends_with(".tmp")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn temporaries_are_recognised_and_tables_are_not() {
+        assert!(is_temporary(".town01_like-clear_noon-0001.parquet.tmp-4242"));
+        assert!(is_temporary(".manifest.json.tmp-1"));
+        assert!(is_temporary("leftover.tmp"));
+        assert!(!is_temporary("town01_like-clear_noon-0001.parquet"));
+        assert!(!is_temporary("manifest.json"));
+        assert!(!is_temporary(".x.tmp-"));
+        assert!(!is_temporary(".x.tmp-12a"));
+    }
+}

@@ -1,11 +1,10 @@
 //! The dataset's Parquet tables: schemas (keys first, Waymo-v2 style), Arrow record batches built from a
-//! clip's script, trace and annotations, and atomic writing (temporary file, then rename).
+//! clip's script, trace and annotations, encoded as Parquet bytes (the writer stores them atomically).
 //!
 //! Layout: `tables/<table>/<clip_id>.parquet`, one file per clip and table, so that pyarrow, polars and DuckDB
 //! read each table directory as one dataset. Every file carries `pedsynth.schema_version`, `pedsynth.version`,
 //! `pedsynth.spec_hash` and `pedsynth.clip_id` in its key-value metadata. DATASET.md documents every column.
 
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use arrow_array::builder::{FixedSizeListBuilder, Float32Builder};
@@ -20,6 +19,7 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
 use crate::dsl::types::{Compression, Output};
+use crate::error::{Error, code};
 use crate::exec::observe::annotate::ClipAnnotations;
 use crate::exec::trace::{ClipTrace, Event, PedestrianId, VehicleId};
 use crate::planner::ClipScript;
@@ -499,21 +499,14 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     )
 }
 
-/// The path of a clip's file of a table.
-pub fn table_path(out_dir: &Path, table: &str, clip_id: &str) -> PathBuf {
-    out_dir.join("tables").join(table).join(format!("{clip_id}.parquet"))
-}
-
-/// Writes a record batch to `path` as Parquet, atomically (temporary file in the same directory, then
-/// rename). Returns the blake3 of the written bytes.
-pub fn write_parquet(
-    path: &Path,
+/// The Parquet bytes of a record batch: zstd (or the spec's codec), with the file's key-value metadata.
+pub fn parquet_bytes(
     batch: &RecordBatch,
     output: &Output,
     meta: &FileMeta,
     table: &str,
     clip_id: &str,
-) -> std::io::Result<String> {
+) -> Result<Vec<u8>, Error> {
     let compression = match output.compression {
         Compression::Zstd => ParquetCompression::ZSTD(ZstdLevel::try_new(output.zstd_level as i32).unwrap_or_default()),
         Compression::Snappy => ParquetCompression::SNAPPY,
@@ -531,9 +524,15 @@ pub fn write_parquet(
             kv("pedsynth.clip_id", clip_id.to_owned()),
         ]))
         .build();
-    let mut writer = ArrowWriter::try_new(Vec::new(), batch.schema(), Some(props)).map_err(std::io::Error::other)?;
-    writer.write(batch).map_err(std::io::Error::other)?;
-    let bytes = writer.into_inner().map_err(std::io::Error::other)?;
-    crate::fsutil::write_atomically(path, &bytes)?;
-    Ok(blake3::hash(&bytes).to_hex().to_string())
+    let encode = || -> Result<Vec<u8>, parquet::errors::ParquetError> {
+        let mut writer = ArrowWriter::try_new(Vec::new(), batch.schema(), Some(props))?;
+        writer.write(batch)?;
+        writer.into_inner()
+    };
+    encode().map_err(|e| {
+        Error::new(
+            code::INTERNAL_SERIALIZE,
+            format!("cannot encode table `{table}` of clip {clip_id} as Parquet: {e}"),
+        )
+    })
 }

@@ -1,0 +1,72 @@
+//! Progress of a generate run on stderr: a bar on a terminal, plain lines otherwise, nothing when quiet. The
+//! only place that reads the wall clock, and only for what it shows the user (never for what it writes).
+
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// Progress over the clips of one run.
+pub(crate) struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    total: usize,
+    done: AtomicUsize,
+    frames: AtomicU64,
+    started: Instant,
+    /// Print a line every this many clips (plain output); None when quiet.
+    every: Option<usize>,
+}
+
+impl Progress {
+    /// Progress over `total` clips.
+    pub fn new(total: usize, quiet: bool) -> Self {
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new(total as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} clips  {msg}  ETA {eta}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar
+        });
+        Progress {
+            bar,
+            total,
+            done: AtomicUsize::new(0),
+            frames: AtomicU64::new(0),
+            started: Instant::now(),
+            every: (!quiet).then_some((total / 20).max(1)),
+        }
+    }
+
+    /// One clip of `frames` frames is done.
+    pub fn clip_done(&self, clip_id: &str, frames: u64) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        let frames = self.frames.fetch_add(frames, Ordering::Relaxed) + frames;
+        let secs = self.started.elapsed().as_secs_f64().max(1e-6);
+        let rate = frames as f64 / secs;
+        match &self.bar {
+            Some(bar) => {
+                bar.set_message(format!("{rate:.0} frames/s"));
+                bar.inc(1);
+            }
+            None if self
+                .every
+                .is_some_and(|every| done.is_multiple_of(every) || done == self.total) =>
+            {
+                let eta = secs / done as f64 * (self.total - done) as f64;
+                // Progress is best effort: a closed stderr must not fail the run.
+                eprintln!(
+                    "[{done}/{}] {clip_id} done ({rate:.0} frames/s, ETA {eta:.0} s)",
+                    self.total
+                );
+            }
+            None => {}
+        }
+    }
+
+    /// Clears the bar.
+    pub fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}

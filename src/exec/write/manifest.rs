@@ -1,0 +1,74 @@
+//! `manifest.json`: what a dataset is (format, versions, spec and plan hashes) and each clip's status and file
+//! hashes. It is derived from the files on disk, so an interrupted and resumed run writes the same manifest as an
+//! uninterrupted one.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, code};
+use crate::planner::Plan;
+
+/// Marker and version of the dataset format (`manifest.json`'s `pedsynth_dataset`).
+pub const DATASET_FORMAT: u32 = 1;
+
+/// A clip's entry in the manifest.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ManifestClip {
+    /// Clip id.
+    pub clip_id: String,
+    /// `done` or `pending`.
+    pub status: String,
+    /// blake3 of each table file, by table.
+    pub files: BTreeMap<String, String>,
+}
+
+/// `manifest.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// Dataset format version; its presence marks a pedsynth dataset.
+    pub pedsynth_dataset: u32,
+    /// pedsynth version that wrote the dataset.
+    pub pedsynth_version: String,
+    /// Table schema version.
+    pub schema_version: u32,
+    /// Dataset name.
+    pub dataset: String,
+    /// blake3 of the resolved spec.
+    pub spec_hash: String,
+    /// blake3 of the plan's canonical JSON.
+    pub plan_hash: String,
+    /// Target sequence-level crossing ratio.
+    pub target_crossing_ratio: f64,
+    /// The tables.
+    pub tables: Vec<String>,
+    /// Sensors and what was written for each.
+    pub sensors: BTreeMap<String, String>,
+    /// Every planned clip.
+    pub clips: Vec<ManifestClip>,
+}
+
+impl Manifest {
+    /// The manifest's JSON text (pretty, with a final newline).
+    pub fn to_json(&self) -> Result<String, Error> {
+        let mut text = crate::error::to_json(self, true)?;
+        text.push('\n');
+        Ok(text)
+    }
+
+    /// Parses a manifest; `what` names it in the error.
+    pub fn parse(text: &str, what: &str) -> Result<Manifest, Error> {
+        serde_json::from_str(text)
+            .map_err(|e| Error::new(code::DATASET_INVALID, format!("{what} is not a pedsynth manifest: {e}")))
+    }
+}
+
+/// blake3 of a plan's canonical JSON, without `spec_dir`: where the spec file lies (and how its path was
+/// spelled) does not change the dataset, so the same spec run from another directory, or its
+/// `spec.resolved.yaml`, resumes the same dataset and writes the same manifest.
+pub fn plan_hash(plan: &Plan) -> Result<String, Error> {
+    let mut plan = plan.clone();
+    plan.spec_dir = String::new();
+    let json = crate::error::to_json(&plan, false)?;
+    Ok(blake3::hash(json.as_bytes()).to_hex().to_string())
+}
