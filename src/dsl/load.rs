@@ -157,7 +157,7 @@ pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptio
     if pruned.iter().any(Vec::is_empty) {
         return fail(problems, &sources);
     }
-    validate::validate(&spec, &root, base_dir, options, &mut problems);
+    validate::validate(&spec, &root, base_dir, options.allow_large, &mut problems);
     if !problems.is_empty() {
         return fail(problems, &sources);
     }

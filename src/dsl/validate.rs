@@ -6,7 +6,6 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::diagnostic::{Problem, code, suggestion};
-use super::load::LoadOptions;
 use super::tree::{Node, PathSeg, Span, parse_path};
 use super::types::*;
 
@@ -14,7 +13,8 @@ use super::types::*;
 const MIX_TOLERANCE: f64 = 1e-6;
 
 /// Validates `spec` (already merged onto the defaults); `tree` is the user's YAML for locating problems.
-pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, options: &LoadOptions, problems: &mut Vec<Problem>) {
+/// With `allow_large`, the sanity limits are not checked (`--allow-large`).
+pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, problems: &mut Vec<Problem>) {
     let mut v = Validator { tree, problems };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
@@ -29,7 +29,7 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, options: &LoadOptions
         22.0,
         "a zstd level",
     );
-    if !options.allow_large {
+    if !allow_large {
         v.limits(spec);
     }
 }

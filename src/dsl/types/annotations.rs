@@ -1,0 +1,159 @@
+//! `annotations`, `output` and `limits`: which pedestrians are annotated and how labels are derived, output
+//! encodings and compression, and the sanity limits on a dataset's size.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::Range;
+
+/// Annotation rules.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Annotations {
+    /// The visibility gate: which pedestrians are annotated in a frame.
+    pub visibility: Visibility,
+    /// A pedestrian keeps C=1 for this many frames after briefly leaving a driving lane (label smoothing).
+    pub crossing_label_smoothing_frames: u32,
+    /// Keypoint format.
+    pub pose_format: PoseFormat,
+}
+
+impl Default for Annotations {
+    fn default() -> Self {
+        Annotations {
+            visibility: Visibility::default(),
+            crossing_label_smoothing_frames: 5,
+            pose_format: PoseFormat::Coco17,
+        }
+    }
+}
+
+/// The paper's four-stage visibility gate plus an occlusion threshold.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Visibility {
+    /// Stage 1: distance to the ego below this, metres.
+    pub max_distance_m: f64,
+    /// Stage 2: in front of the camera.
+    pub require_in_front: bool,
+    /// Stage 3: smallest box `[width, height]`, pixels.
+    pub min_box_px: Range,
+    /// Beyond this distance the far minimum applies, metres.
+    pub far_distance_m: f64,
+    /// Stage 3 beyond `far_distance_m`: smallest box `[width, height]`, pixels.
+    pub min_box_far_px: Range,
+    /// Stage 4: the box lies within the image.
+    pub require_inside_image: bool,
+    /// Pedestrians occluded by more than this fraction are not annotated.
+    pub max_occlusion: f64,
+}
+
+impl Default for Visibility {
+    fn default() -> Self {
+        Visibility {
+            max_distance_m: 70.0,
+            require_in_front: true,
+            min_box_px: Range(15.0, 30.0),
+            far_distance_m: 50.0,
+            min_box_far_px: Range(8.0, 15.0),
+            require_inside_image: true,
+            max_occlusion: 0.8,
+        }
+    }
+}
+
+/// Keypoint formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum PoseFormat {
+    /// COCO-17 keypoints with COCO visibility flags.
+    Coco17,
+}
+
+/// Output encodings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Output {
+    /// Parquet compression codec of the annotation tables.
+    pub compression: Compression,
+    /// zstd level (1–22).
+    pub zstd_level: u32,
+    /// Encoding of RGB frames.
+    pub rgb_encoding: RgbEncoding,
+    /// Encoding of LiDAR sweeps.
+    pub lidar_encoding: LidarEncoding,
+    /// Encoding of DVS events.
+    pub dvs_encoding: DvsEncoding,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Output {
+            compression: Compression::Zstd,
+            zstd_level: 3,
+            rgb_encoding: RgbEncoding::Png,
+            lidar_encoding: LidarEncoding::Parquet,
+            dvs_encoding: DvsEncoding::Parquet,
+        }
+    }
+}
+
+/// Table compression codecs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Compression {
+    /// zstd.
+    Zstd,
+    /// Snappy.
+    Snappy,
+    /// No compression.
+    None,
+}
+
+/// RGB frame encodings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum RgbEncoding {
+    /// One PNG per frame (fast compression).
+    Png,
+}
+
+/// LiDAR sweep encodings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LidarEncoding {
+    /// A Parquet table per clip (frame, x, y, z, intensity).
+    Parquet,
+    /// One little-endian f32 `x y z intensity` file per sweep (the seed system's `.bin`).
+    BinF32,
+}
+
+/// DVS event encodings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DvsEncoding {
+    /// A Parquet table per clip (frame, x, y, t_ns, polarity).
+    Parquet,
+}
+
+/// Sanity limits; a spec beyond one is rejected unless `--allow-large` is given.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Limits {
+    /// Most clips in a dataset.
+    pub max_clips: u64,
+    /// Most pixels in one image (width × height).
+    pub max_image_pixels: u64,
+    /// Largest estimated dataset size, bytes.
+    pub max_dataset_bytes: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_clips: 100_000,
+            max_image_pixels: 3840 * 2160,
+            max_dataset_bytes: 2_000_000_000_000,
+        }
+    }
+}

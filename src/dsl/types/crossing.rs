@@ -1,0 +1,260 @@
+//! `crossing`: crossing-rate control — the target, the four layers (paper, Table "Four-layer crossing rate
+//! engineering strategy"), gap acceptance, the in-road lookahead, retreat and patience.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::Range;
+
+/// Crossing-rate control and crossing behaviour.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Crossing {
+    /// Target share of pedestrians that cross (sequence level).
+    pub target_ratio: f64,
+    /// Share of pedestrians not allocated as crossers that still cross on their own, as CARLA's AI walkers do
+    /// (about 9%).
+    pub baseline_ratio: f64,
+    /// The paper's four crossing-rate layers.
+    pub layers: Layers,
+    /// Time-to-collision gap acceptance.
+    pub gap_acceptance: GapAcceptance,
+    /// In-road lookahead while crossing.
+    pub lookahead: Lookahead,
+    /// Mid-crossing retreat.
+    pub retreat: Retreat,
+    /// What happens when a waiting pedestrian's patience cap expires.
+    pub patience: Patience,
+    /// A potential crosser commits when the ego vehicle is this far away, metres `[min, max]`.
+    pub decision_window_m: Range,
+}
+
+impl Default for Crossing {
+    fn default() -> Self {
+        Crossing {
+            target_ratio: 0.6,
+            baseline_ratio: 0.09,
+            layers: Layers::default(),
+            gap_acceptance: GapAcceptance::default(),
+            lookahead: Lookahead::default(),
+            retreat: Retreat::default(),
+            patience: Patience::default(),
+            decision_window_m: Range(10.0, 40.0),
+        }
+    }
+}
+
+/// The four crossing-rate layers (paper, Table "Four-layer crossing rate engineering strategy").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct Layers {
+    /// Layer 1: crosser allocation at spawn.
+    pub crosser_allocation: CrosserAllocation,
+    /// Layer 2: behavioural type assignment.
+    pub behaviour_mix: BehaviourMixLayer,
+    /// Layer 3: mid-road jaywalker injection.
+    pub midroad_jaywalkers: MidroadJaywalkers,
+    /// Layer 4: group crossing formation.
+    pub groups: Groups,
+}
+
+/// Layer 1: allocate crossers at spawn, on sidewalk positions ahead of the ego vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct CrosserAllocation {
+    /// Whether the layer is on.
+    pub enabled: bool,
+    /// Largest share of pedestrians allocated as crossers (paper: 90%). The planner allocates what the
+    /// target needs, up to this share.
+    pub max_crosser_ratio: f64,
+    /// Crossers spawn on sidewalks this far ahead of the ego vehicle along its route, metres.
+    pub spawn_ahead_m: Range,
+}
+
+impl Default for CrosserAllocation {
+    fn default() -> Self {
+        CrosserAllocation {
+            enabled: true,
+            max_crosser_ratio: 0.9,
+            spawn_ahead_m: Range(10.0, 55.0),
+        }
+    }
+}
+
+/// Layer 2: behaviour types of crossers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct BehaviourMixLayer {
+    /// Whether the layer is on (off: every crosser is `normal`).
+    pub enabled: bool,
+    /// Share of each behaviour type among crossers; must sum to 1.
+    pub mix: BehaviourMix,
+}
+
+impl Default for BehaviourMixLayer {
+    fn default() -> Self {
+        BehaviourMixLayer {
+            enabled: true,
+            mix: BehaviourMix {
+                normal: 0.5,
+                sudden: 0.25,
+                jaywalk: 0.25,
+            },
+        }
+    }
+}
+
+/// Shares of crossing behaviour types (missing ones are 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BehaviourMix {
+    /// Checks traffic, crosses when the gap is accepted.
+    #[serde(default)]
+    pub normal: f64,
+    /// Enters the road abruptly without checking.
+    #[serde(default)]
+    pub sudden: f64,
+    /// Crosses mid-block, away from crosswalks.
+    #[serde(default)]
+    pub jaywalk: f64,
+}
+
+/// Layer 3: pedestrians injected directly in driving lanes, mid-road.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct MidroadJaywalkers {
+    /// Whether the layer is on.
+    pub enabled: bool,
+    /// Share of crossers spawned mid-road instead of on a sidewalk.
+    pub share_of_crossers: f64,
+    /// Lateral spawn offset from the lane centre, metres (± this value).
+    pub lateral_offset_m: f64,
+}
+
+impl Default for MidroadJaywalkers {
+    fn default() -> Self {
+        MidroadJaywalkers {
+            enabled: true,
+            share_of_crossers: 0.1,
+            lateral_offset_m: 1.5,
+        }
+    }
+}
+
+/// Layer 4: synchronised crossing groups.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Groups {
+    /// Whether the layer is on.
+    pub enabled: bool,
+    /// Probability that potential crossers form a group with a shared leader.
+    pub probability: f64,
+    /// Shares of group sizes; must sum to 1.
+    pub size_mix: GroupSizeMix,
+}
+
+impl Default for Groups {
+    fn default() -> Self {
+        Groups {
+            enabled: true,
+            probability: 0.4,
+            size_mix: GroupSizeMix {
+                pairs: 0.7,
+                triples: 0.3,
+            },
+        }
+    }
+}
+
+/// Shares of group sizes (missing ones are 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct GroupSizeMix {
+    /// Groups of two.
+    #[serde(default)]
+    pub pairs: f64,
+    /// Groups of three.
+    #[serde(default)]
+    pub triples: f64,
+}
+
+/// Time-to-collision gap acceptance: cross when min TTC > τ_ttc + Δ_safety + w_road / s_cross.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct GapAcceptance {
+    /// Safety buffer Δ_safety, seconds.
+    pub safety_margin_s: Range,
+    /// Vehicles within this distance of the pedestrian are considered, metres.
+    pub vehicle_range_m: f64,
+}
+
+impl Default for GapAcceptance {
+    fn default() -> Self {
+        GapAcceptance {
+            safety_margin_s: Range(0.5, 1.0),
+            vehicle_range_m: 60.0,
+        }
+    }
+}
+
+/// In-road lookahead: halt when a vehicle is within `radius_m` of a probe point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Lookahead {
+    /// Probe distances along the crossing vector, metres.
+    pub points_m: Vec<f64>,
+    /// Also probe the position predicted this far ahead, seconds.
+    pub prediction_s: f64,
+    /// Safety radius around each probe, metres.
+    pub radius_m: f64,
+}
+
+impl Default for Lookahead {
+    fn default() -> Self {
+        Lookahead {
+            points_m: vec![0.5, 1.5, 2.5],
+            prediction_s: 0.5,
+            radius_m: 3.0,
+        }
+    }
+}
+
+/// Mid-crossing retreat.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Retreat {
+    /// Probability of retreating, drawn once per in-road conflict.
+    pub probability: f64,
+    /// Retreat is possible only in this first fraction of the crossing path.
+    pub window_fraction: f64,
+    /// Retreat speed, m/s.
+    pub speed_mps: Range,
+}
+
+impl Default for Retreat {
+    fn default() -> Self {
+        Retreat {
+            probability: 0.15,
+            window_fraction: 0.4,
+            speed_mps: Range(2.0, 3.0),
+        }
+    }
+}
+
+/// Patience expiry.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Patience {
+    /// On expiry, probability of a sudden crossing (otherwise the pedestrian abandons the attempt).
+    pub sudden_crossing_probability: f64,
+}
+
+impl Default for Patience {
+    fn default() -> Self {
+        Patience {
+            sudden_crossing_probability: 0.5,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------------

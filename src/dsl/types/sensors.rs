@@ -1,0 +1,178 @@
+//! `sensors`: the sensors on the ego vehicle — RGB camera, ray-cast LiDAR and DVS event camera, with their
+//! mounts (the paper's and the seed's values as defaults).
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// Sensors on the ego vehicle. All share the clip's frame clock.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct Sensors {
+    /// RGB camera.
+    pub rgb: Rgb,
+    /// Ray-cast LiDAR.
+    pub lidar: Lidar,
+    /// DVS event camera (co-located with the RGB camera, same intrinsics).
+    pub dvs: Dvs,
+}
+
+/// A sensor mount in the ego vehicle's body frame (x forward, y left, z up, metres; angles in degrees).
+/// CARLA's `(x 0.8, y -0.3, z 1.4)` is `forward_m 0.8, left_m 0.3, up_m 1.4` here.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Mount {
+    /// Forward of the vehicle origin, metres.
+    pub forward_m: f64,
+    /// Left of the vehicle origin, metres.
+    pub left_m: f64,
+    /// Above the ground, metres.
+    pub up_m: f64,
+    /// Pitch, degrees (negative looks down).
+    pub pitch_deg: f64,
+    /// Yaw, degrees (positive turns left).
+    pub yaw_deg: f64,
+    /// Roll, degrees.
+    pub roll_deg: f64,
+}
+
+impl Default for Mount {
+    fn default() -> Self {
+        Mount {
+            forward_m: 0.8,
+            left_m: 0.3,
+            up_m: 1.4,
+            pitch_deg: -8.0,
+            yaw_deg: 0.0,
+            roll_deg: 0.0,
+        }
+    }
+}
+
+/// RGB camera (pinhole; horizontal field of view).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Rgb {
+    /// Whether RGB images are written.
+    pub enabled: bool,
+    /// Image width, pixels.
+    pub width_px: u32,
+    /// Image height, pixels.
+    pub height_px: u32,
+    /// Horizontal field of view, degrees.
+    pub fov_deg: f64,
+    /// Mount at the driver's eye.
+    pub mount: Mount,
+}
+
+impl Default for Rgb {
+    fn default() -> Self {
+        Rgb {
+            enabled: true,
+            width_px: 1280,
+            height_px: 720,
+            fov_deg: 90.0,
+            mount: Mount::default(),
+        }
+    }
+}
+
+/// Ray-cast LiDAR (CARLA `sensor.lidar.ray_cast` semantics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Lidar {
+    /// Whether LiDAR sweeps are written.
+    pub enabled: bool,
+    /// Number of laser channels.
+    pub channels: u32,
+    /// Maximum range, metres.
+    pub range_m: f64,
+    /// Points per second over all channels.
+    pub points_per_second: u32,
+    /// Rotation frequency, Hz.
+    pub rotation_hz: f64,
+    /// Elevation of the top channel, degrees.
+    pub upper_fov_deg: f64,
+    /// Elevation of the bottom channel, degrees.
+    pub lower_fov_deg: f64,
+    /// Horizontal field of view, degrees.
+    pub horizontal_fov_deg: f64,
+    /// Atmospheric attenuation rate, 1/m (intensity = exp(-rate × distance)).
+    pub atmosphere_attenuation_per_m: f64,
+    /// Share of rays dropped at random.
+    pub dropoff_general_rate: f64,
+    /// Intensity above which no intensity-based drop-off happens.
+    pub dropoff_intensity_limit: f64,
+    /// Drop-off probability of a zero-intensity return.
+    pub dropoff_zero_intensity: f64,
+    /// Standard deviation of range noise along the ray, metres.
+    pub noise_stddev_m: f64,
+    /// Roof mount.
+    pub mount: Mount,
+}
+
+impl Default for Lidar {
+    fn default() -> Self {
+        Lidar {
+            enabled: true,
+            channels: 64,
+            range_m: 100.0,
+            points_per_second: 1_000_000,
+            rotation_hz: 20.0,
+            upper_fov_deg: 15.0,
+            lower_fov_deg: -25.0,
+            horizontal_fov_deg: 360.0,
+            atmosphere_attenuation_per_m: 0.004,
+            dropoff_general_rate: 0.45,
+            dropoff_intensity_limit: 0.8,
+            dropoff_zero_intensity: 0.4,
+            noise_stddev_m: 0.0,
+            mount: Mount {
+                forward_m: 0.0,
+                left_m: 0.0,
+                up_m: 2.4,
+                pitch_deg: 0.0,
+                yaw_deg: 0.0,
+                roll_deg: 0.0,
+            },
+        }
+    }
+}
+
+/// DVS event camera (ESIM, CARLA `sensor.camera.dvs` semantics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Dvs {
+    /// Whether events are written.
+    pub enabled: bool,
+    /// Positive contrast threshold Cp.
+    pub positive_threshold: f64,
+    /// Negative contrast threshold Cm.
+    pub negative_threshold: f64,
+    /// Per-pixel, per-frame standard deviation of Cp.
+    pub sigma_positive_threshold: f64,
+    /// Per-pixel, per-frame standard deviation of Cm.
+    pub sigma_negative_threshold: f64,
+    /// Refractory period, nanoseconds.
+    pub refractory_period_ns: u64,
+    /// Work on log intensity.
+    pub use_log: bool,
+    /// Epsilon added before the logarithm.
+    pub log_eps: f64,
+}
+
+impl Default for Dvs {
+    fn default() -> Self {
+        Dvs {
+            enabled: true,
+            positive_threshold: 0.3,
+            negative_threshold: 0.3,
+            sigma_positive_threshold: 0.0,
+            sigma_negative_threshold: 0.0,
+            refractory_period_ns: 0,
+            use_log: true,
+            log_eps: 0.001,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------------

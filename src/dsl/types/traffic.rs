@@ -1,0 +1,182 @@
+//! `traffic`: vehicles per clip, driving profiles (CARLA Traffic Manager semantics), IDM constants, the ego
+//! vehicle and emergency scenarios.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::{CountRange, Range};
+
+/// Traffic and the ego vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Traffic {
+    /// Traffic vehicles per clip (besides the ego), `[min, max]`.
+    pub vehicles_per_clip: CountRange,
+    /// Share of each driving profile; must sum to 1.
+    pub profile_mix: DrivingProfileMix,
+    /// Parameters of each driving profile.
+    pub profiles: DrivingProfiles,
+    /// Intelligent Driver Model constants shared by all vehicles.
+    pub idm: Idm,
+    /// The ego vehicle.
+    pub ego: Ego,
+    /// Emergency scenarios (a vehicle braking hard or a pedestrian darting out close to the ego).
+    pub emergency: Emergency,
+}
+
+impl Default for Traffic {
+    fn default() -> Self {
+        Traffic {
+            vehicles_per_clip: CountRange(5, 10),
+            profile_mix: DrivingProfileMix {
+                aggressive: 0.2,
+                normal: 0.6,
+                cautious: 0.2,
+            },
+            profiles: DrivingProfiles::default(),
+            idm: Idm::default(),
+            ego: Ego::default(),
+            emergency: Emergency::default(),
+        }
+    }
+}
+
+/// Shares of driving profiles (missing ones are 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct DrivingProfileMix {
+    /// Aggressive drivers.
+    #[serde(default)]
+    pub aggressive: f64,
+    /// Normal drivers.
+    #[serde(default)]
+    pub normal: f64,
+    /// Cautious drivers.
+    #[serde(default)]
+    pub cautious: f64,
+}
+
+/// The three driving profiles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct DrivingProfiles {
+    /// Aggressive: faster than the limit, short gaps, may ignore lights or pedestrians.
+    pub aggressive: DrivingProfile,
+    /// Normal.
+    pub normal: DrivingProfile,
+    /// Cautious: slower, long gaps.
+    pub cautious: DrivingProfile,
+}
+
+impl Default for DrivingProfiles {
+    fn default() -> Self {
+        let p = |speed: (f64, f64), gap: (f64, f64), headway: (f64, f64), lights, walkers| DrivingProfile {
+            speed_difference_pct: Range(speed.0, speed.1),
+            min_gap_m: Range(gap.0, gap.1),
+            time_headway_s: Range(headway.0, headway.1),
+            ignore_lights_probability: lights,
+            ignore_walkers_probability: walkers,
+        };
+        DrivingProfiles {
+            aggressive: p((-30.0, -15.0), (0.5, 1.0), (0.8, 1.1), 0.2, 0.05),
+            normal: p((-10.0, 10.0), (1.0, 2.0), (1.3, 1.7), 0.0, 0.0),
+            cautious: p((10.0, 25.0), (2.0, 3.5), (1.9, 2.5), 0.0, 0.0),
+        }
+    }
+}
+
+/// One driving profile (CARLA Traffic Manager semantics).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct DrivingProfile {
+    /// Percentage below the speed limit (negative: faster than the limit).
+    pub speed_difference_pct: Range,
+    /// IDM minimum gap s0 to the leader, metres.
+    pub min_gap_m: Range,
+    /// IDM desired time headway T, seconds.
+    pub time_headway_s: Range,
+    /// Probability that a vehicle of this profile ignores traffic lights.
+    pub ignore_lights_probability: f64,
+    /// Probability that a vehicle of this profile ignores pedestrians (it still records any contact).
+    pub ignore_walkers_probability: f64,
+}
+
+impl Default for DrivingProfile {
+    fn default() -> Self {
+        DrivingProfiles::default().normal
+    }
+}
+
+/// Intelligent Driver Model constants.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Idm {
+    /// Maximum acceleration a, m/s².
+    pub max_accel_mps2: f64,
+    /// Comfortable deceleration b, m/s².
+    pub comfortable_decel_mps2: f64,
+    /// Largest deceleration a vehicle can apply, m/s².
+    pub max_decel_mps2: f64,
+    /// Acceleration exponent δ.
+    pub exponent: f64,
+}
+
+impl Default for Idm {
+    fn default() -> Self {
+        Idm {
+            max_accel_mps2: 1.5,
+            comfortable_decel_mps2: 3.0,
+            max_decel_mps2: 8.0,
+            exponent: 4.0,
+        }
+    }
+}
+
+/// The ego vehicle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Ego {
+    /// Percentage below the speed limit the ego drives at.
+    pub speed_below_limit_pct: Range,
+    /// Minimum gap to a leading vehicle, metres.
+    pub min_gap_m: f64,
+    /// The ego brakes for a crossing pedestrian closer than this ahead, metres.
+    pub brake_ahead_m: f64,
+    /// ... and within this lateral distance of its path, metres.
+    pub brake_lateral_m: f64,
+    /// Route length beyond what the clip needs, metres.
+    pub route_margin_m: f64,
+}
+
+impl Default for Ego {
+    fn default() -> Self {
+        Ego {
+            speed_below_limit_pct: Range(15.0, 35.0),
+            min_gap_m: 2.5,
+            brake_ahead_m: 15.0,
+            brake_lateral_m: 5.0,
+            route_margin_m: 60.0,
+        }
+    }
+}
+
+/// Emergency scenarios.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Emergency {
+    /// Whether emergency scenarios are generated.
+    pub enabled: bool,
+    /// Share of clips with an emergency scenario.
+    pub clip_share: f64,
+}
+
+impl Default for Emergency {
+    fn default() -> Self {
+        Emergency {
+            enabled: false,
+            clip_share: 0.1,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
