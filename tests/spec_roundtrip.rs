@@ -29,6 +29,27 @@ fn assert_round_trips(loaded: &dsl::LoadedSpec) {
     assert_eq!(again.hash().expect("hash"), loaded.hash().expect("hash"));
 }
 
+/// `min_box_px` is a width and a height, not a range: a box wider than tall is valid in either form (it was
+/// once parsed as a range, so `[30, 15]` was rejected as empty and its values read as min/max).
+#[test]
+fn box_sizes_are_width_by_height_in_either_form() {
+    for text in [
+        "version: 1\nannotations: {visibility: {min_box_px: [30, 15]}}\n",
+        "version: 1\nannotations: {visibility: {min_box_px: {width_px: 30, height_px: 15}}}\n",
+    ] {
+        let loaded = load_text(text.as_bytes(), Vec::new()).unwrap_or_else(|e| panic!("{}", e.render_plain(100)));
+        let b = loaded.spec.annotations.visibility.min_box_px;
+        assert_eq!((b.width_px, b.height_px), (30.0, 15.0), "{text}");
+        assert_round_trips(&loaded);
+    }
+    let bad = load_text(
+        b"version: 1\nannotations: {visibility: {min_box_px: {width_px: 3, heigth_px: 4}}}\n",
+        Vec::new(),
+    )
+    .expect_err("a misspelt key");
+    assert_eq!(bad.codes(), ["pedsynth::spec::missing_key", "pedsynth::spec::unknown_key"]);
+}
+
 #[test]
 fn shipped_specs_round_trip() {
     for entry in std::fs::read_dir(root().join("specs")).unwrap() {

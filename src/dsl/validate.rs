@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use super::diagnostic::{Problem, code, suggestion};
-use super::tree::{Node, PathSeg, Span, parse_path};
+use super::tree::{Node, PathSeg, Span, Value, parse_path};
 use super::types::*;
 
 /// Tolerance on a mix's sum.
@@ -175,6 +175,18 @@ impl Validator<'_> {
             .help("write the range as [min, max] with min ≤ max");
             self.problems.push(problem);
         }
+    }
+
+    /// A box size: width and height each in `[0, 4096]` pixels (either may be the larger).
+    fn box_size(&mut self, path: &str, b: BoxSize) {
+        let list = matches!(self.tree.at(&Self::path(path)).map(|n| &n.value), Some(Value::Seq(_)));
+        let (w, h) = if list {
+            (format!("{path}[0]"), format!("{path}[1]"))
+        } else {
+            (format!("{path}.width_px"), format!("{path}.height_px"))
+        };
+        self.num(&w, b.width_px, 0.0, 4096.0, "a box width in pixels");
+        self.num(&h, b.height_px, 0.0, 4096.0, "a box height in pixels");
     }
 
     fn count_range(&mut self, path: &str, r: CountRange, lo: u32, hi: u32, what: &str) {
@@ -847,26 +859,14 @@ impl Validator<'_> {
             1000.0,
             "a distance in metres",
         );
-        self.range(
-            "annotations.visibility.min_box_px",
-            v.min_box_px,
-            0.0,
-            4096.0,
-            "a box size [width, height] in pixels",
-        );
+        self.box_size("annotations.visibility.min_box_px", v.min_box_px);
         self.positive(
             "annotations.visibility.far_distance_m",
             v.far_distance_m,
             1000.0,
             "a distance in metres",
         );
-        self.range(
-            "annotations.visibility.min_box_far_px",
-            v.min_box_far_px,
-            0.0,
-            4096.0,
-            "a box size [width, height] in pixels",
-        );
+        self.box_size("annotations.visibility.min_box_far_px", v.min_box_far_px);
         self.probability("annotations.visibility.max_occlusion", v.max_occlusion);
         self.num(
             "annotations.crossing_label_smoothing_frames",

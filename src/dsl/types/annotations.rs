@@ -4,7 +4,6 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::Range;
 
 /// Annotation rules.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -36,12 +35,12 @@ pub struct Visibility {
     pub max_distance_m: f64,
     /// Stage 2: in front of the camera.
     pub require_in_front: bool,
-    /// Stage 3: smallest box `[width, height]`, pixels.
-    pub min_box_px: Range,
+    /// Stage 3: smallest box, pixels: `{width_px, height_px}` (or `[width, height]`).
+    pub min_box_px: BoxSize,
     /// Beyond this distance the far minimum applies, metres.
     pub far_distance_m: f64,
-    /// Stage 3 beyond `far_distance_m`: smallest box `[width, height]`, pixels.
-    pub min_box_far_px: Range,
+    /// Stage 3 beyond `far_distance_m`: smallest box, pixels: `{width_px, height_px}` (or `[width, height]`).
+    pub min_box_far_px: BoxSize,
     /// Stage 4: the box lies within the image.
     pub require_inside_image: bool,
     /// Pedestrians occluded by more than this fraction are not annotated.
@@ -53,11 +52,54 @@ impl Default for Visibility {
         Visibility {
             max_distance_m: 70.0,
             require_in_front: true,
-            min_box_px: Range(15.0, 30.0),
+            min_box_px: BoxSize::new(15.0, 30.0),
             far_distance_m: 50.0,
-            min_box_far_px: Range(8.0, 15.0),
+            min_box_far_px: BoxSize::new(8.0, 15.0),
             require_inside_image: true,
             max_occlusion: 0.8,
+        }
+    }
+}
+
+/// The size of an image box, pixels. Written `{width_px: 15, height_px: 30}` or, briefly, `[15, 30]` (width
+/// first); it is not a range, so the width may exceed the height.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(from = "BoxSizeForm")]
+pub struct BoxSize {
+    /// Width, pixels.
+    pub width_px: f64,
+    /// Height, pixels.
+    pub height_px: f64,
+}
+
+impl BoxSize {
+    /// A box size.
+    pub const fn new(width_px: f64, height_px: f64) -> BoxSize {
+        BoxSize { width_px, height_px }
+    }
+}
+
+/// The two ways to write a [`BoxSize`].
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, JsonSchema)]
+#[serde(untagged, deny_unknown_fields)]
+enum BoxSizeForm {
+    /// `{width_px, height_px}`.
+    Map {
+        /// Width, pixels.
+        width_px: f64,
+        /// Height, pixels.
+        height_px: f64,
+    },
+    /// `[width, height]`.
+    List(f64, f64),
+}
+
+impl From<BoxSizeForm> for BoxSize {
+    fn from(form: BoxSizeForm) -> BoxSize {
+        match form {
+            BoxSizeForm::Map { width_px, height_px } | BoxSizeForm::List(width_px, height_px) => {
+                BoxSize { width_px, height_px }
+            }
         }
     }
 }

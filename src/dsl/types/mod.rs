@@ -171,6 +171,6 @@ mod tests {
             (spec.sensors.lidar.channels, spec.sensors.lidar.points_per_second),
             (64, 1_000_000)
         );
-        assert_eq!(spec.annotations.visibility.min_box_far_px, Range(8.0, 15.0));
+        assert_eq!(spec.annotations.visibility.min_box_far_px, BoxSize::new(8.0, 15.0));
     }
 }

@@ -12,7 +12,7 @@ use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M};
 use super::rig::{Camera, CameraPose};
-use crate::dsl::types::Annotations;
+use crate::dsl::types::{Annotations, BoxSize};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::{ClipTrace, Event, PedFrame, PedState};
 use crate::planner::ClipScript;
@@ -252,6 +252,11 @@ pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
     Some([lo.x, lo.y, hi.x, hi.y])
 }
 
+/// Stage 3 of the gate: whether a `width` × `height` box (pixels) is smaller than `min` in either dimension.
+fn too_small(width: f64, height: f64, min: BoxSize) -> bool {
+    width < min.width_px || height < min.height_px
+}
+
 /// Annotates a simulated clip.
 pub fn annotate(
     script: &ClipScript,
@@ -351,7 +356,7 @@ pub fn annotate(
             } else {
                 gate.min_box_px
             };
-            if w < min.min() || hgt < min.max() {
+            if too_small(w, hgt, min) {
                 out.rejections.too_small += 1;
                 continue;
             }
@@ -484,6 +489,16 @@ mod tests {
             crossing_labels(&frames, 0),
             vec![false, false, true, false, false, false, true, false]
         );
+    }
+
+    #[test]
+    fn the_size_gate_compares_width_with_width_and_height_with_height() {
+        let tall = BoxSize::new(15.0, 30.0);
+        let wide = BoxSize::new(30.0, 15.0);
+        assert!(!too_small(20.0, 40.0, tall));
+        assert!(too_small(20.0, 40.0, wide), "20 px wide is narrower than 30");
+        assert!(too_small(40.0, 20.0, tall), "20 px high is lower than 30");
+        assert!(!too_small(40.0, 20.0, wide));
     }
 
     #[test]
