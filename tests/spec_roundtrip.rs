@@ -47,7 +47,10 @@ fn box_sizes_are_width_by_height_in_either_form() {
         Vec::new(),
     )
     .expect_err("a misspelt key");
-    assert_eq!(bad.codes(), ["pedsynth::spec::missing_key", "pedsynth::spec::unknown_key"]);
+    assert_eq!(
+        bad.codes(),
+        ["pedsynth::spec::missing_key", "pedsynth::spec::unknown_key"]
+    );
 }
 
 #[test]

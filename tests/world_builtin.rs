@@ -1,10 +1,10 @@
 //! The built-in towns pass the same checks as the CARLA maps, match their golden summaries, and are
 //! deterministic (built twice, identical geometry).
 
-mod world_common;
+mod common;
 
+use common::*;
 use pedsynth::world::{BUILTIN_TOWN_NAMES, RoadNetwork};
-use world_common::*;
 
 fn check(name: &str) {
     let t = std::time::Instant::now();

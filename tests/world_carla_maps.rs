@@ -1,22 +1,23 @@
-//! The real CARLA maps (MIT, read from ../shared/maps/carla, never copied into the repository): each loads,
+//! The real CARLA maps (MIT, read from `$PEDSYNTH_CARLA_MAPS` or ../shared/maps/carla, never copied into the
+//! repository): each loads,
 //! its summary matches the golden file, sampled points classify correctly, long routes exist and crossing
 //! vectors land on the far sidewalk.
 
-mod world_common;
+mod common;
 
+use common::*;
 use pedsynth::world::RoadNetwork;
-use world_common::*;
 
-fn load(town: &str) -> RoadNetwork {
-    let path = carla_dir().join(format!("{town}.xodr"));
+fn load(town: &str) -> Option<RoadNetwork> {
+    let path = carla_map(town)?;
     let t = std::time::Instant::now();
     let net = RoadNetwork::from_xodr_file(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     eprintln!("{town}: loaded in {:?}", t.elapsed());
-    net
+    Some(net)
 }
 
 fn check(town: &str) {
-    let net = load(town);
+    let Some(net) = load(town) else { return };
     let mut s = net.summary();
     s.source = pedsynth::world::TownSource::Xodr {
         path: format!("../shared/maps/carla/{town}.xodr"),

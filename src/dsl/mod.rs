@@ -6,6 +6,7 @@
 pub mod check;
 pub mod diagnostic;
 pub mod load;
+pub mod not_yet;
 pub mod schema;
 pub mod tree;
 pub mod types;

@@ -32,6 +32,7 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
     if !allow_large {
         v.limits(spec);
     }
+    super::not_yet::check(spec, tree, problems);
 }
 
 /// Number of clips a spec asks for.
@@ -853,6 +854,16 @@ impl Validator<'_> {
 
     fn annotations(&mut self, a: &Annotations) {
         let v = &a.visibility;
+        if !v.require_in_front {
+            let path = "annotations.visibility.require_in_front";
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!("`{path}` must be true: stage 2 of the gate cannot be turned off"),
+            )
+            .at(self.span(path), "must be true")
+            .help("a pedestrian behind the camera has no image box, so it is never annotated; remove the key");
+            self.problems.push(problem);
+        }
         self.positive(
             "annotations.visibility.max_distance_m",
             v.max_distance_m,

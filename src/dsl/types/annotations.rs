@@ -4,7 +4,6 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-
 /// Annotation rules.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -13,7 +12,7 @@ pub struct Annotations {
     pub visibility: Visibility,
     /// A pedestrian keeps C=1 for this many frames after briefly leaving a driving lane (label smoothing).
     pub crossing_label_smoothing_frames: u32,
-    /// Keypoint format.
+    /// Keypoint format of the `keypoints` and `keypoints_3d` columns.
     pub pose_format: PoseFormat,
 }
 
@@ -33,7 +32,8 @@ impl Default for Annotations {
 pub struct Visibility {
     /// Stage 1: distance to the ego below this, metres.
     pub max_distance_m: f64,
-    /// Stage 2: in front of the camera.
+    /// Stage 2: in front of the camera. Always true: a pedestrian behind the camera has no image box (the key
+    /// is kept because the paper names the stage).
     pub require_in_front: bool,
     /// Stage 3: smallest box, pixels: `{width_px, height_px}` (or `[width, height]`).
     pub min_box_px: BoxSize,
@@ -110,6 +110,10 @@ impl From<BoxSizeForm> for BoxSize {
 pub enum PoseFormat {
     /// COCO-17 keypoints with COCO visibility flags.
     Coco17,
+    /// OpenPose-18 (COCO-18) keypoints in the order PedestrianActionBenchmark reads (nose, neck, right
+    /// shoulder/elbow/wrist, left shoulder/elbow/wrist, right hip/knee/ankle, left hip/knee/ankle, left eye,
+    /// right eye, left ear, right ear); the neck is the shoulders' midpoint.
+    Openpose18,
 }
 
 /// Output encodings.

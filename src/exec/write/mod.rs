@@ -103,7 +103,10 @@ impl DatasetWriter {
         let batches = [
             ("frames", tables::frames_batch(script, trace)),
             ("pedestrians", tables::pedestrians_batch(script, ann)),
-            ("annotations", tables::annotations_batch(script, ann)),
+            (
+                "annotations",
+                tables::annotations_batch(script, ann, plan.spec.annotations.pose_format),
+            ),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
             ("clips", tables::clips_batch(script, trace, ann)),

@@ -18,7 +18,7 @@ use parquet::basic::{Compression as ParquetCompression, ZstdLevel};
 use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
-use crate::dsl::types::{Compression, Output};
+use crate::dsl::types::{Compression, Output, PoseFormat};
 use crate::error::{Error, code};
 use crate::exec::observe::annotate::ClipAnnotations;
 use crate::exec::trace::{ClipTrace, Event, PedestrianId, VehicleId};
@@ -240,28 +240,36 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
     )
 }
 
-fn fixed_list(
+fn keypoint_list(
     rows: &[crate::exec::observe::annotate::AnnotationRow],
+    format: PoseFormat,
+    flags: bool,
     get: fn(&crate::exec::observe::annotate::AnnotationRow) -> &[f32; 51],
 ) -> ArrayRef {
-    let mut builder =
-        FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(rows.len() * 51), 51, rows.len())
-            .with_field(Field::new("item", DataType::Float32, false));
+    let width = 3 * crate::exec::observe::body::joint_count(format);
+    let mut values = Vec::with_capacity(rows.len() * width);
     for r in rows {
-        builder.values().append_slice(get(r));
+        crate::exec::observe::body::push_keypoints(get(r), format, flags, &mut values);
+    }
+    let mut builder =
+        FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(values.len()), width as i32, rows.len())
+            .with_field(Field::new("item", DataType::Float32, false));
+    for chunk in values.chunks_exact(width) {
+        builder.values().append_slice(chunk);
         builder.append(true);
     }
     Arc::new(builder.finish())
 }
 
 /// The `annotations` table: one row per annotated pedestrian-frame.
-pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
+pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: PoseFormat) -> RecordBatch {
     let rows = &ann.rows;
     let n = rows.len();
     let f32c = |get: fn(&crate::exec::observe::annotate::AnnotationRow) -> f32| -> ArrayRef {
         Arc::new(Float32Array::from_iter_values(rows.iter().map(get)))
     };
-    let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), 51);
+    let width = 3 * crate::exec::observe::body::joint_count(format) as i32;
+    let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), width);
     batch(
         vec![
             field("clip_id", DataType::Utf8, false),
@@ -305,8 +313,8 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             f32c(|r| r.distance_m),
             Arc::new(Int32Array::from_iter(rows.iter().map(|r| r.tte_frames))),
             f32c(|r| r.occlusion),
-            fixed_list(rows, |r| &r.keypoints),
-            fixed_list(rows, |r| &r.keypoints_3d),
+            keypoint_list(rows, format, true, |r| &r.keypoints),
+            keypoint_list(rows, format, false, |r| &r.keypoints_3d),
             f32c(|r| r.pos_m[0]),
             f32c(|r| r.pos_m[1]),
             f32c(|r| r.pos_m[2]),

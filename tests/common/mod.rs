@@ -1,5 +1,12 @@
-//! Checks shared by the CARLA-map and built-in-town tests: lane classification of sampled points, routes,
-//! crossing vectors.
+//! Helpers shared by the integration tests: where the real CARLA maps are (one setting), whether the slow
+//! statistical tests run, and the checks shared by the CARLA-map and built-in-town tests (lane classification of
+//! sampled points, routes, crossing vectors).
+//!
+//! - `PEDSYNTH_CARLA_MAPS`: the directory of CARLA's `Town01.xodr` ... (default `../shared/maps/carla` beside
+//!   the repository). Tests that need the maps skip, saying why, when they are absent; with
+//!   `PEDSYNTH_REQUIRE_CARLA_MAPS=1` (set by `.ci/run`) a missing map fails the test instead, so CI cannot pass
+//!   by skipping.
+//! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
 #![allow(dead_code)]
 
 use glam::DVec2;
@@ -7,9 +14,40 @@ use pedsynth::world::{LaneType, RoadNetwork};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-/// Directory holding the real CARLA maps (beside the repository, never copied into it).
+/// Directory holding the real CARLA maps: `$PEDSYNTH_CARLA_MAPS`, or `../shared/maps/carla` beside the
+/// repository (never copied into it).
 pub fn carla_dir() -> std::path::PathBuf {
-    std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/maps/carla"))
+    match std::env::var_os("PEDSYNTH_CARLA_MAPS") {
+        Some(dir) if !dir.is_empty() => std::path::PathBuf::from(dir),
+        _ => std::path::PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/maps/carla")),
+    }
+}
+
+/// The path of CARLA map `town` (e.g. `Town01`), or `None` when it is absent and the test should skip (the
+/// reason is printed). Panics instead when `$PEDSYNTH_REQUIRE_CARLA_MAPS` is set, so CI cannot skip.
+pub fn carla_map(town: &str) -> Option<std::path::PathBuf> {
+    let path = carla_dir().join(format!("{town}.xodr"));
+    if path.is_file() {
+        return Some(path);
+    }
+    let why = format!(
+        "the CARLA map {} is absent (set PEDSYNTH_CARLA_MAPS to the directory of CARLA's Town*.xodr)",
+        path.display()
+    );
+    if std::env::var_os("PEDSYNTH_REQUIRE_CARLA_MAPS").is_some_and(|v| !v.is_empty() && v != "0") {
+        panic!("{why}; PEDSYNTH_REQUIRE_CARLA_MAPS forbids skipping");
+    }
+    eprintln!("skipped: {why}");
+    None
+}
+
+/// Whether the slow statistical tests run (`PEDSYNTH_SLOW_TESTS=1`); prints why a test is skipped otherwise.
+pub fn slow_tests(test: &str) -> bool {
+    let on = std::env::var_os("PEDSYNTH_SLOW_TESTS").is_some_and(|v| !v.is_empty() && v != "0");
+    if !on {
+        eprintln!("skipped: {test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it");
+    }
+    on
 }
 
 /// A point inside lane piece `pi`: `along` ∈ [0,1] between its stations, `across` ∈ [0,1] inner→outer.
