@@ -9,6 +9,7 @@
 //! stratum or clip id), so adding a weather or a town leaves every other stratum's clips byte-identical, and
 //! `--only CLIP_ID` re-plans exactly the same script.
 
+pub mod identity;
 pub mod quota;
 pub mod script;
 pub mod seeds;
@@ -458,6 +459,7 @@ fn plan_clip(
             first_ped,
             archetype_names,
             duration_s,
+            basics.seed,
             &mut rng,
         )
         .and_then(|pedestrians| {
@@ -534,6 +536,7 @@ fn plan_pedestrians(
     first_ped: usize,
     archetype_names: &[&String],
     duration_s: f64,
+    clip_seed: u64,
     rng: &mut ChaCha20Rng,
 ) -> Result<Vec<PedestrianScript>, String> {
     let p = &spec.pedestrians;
@@ -631,6 +634,7 @@ fn plan_pedestrians(
         if role == Role::Crosser && crossing.is_none() {
             return Err(format!("pedestrian {id} is a crosser but has no road to cross"));
         }
+        let (identity, child) = identity::identities(clip_seed, id, name, a.body);
         scripts.push(PedestrianScript {
             id,
             archetype: name.to_owned(),
@@ -652,6 +656,8 @@ fn plan_pedestrians(
             spawn_heading_rad: heading,
             ahead_of_ego_m: ahead,
             crossing,
+            identity,
+            child,
         });
     }
     Ok(scripts)

@@ -350,4 +350,76 @@ pub struct PedestrianScript {
     pub ahead_of_ego_m: f64,
     /// The planned crossing (crossers only).
     pub crossing: Option<CrossingScript>,
+    /// Who the pedestrian is: body height and looks, the same for every sensor and label.
+    pub identity: Identity,
+    /// The child walking beside a parent (`parent_with_child` bodies).
+    pub child: Option<Identity>,
+}
+
+/// Age group of a person (for the renderer's body proportions and the PIE/JAAD attributes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AgeGroup {
+    /// Under about 12.
+    Child,
+    /// Teenager or young adult.
+    Young,
+    /// Adult.
+    Adult,
+    /// Senior.
+    Senior,
+}
+
+impl AgeGroup {
+    /// The group's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Child => "child",
+            Self::Young => "young",
+            Self::Adult => "adult",
+            Self::Senior => "senior",
+        }
+    }
+}
+
+/// Gender presentation of a person (for the renderer and the PIE/JAAD attributes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Gender {
+    /// Female.
+    Female,
+    /// Male.
+    Male,
+}
+
+impl Gender {
+    /// The gender's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Female => "female",
+            Self::Male => "male",
+        }
+    }
+}
+
+/// Who a person is: drawn once by the planner, so that every observer (labels, cameras, LiDAR, exports) sees the
+/// same person. Colours are sRGB.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Identity {
+    /// Body height, metres.
+    pub height_m: f64,
+    /// Age group.
+    pub age: AgeGroup,
+    /// Gender presentation.
+    pub gender: Gender,
+    /// Skin colour.
+    pub skin_rgb: [u8; 3],
+    /// Hair colour.
+    pub hair_rgb: [u8; 3],
+    /// Colour of the top (shirt, coat).
+    pub top_rgb: [u8; 3],
+    /// Colour of the trousers, skirt or shorts.
+    pub bottom_rgb: [u8; 3],
+    /// Colour of the shoes.
+    pub shoes_rgb: [u8; 3],
 }

@@ -270,7 +270,7 @@ pub fn annotate(
     let heights: Vec<(f64, Option<f64>)> = script
         .pedestrians
         .iter()
-        .map(|p| body::heights_m(p.body, script.seed, p.id))
+        .map(|p| (p.identity.height_m, p.child.map(|c| c.height_m)))
         .chain(std::iter::repeat((1.75, None)))
         .take(n_peds)
         .collect();

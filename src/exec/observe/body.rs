@@ -10,7 +10,7 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3};
 
-use crate::dsl::types::{Body, PoseFormat};
+use crate::dsl::types::PoseFormat;
 use crate::exec::trace::PedFrame;
 
 /// COCO-17 keypoint names, in COCO order.
@@ -133,22 +133,6 @@ impl BodyPose {
             self.ground + DMat3::from_rotation_z(self.yaw_rad) * ((lo + hi) * 0.5),
             hi - lo,
         )
-    }
-}
-
-/// Height of a pedestrian's main body and, for a parent with a child, the child's, metres. Drawn
-/// deterministically from the clip seed and the pedestrian id (adults 1.55–1.95 m, children 1.0–1.3 m).
-pub fn heights_m(body: Body, clip_seed: u64, pedestrian: u32) -> (f64, Option<f64>) {
-    let h = blake3::hash(&[clip_seed.to_le_bytes(), u64::from(pedestrian).to_le_bytes()].concat());
-    let b = h.as_bytes();
-    let u1 = f64::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0;
-    let u2 = f64::from(u16::from_le_bytes([b[2], b[3]])) / 65535.0;
-    let adult = 1.55 + 0.4 * u1;
-    let child = 1.0 + 0.3 * u2;
-    match body {
-        Body::Adult => (adult, None),
-        Body::Child => (child, None),
-        Body::AdultWithChild => (adult, Some(child)),
     }
 }
 
@@ -339,13 +323,5 @@ mod tests {
         out.clear();
         push_keypoints(&coco, PoseFormat::Coco17, true, &mut out);
         assert_eq!(out, coco);
-    }
-
-    #[test]
-    fn heights_are_deterministic_and_in_range() {
-        let (a, c) = heights_m(Body::AdultWithChild, 7, 3);
-        assert_eq!((a, c), heights_m(Body::AdultWithChild, 7, 3));
-        assert!((1.55..=1.95).contains(&a) && c.is_some_and(|c| (1.0..=1.3).contains(&c)));
-        assert!(heights_m(Body::Child, 7, 3).1.is_none());
     }
 }

@@ -26,7 +26,7 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 1;
+pub const SCHEMA_VERSION: u32 = 2;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
 pub const TABLES: [&str; 6] = ["frames", "pedestrians", "annotations", "vehicles", "events", "clips"];
@@ -209,6 +209,8 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             field("safety_margin_s", DataType::Float32, false),
             field("patience_s", DataType::Float32, false),
             field("height_m", DataType::Float32, false),
+            field("age_group", DataType::Utf8, false),
+            field("gender", DataType::Utf8, false),
             field("crosser", DataType::Boolean, false),
             field("first_crossing_frame", DataType::UInt32, true),
             field("intention_frame", DataType::UInt32, true),
@@ -231,7 +233,9 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             f32c(&|p| p.ttc_threshold_s),
             f32c(&|p| p.safety_margin_s),
             f32c(&|p| p.patience_s),
-            f32c(&|p| crate::exec::observe::body::heights_m(p.body, script.seed, p.id).0),
+            f32c(&|p| p.identity.height_m),
+            s(&|p| p.identity.age.name().to_owned()),
+            s(&|p| p.identity.gender.name().to_owned()),
             Arc::new(BooleanArray::from_iter((0..n).map(|i| Some(label(i).crosser)))),
             Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).first_crossing_frame))),
             Arc::new(UInt32Array::from_iter((0..n).map(|i| label(i).intention_frame))),
