@@ -131,6 +131,8 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
             direction: c.direction,
             carriageway_width_m: c.carriageway_width_m,
         }),
+        identity: pedsynth::planner::identity::identities(1, id, "casual_person", Body::Adult).0,
+        child: None,
     }
 }
 
