@@ -179,26 +179,36 @@ fn states(trace: &ClipTrace, i: usize) -> Vec<PedState> {
     out
 }
 
-/// No pedestrian disc overlaps a vehicle footprint in any frame, and there is no contact event.
-fn assert_no_interpenetration(trace: &ClipTrace) {
+/// Every (pedestrian, frame) whose ground disc overlaps a vehicle footprint.
+fn overlapping_frames(trace: &ClipTrace) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
     for (k, ped) in trace.pedestrians.iter().enumerate() {
         for (f, pf) in ped.iter().enumerate() {
-            for v in std::iter::once(&trace.ego).chain(trace.vehicles.iter()) {
+            let overlaps = std::iter::once(&trace.ego).chain(trace.vehicles.iter()).any(|v| {
                 let vf = &v[f];
-                let d = ttc::distance_to_box_m(
+                ttc::distance_to_box_m(
                     pf.pos.truncate(),
                     vf.pos.truncate(),
                     vf.yaw_rad,
                     VEHICLE_LENGTH_M / 2.0,
                     VEHICLE_WIDTH_M / 2.0,
-                );
-                assert!(
-                    d >= PED_RADIUS_M - 1e-9,
-                    "pedestrian {k} overlaps a vehicle at frame {f}"
-                );
+                ) < PED_RADIUS_M - 1e-9
+            });
+            if overlaps {
+                out.push((k, f));
             }
         }
     }
+    out
+}
+
+/// No pedestrian disc overlaps a vehicle footprint in any frame, and there is no contact event.
+fn assert_no_interpenetration(trace: &ClipTrace) {
+    let overlaps = overlapping_frames(trace);
+    assert!(
+        overlaps.is_empty(),
+        "(pedestrian, frame) overlapping a vehicle: {overlaps:?}"
+    );
     assert!(
         !trace.events.iter().any(|e| matches!(e, Event::Contact { .. })),
         "contacts: {:?}",
@@ -208,6 +218,57 @@ fn assert_no_interpenetration(trace: &ClipTrace) {
             .filter(|e| matches!(e, Event::Contact { .. }))
             .collect::<Vec<_>>()
     );
+}
+
+/// The input that makes agents touch, and the proof that the overlap check can fail: a mid-road jaywalker
+/// injected 2 m in front of a vehicle at 30 km/h that ignores walkers — it cannot stop in 2 m. Without the
+/// contact step of the simulation (step 7: record, push the pedestrian out, stop the vehicle) the footprint
+/// would cover the pedestrian; with it the collision is an event and no frame overlaps. The check itself is
+/// shown to fail on the same trace with the pedestrian put back under the vehicle.
+#[test]
+fn a_collision_is_recorded_and_resolved_so_that_nothing_overlaps() {
+    let net = road();
+    let mut p = crosser(&net, 0, 100.0, Behaviour::MidroadJaywalker, CrosserSource::Allocated);
+    let c = p.crossing.clone().expect("crossing");
+    // In the south lane (towards +x), on the vehicle's path, 2 m ahead of its front bumper.
+    p.spawn = c.near_curb + c.direction * 1.75;
+    p.spawn_place = SpawnPlace::DrivingLane;
+    p.base_speed_mps = 0.3;
+    let front_x = p.spawn.x - 2.0 - VEHICLE_LENGTH_M / 2.0;
+    let script = clip(
+        ego_at(&net, -45.0, 0.0),
+        vec![vehicle(&net, 0, true, front_x, 0.0, true)],
+        vec![p],
+        4,
+    );
+    let trace = simulate::simulate(&script, &params(), &net);
+    let contacts: Vec<&Event> = trace
+        .events
+        .iter()
+        .filter(|e| {
+            matches!(
+                e,
+                Event::Contact {
+                    pedestrian: Some(_),
+                    ..
+                }
+            )
+        })
+        .collect();
+    assert!(
+        !contacts.is_empty(),
+        "the input must make the vehicle touch the pedestrian"
+    );
+    assert!(
+        overlapping_frames(&trace).is_empty(),
+        "{:?}",
+        overlapping_frames(&trace)
+    );
+    // The check finds an overlap where there is one.
+    let mut broken = trace.clone();
+    let f = 10;
+    broken.pedestrians[0][f].pos = broken.vehicles[0][f].pos;
+    assert_eq!(overlapping_frames(&broken), vec![(0, f)]);
 }
 
 /// State-change events agree with the recorded states.
