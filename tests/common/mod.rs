@@ -37,7 +37,8 @@ pub fn carla_map(town: &str) -> Option<std::path::PathBuf> {
     if std::env::var_os("PEDSYNTH_REQUIRE_CARLA_MAPS").is_some_and(|v| !v.is_empty() && v != "0") {
         panic!("{why}; PEDSYNTH_REQUIRE_CARLA_MAPS forbids skipping");
     }
-    eprintln!("skipped: {why}");
+    static SAID: std::sync::Once = std::sync::Once::new();
+    SAID.call_once(|| skip(&why));
     None
 }
 
@@ -45,9 +46,15 @@ pub fn carla_map(town: &str) -> Option<std::path::PathBuf> {
 pub fn slow_tests(test: &str) -> bool {
     let on = std::env::var_os("PEDSYNTH_SLOW_TESTS").is_some_and(|v| !v.is_empty() && v != "0");
     if !on {
-        eprintln!("skipped: {test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it");
+        skip(&format!("{test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it"));
     }
     on
+}
+
+/// Says on stderr, past the test harness's capture (which only takes the print macros), why a test is skipped.
+fn skip(why: &str) {
+    use std::io::Write;
+    writeln!(std::io::stderr(), "skipped: {why}").ok();
 }
 
 /// A point inside lane piece `pi`: `along` ∈ [0,1] between its stations, `across` ∈ [0,1] inner→outer.
