@@ -46,7 +46,9 @@ pub fn carla_map(town: &str) -> Option<std::path::PathBuf> {
 pub fn slow_tests(test: &str) -> bool {
     let on = std::env::var_os("PEDSYNTH_SLOW_TESTS").is_some_and(|v| !v.is_empty() && v != "0");
     if !on {
-        skip(&format!("{test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it"));
+        skip(&format!(
+            "{test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it"
+        ));
     }
     on
 }

@@ -123,7 +123,6 @@ pub(crate) fn transition(
 ) {
     let params = ctx.params;
     let frame = ctx.next_frame;
-    let t = p.state_time_s;
 
     // Distraction (phone use) starts at its planned time, whatever the pedestrian is doing. A crosser waiting
     // for the ego's decision window does not pick up its phone before the attempt is over (it would miss the
@@ -188,202 +187,244 @@ pub(crate) fn transition(
     }
 
     match p.activity {
-        Activity::WalkingSidewalk => {
-            if !p.attempt.over() {
-                if p.attempt.at_curb() && group_ready {
-                    if p.traits.behaviour == Behaviour::Sudden {
-                        if ego_reached_window(p, params) {
-                            decide_to_cross(p, frame, events);
-                            switch_profile(p, params, SpeedProfile::Rushed);
-                            enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
-                        }
-                    } else {
-                        enter(p, Activity::LookingAround, frame, events);
-                    }
+        Activity::WalkingSidewalk => walking(p, ctx, group_ready, events),
+        Activity::LookingAround => looking_around(p, ctx, events),
+        Activity::CheckingTraffic => checking_traffic(p, ctx, events),
+        Activity::Hesitating => hesitating(p, ctx, events),
+        Activity::Crossing(mode) => crossing(p, ctx, mode, group_conflict, events),
+        Activity::PausingMidCross { cause, resume } => pausing(p, ctx, cause, resume, group_conflict, events),
+        Activity::Retreat => retreating(p, ctx, events),
+        Activity::FinishedCrossing => finished(p, ctx, events),
+        Activity::DistractedBehavior { resume } => distracted(p, ctx, resume, events),
+    }
+}
+
+/// WALKING_SIDEWALK: a crosser at its curb (with its group) starts looking (a sudden crosser steps out once the
+/// ego reaches the decision window); a walker scans from time to time.
+fn walking(p: &mut Ped, ctx: &StepCtx, group_ready: bool, events: &mut Vec<Event>) {
+    let (params, frame) = (ctx.params, ctx.next_frame);
+    if !p.attempt.over() {
+        if p.attempt.at_curb() && group_ready {
+            if p.traits.behaviour == Behaviour::Sudden {
+                if ego_reached_window(p, params) {
+                    decide_to_cross(p, frame, events);
+                    switch_profile(p, params, SpeedProfile::Rushed);
+                    enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
                 }
-            } else if ctx.time_s >= p.next_scan_s {
-                p.next_scan_s = ctx.time_s + motion::scan_interval_s(&mut p.rng, p.traits.attention);
+            } else {
                 enter(p, Activity::LookingAround, frame, events);
             }
         }
-        Activity::LookingAround => {
-            let over = p.attempt.over();
-            // A jaywalker, or any crosser with the ego already inside the decision window, only glances.
-            let brief = p.traits.behaviour == Behaviour::Jaywalk || (!over && ego_in_window(p, params));
-            if t < motion::scan_duration_s(p.traits.attention, brief || over) {
-                return;
-            }
-            if over {
-                enter(p, Activity::WalkingSidewalk, frame, events);
-            } else if p.traits.behaviour == Behaviour::Jaywalk {
-                // Mid-block crossing after a brief check: only a vehicle about to arrive holds it back.
-                let ttc = if ego_in_window(p, params) {
-                    p.percept.min_ttc_others_s
-                } else {
-                    p.percept.min_ttc_s
-                };
-                if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S {
-                    decide_to_cross(p, frame, events);
-                    enter(p, Activity::Crossing(CrossMode::Jaywalking), frame, events);
-                }
-            } else {
-                enter(p, Activity::CheckingTraffic, frame, events);
-            }
+    } else if ctx.time_s >= p.next_scan_s {
+        p.next_scan_s = ctx.time_s + motion::scan_interval_s(&mut p.rng, p.traits.attention);
+        enter(p, Activity::LookingAround, frame, events);
+    }
+}
+
+/// LOOKING_AROUND: after the scan, a walker walks on, a jaywalker crosses if no vehicle is about to arrive, a
+/// crosser checks the traffic.
+fn looking_around(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let (params, frame, t) = (ctx.params, ctx.next_frame, p.state_time_s);
+    let over = p.attempt.over();
+    // A jaywalker, or any crosser with the ego already inside the decision window, only glances.
+    let brief = p.traits.behaviour == Behaviour::Jaywalk || (!over && ego_in_window(p, params));
+    if t < motion::scan_duration_s(p.traits.attention, brief || over) {
+        return;
+    }
+    if over {
+        enter(p, Activity::WalkingSidewalk, frame, events);
+    } else if p.traits.behaviour == Behaviour::Jaywalk {
+        // Mid-block crossing after a brief check: only a vehicle about to arrive holds it back.
+        let ttc = if ego_in_window(p, params) {
+            p.percept.min_ttc_others_s
+        } else {
+            p.percept.min_ttc_s
+        };
+        if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S {
+            decide_to_cross(p, frame, events);
+            enter(p, Activity::Crossing(CrossMode::Jaywalking), frame, events);
         }
-        Activity::CheckingTraffic => {
-            if t < CHECK_MIN_S {
-                return;
-            }
-            let baseline = p.traits.source == CrosserSource::Baseline;
-            let go = if baseline {
-                baseline_clear(p)
-            } else {
-                ego_in_window_or_past(p, params) && gap_ok(p, params)
+    } else {
+        enter(p, Activity::CheckingTraffic, frame, events);
+    }
+}
+
+/// CHECKING_TRAFFIC: after a minimum check, the gap-acceptance rule (or CARLA's stop-and-check for a baseline
+/// crosser) decides to cross.
+fn checking_traffic(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let (params, frame) = (ctx.params, ctx.next_frame);
+    if p.state_time_s < CHECK_MIN_S {
+        return;
+    }
+    let baseline = p.traits.source == CrosserSource::Baseline;
+    let go = if baseline {
+        baseline_clear(p)
+    } else {
+        ego_in_window_or_past(p, params) && gap_ok(p, params)
+    };
+    if go {
+        let window_commit = !baseline && ego_in_window(p, params);
+        decide_to_cross(p, frame, events);
+        if let Attempt::Committed { window_commit: w, .. } = &mut p.attempt {
+            *w = window_commit;
+        }
+        enter(p, Activity::Hesitating, frame, events);
+    }
+}
+
+/// HESITATING: the decided crosser pauses at the road edge; it steps out after its hesitation time (earlier if
+/// the ego comes close) unless the gap is lost.
+fn hesitating(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let (params, frame, t) = (ctx.params, ctx.next_frame, p.state_time_s);
+    let threshold = gap_threshold_s(p, params);
+    let window_commit = matches!(
+        p.attempt,
+        Attempt::Committed {
+            window_commit: true,
+            ..
+        }
+    );
+    let lost = if p.traits.source == CrosserSource::Baseline {
+        !baseline_clear(p)
+    } else if window_commit {
+        // Committed with the ego in the window: only another vehicle about to arrive holds it back.
+        p.percept.min_ttc_others_s <= COMMIT_MIN_TTC_S
+    } else {
+        !gap_ok(p, params)
+    };
+    // Committed inside the window, a crosser cuts its hesitation short rather than let the ego come so close
+    // that stepping out would be unsafe.
+    let ego_closing_in = window_commit
+        && p.percept.ego_ahead
+        && p.percept.ego_dist_m <= params.decision_window_m.min() + HESITATION_CUTOFF_M;
+    if lost {
+        enter(p, Activity::CheckingTraffic, frame, events);
+    } else if t >= p.traits.hesitation_s || ego_closing_in {
+        // Closing a tight gap: rushed.
+        if p.percept.min_ttc_s < RUSHED_GAP_FACTOR * threshold {
+            switch_profile(p, params, SpeedProfile::Rushed);
+        }
+        enter(p, Activity::Crossing(CrossMode::CrossingRoad), frame, events);
+    }
+}
+
+/// A crossing mode: finishes beyond the far curb; a lookahead conflict pauses it (or, once per conflict, turns
+/// it back); a vehicle closing in makes it run.
+fn crossing(p: &mut Ped, ctx: &StepCtx, mode: CrossMode, group_conflict: Option<VehicleId>, events: &mut Vec<Event>) {
+    let (params, frame) = (ctx.params, ctx.next_frame);
+    let Some(line) = p.traits.line else {
+        return;
+    };
+    let along = line.along_m(p.body.pos);
+    if along >= line.width_m + FINISH_BEYOND_CURB_M {
+        p.attempt.end();
+        enter(p, Activity::FinishedCrossing, frame, events);
+    } else if let Some(vehicle) = group_conflict {
+        // A new conflict (a crossing mode is never entered with one open): one retreat draw.
+        let in_window = along / line.width_m < params.retreat.window_fraction;
+        let retreated = in_window && p.rng.random_bool(params.retreat.probability.clamp(0.0, 1.0));
+        events.push(Event::Conflict {
+            frame,
+            pedestrian: p.traits.id,
+            vehicle,
+            in_retreat_window: in_window,
+            retreated,
+        });
+        if retreated {
+            enter(p, Activity::Retreat, frame, events);
+        } else {
+            let pause = Activity::PausingMidCross {
+                cause: PauseCause::Conflict { clear_s: 0.0 },
+                resume: mode,
             };
-            if go {
-                let window_commit = !baseline && ego_in_window(p, params);
-                decide_to_cross(p, frame, events);
-                if let Attempt::Committed { window_commit: w, .. } = &mut p.attempt {
-                    *w = window_commit;
-                }
-                enter(p, Activity::Hesitating, frame, events);
-            }
+            enter(p, pause, frame, events);
         }
-        Activity::Hesitating => {
-            let threshold = gap_threshold_s(p, params);
-            let window_commit = matches!(
-                p.attempt,
-                Attempt::Committed {
-                    window_commit: true,
-                    ..
-                }
-            );
-            let lost = if p.traits.source == CrosserSource::Baseline {
-                !baseline_clear(p)
-            } else if window_commit {
-                // Committed with the ego in the window: only another vehicle about to arrive holds it back.
-                p.percept.min_ttc_others_s <= COMMIT_MIN_TTC_S
-            } else {
-                !gap_ok(p, params)
-            };
-            // Committed inside the window, a crosser cuts its hesitation short rather than let the ego come so
-            // close that stepping out would be unsafe.
-            let ego_closing_in = window_commit
-                && p.percept.ego_ahead
-                && p.percept.ego_dist_m <= params.decision_window_m.min() + HESITATION_CUTOFF_M;
-            if lost {
-                enter(p, Activity::CheckingTraffic, frame, events);
-            } else if t >= p.traits.hesitation_s || ego_closing_in {
-                // Closing a tight gap: rushed.
-                if p.percept.min_ttc_s < RUSHED_GAP_FACTOR * threshold {
-                    switch_profile(p, params, SpeedProfile::Rushed);
-                }
-                enter(p, Activity::Crossing(CrossMode::CrossingRoad), frame, events);
-            }
+    } else if along > 0.0 && mode != CrossMode::RunningAcross && must_run(p) {
+        // A vehicle is approaching while on the road: run.
+        switch_profile(p, params, SpeedProfile::Rushed);
+        enter(p, Activity::Crossing(CrossMode::RunningAcross), frame, events);
+    }
+}
+
+/// PAUSING_MID_CROSS: a phone pause ends after its time; a conflict pause once the lookahead has been clear for
+/// a while (running on if a vehicle is close), or turns back when a standing vehicle blocks the way too long.
+fn pausing(
+    p: &mut Ped,
+    ctx: &StepCtx,
+    cause: PauseCause,
+    resume: CrossMode,
+    group_conflict: Option<VehicleId>,
+    events: &mut Vec<Event>,
+) {
+    let (params, frame, t) = (ctx.params, ctx.next_frame, p.state_time_s);
+    let PauseCause::Conflict { clear_s } = cause else {
+        if t >= DISTRACTION_PAUSE_S {
+            enter(p, Activity::Crossing(resume), frame, events);
         }
-        Activity::Crossing(mode) => {
-            let Some(line) = p.traits.line else {
-                return;
-            };
-            let along = line.along_m(p.body.pos);
-            if along >= line.width_m + FINISH_BEYOND_CURB_M {
-                p.attempt.end();
-                enter(p, Activity::FinishedCrossing, frame, events);
-            } else if let Some(vehicle) = group_conflict {
-                // A new conflict (a crossing mode is never entered with one open): one retreat draw.
-                let in_window = along / line.width_m < params.retreat.window_fraction;
-                let retreated = in_window && p.rng.random_bool(params.retreat.probability.clamp(0.0, 1.0));
-                events.push(Event::Conflict {
-                    frame,
-                    pedestrian: p.traits.id,
-                    vehicle,
-                    in_retreat_window: in_window,
-                    retreated,
-                });
-                if retreated {
-                    enter(p, Activity::Retreat, frame, events);
-                } else {
-                    let pause = Activity::PausingMidCross {
-                        cause: PauseCause::Conflict { clear_s: 0.0 },
-                        resume: mode,
-                    };
-                    enter(p, pause, frame, events);
-                }
-            } else if along > 0.0 && mode != CrossMode::RunningAcross && must_run(p) {
-                // A vehicle is approaching while on the road: run.
-                switch_profile(p, params, SpeedProfile::Rushed);
-                enter(p, Activity::Crossing(CrossMode::RunningAcross), frame, events);
-            }
-        }
-        Activity::PausingMidCross {
-            cause: PauseCause::Phone,
+        return;
+    };
+    if group_conflict.is_some() {
+        p.activity = Activity::PausingMidCross {
+            cause: PauseCause::Conflict { clear_s: 0.0 },
             resume,
-        } => {
-            if t >= DISTRACTION_PAUSE_S {
-                enter(p, Activity::Crossing(resume), frame, events);
-            }
+        };
+        if p.percept.blocked_by_standing && t >= BLOCKED_RETREAT_S {
+            // Blocked by a vehicle that waits for us: step back to the curb and let it go.
+            enter(p, Activity::Retreat, frame, events);
         }
-        Activity::PausingMidCross {
-            cause: PauseCause::Conflict { clear_s },
-            resume,
-        } => {
-            if group_conflict.is_some() {
-                p.activity = Activity::PausingMidCross {
-                    cause: PauseCause::Conflict { clear_s: 0.0 },
-                    resume,
-                };
-                if p.percept.blocked_by_standing && t >= BLOCKED_RETREAT_S {
-                    // Blocked by a vehicle that waits for us: step back to the curb and let it go.
-                    enter(p, Activity::Retreat, frame, events);
-                }
-            } else {
-                let clear_s = clear_s + ctx.dt_s;
-                p.activity = Activity::PausingMidCross {
-                    cause: PauseCause::Conflict { clear_s },
-                    resume,
-                };
-                if clear_s >= CONFLICT_CLEAR_S {
-                    let next = if must_run(p) { CrossMode::RunningAcross } else { resume };
-                    if next == CrossMode::RunningAcross {
-                        switch_profile(p, params, SpeedProfile::Rushed);
-                    }
-                    enter(p, Activity::Crossing(next), frame, events);
-                }
-            }
+        return;
+    }
+    let clear_s = clear_s + ctx.dt_s;
+    p.activity = Activity::PausingMidCross {
+        cause: PauseCause::Conflict { clear_s },
+        resume,
+    };
+    if clear_s >= CONFLICT_CLEAR_S {
+        let next = if must_run(p) { CrossMode::RunningAcross } else { resume };
+        if next == CrossMode::RunningAcross {
+            switch_profile(p, params, SpeedProfile::Rushed);
         }
-        Activity::Retreat => {
-            let Some(line) = p.traits.line else {
-                return;
-            };
-            if line.along_m(p.body.pos) <= -CURB_STANDOFF_M + 1e-6 {
-                p.attempt.reach_curb();
-                switch_profile(p, params, p.traits.initial_profile);
-                enter(p, Activity::CheckingTraffic, frame, events);
-            }
+        enter(p, Activity::Crossing(next), frame, events);
+    }
+}
+
+/// RETREAT: back at the curb, the crosser checks the traffic again.
+fn retreating(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let Some(line) = p.traits.line else {
+        return;
+    };
+    if line.along_m(p.body.pos) <= -CURB_STANDOFF_M + 1e-6 {
+        p.attempt.reach_curb();
+        switch_profile(p, ctx.params, p.traits.initial_profile);
+        enter(p, Activity::CheckingTraffic, ctx.next_frame, events);
+    }
+}
+
+/// FINISHED_CROSSING: at the end of its crossing (or after a while), the pedestrian walks on along the far
+/// sidewalk, either way.
+fn finished(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
+    let Some(line) = p.traits.line else {
+        return;
+    };
+    if line.along_m(p.body.pos) >= line.end_along_m() - FINISHED_ARRIVAL_M || p.state_time_s > FINISHED_MAX_S {
+        switch_profile(p, ctx.params, p.traits.initial_profile);
+        let side = if p.rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        p.walker = SidewalkWalker::start(ctx.net, p.body.pos, line.dir.perp() * side);
+        enter(p, Activity::WalkingSidewalk, ctx.next_frame, events);
+    }
+}
+
+/// DISTRACTED_BEHAVIOR: after its phone-use episode, the pedestrian returns to what it was doing.
+fn distracted(p: &mut Ped, ctx: &StepCtx, resume: AfterPhone, events: &mut Vec<Event>) {
+    if p.state_time_s >= p.traits.distraction_len_s {
+        if p.traits.initial_profile != SpeedProfile::Distracted {
+            switch_profile(p, ctx.params, p.traits.initial_profile);
         }
-        Activity::FinishedCrossing => {
-            let Some(line) = p.traits.line else {
-                return;
-            };
-            if line.along_m(p.body.pos) >= line.end_along_m() - FINISHED_ARRIVAL_M || t > FINISHED_MAX_S {
-                switch_profile(p, params, p.traits.initial_profile);
-                let side = if p.rng.random_bool(0.5) { 1.0 } else { -1.0 };
-                p.walker = SidewalkWalker::start(ctx.net, p.body.pos, line.dir.perp() * side);
-                enter(p, Activity::WalkingSidewalk, frame, events);
-            }
-        }
-        Activity::DistractedBehavior { resume } => {
-            if t >= p.traits.distraction_len_s {
-                if p.traits.initial_profile != SpeedProfile::Distracted {
-                    switch_profile(p, params, p.traits.initial_profile);
-                }
-                let to = match resume {
-                    AfterPhone::WalkingSidewalk => Activity::WalkingSidewalk,
-                    AfterPhone::LookingAround => Activity::LookingAround,
-                };
-                enter(p, to, frame, events);
-            }
-        }
+        let to = match resume {
+            AfterPhone::WalkingSidewalk => Activity::WalkingSidewalk,
+            AfterPhone::LookingAround => Activity::LookingAround,
+        };
+        enter(p, to, ctx.next_frame, events);
     }
 }
 
