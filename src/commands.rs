@@ -206,7 +206,7 @@ pub fn plan(spec_path: &Path, options: &LoadOptions, args: &PlanArgs, out: &mut 
     let text = if args.json {
         crate::error::to_json(&stats, true)? + "\n"
     } else {
-        planner::stats::render_text(&stats)
+        stats.to_string()
     };
     emit(out, &text)
 }
@@ -222,18 +222,7 @@ pub fn town_show(town: &str, png: Option<&Path>, json: bool, out: &mut dyn Write
     emit(out, &text)
 }
 
-/// Options of `pedsynth generate`.
-#[derive(Clone, Debug, Default)]
-pub struct GenerateArgs {
-    /// Output directory.
-    pub out: PathBuf,
-    /// Worker threads.
-    pub jobs: Option<usize>,
-    /// Generate only this clip.
-    pub only: Option<String>,
-    /// No progress output.
-    pub quiet: bool,
-}
+pub use crate::exec::generate::GenerateOptions as GenerateArgs;
 
 /// Reads a plan file (`pedsynth plan --emit`) and the towns it names (relative paths resolve against the
 /// directory the plan was made in, as recorded in the plan).
@@ -278,13 +267,7 @@ pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &
         let towns = load_towns(&loaded)?;
         (compile(&loaded, &towns, None)?, towns)
     };
-    let gen_options = crate::exec::generate::GenerateOptions {
-        out_dir: args.out.clone(),
-        jobs: args.jobs,
-        only: args.only.clone(),
-        quiet: args.quiet,
-    };
-    let report = crate::exec::generate::generate(&plan, &towns, &gen_options)?;
+    let report = crate::exec::generate::generate(&plan, &towns, args)?;
     emit(
         out,
         &format!(

@@ -6,8 +6,6 @@
 //! every code with its kind and meaning; README.md's table of codes is generated from it (a test fails when the
 //! two drift, and another when a code appears in the source but not here).
 
-use std::fmt::Write as _;
-
 use crate::dsl::SpecErrors;
 use crate::dsl::diagnostic::code as spec;
 use crate::world::WorldError;
@@ -198,7 +196,7 @@ pub fn code_info(code: &str) -> Option<&'static CodeInfo> {
 pub fn codes_markdown() -> String {
     let mut out = String::from("| code | exit | meaning |\n|---|---|---|\n");
     for c in CODES {
-        let _ = writeln!(out, "| `{}` | {} | {} |", c.code, c.kind.exit_code(), c.meaning);
+        out.push_str(&format!("| `{}` | {} | {} |\n", c.code, c.kind.exit_code(), c.meaning));
     }
     out
 }
@@ -303,7 +301,7 @@ impl Error {
             Error::Other { code, message, help } => {
                 let mut out = format!("{code}\n\n  × {message}\n");
                 if let Some(help) = help {
-                    let _ = writeln!(out, "  help: {help}");
+                    out.push_str(&format!("  help: {help}\n"));
                 }
                 out
             }

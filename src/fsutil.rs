@@ -23,7 +23,9 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         std::fs::rename(&tmp, path)
     })();
     if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        // The write failed (the error is returned): the temporary file goes too, if it can; a leftover one is
+        // removed by the next run (`DatasetWriter::open`).
+        std::fs::remove_file(&tmp).ok();
     }
     result
 }

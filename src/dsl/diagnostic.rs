@@ -214,7 +214,10 @@ impl SpecErrors {
         out.push('\n');
         for problem in &self.problems {
             out.push('\n');
-            let _ = handler.render_report(&mut out, problem);
+            if handler.render_report(&mut out, problem).is_err() {
+                // Rendering into a String fails only on a formatting bug: keep the message rather than lose it.
+                out.push_str(&format!("{}: {}\n", problem.problem.code, problem.problem.message));
+            }
         }
         out
     }

@@ -140,7 +140,16 @@ pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptio
         }
     }
 
-    let mut merged = serde_json::to_value(Spec::default()).unwrap_or_default();
+    let mut merged = match serde_json::to_value(Spec::default()) {
+        Ok(defaults) => defaults,
+        Err(e) => {
+            let problem = Problem::new(
+                code::IO,
+                format!("internal error: cannot serialise the spec's defaults: {e}"),
+            );
+            return fail(vec![problem], &sources);
+        }
+    };
     merge(&mut merged, root.to_json(), None);
     let spec: Spec = match serde_json::from_value(merged) {
         Ok(spec) => spec,

@@ -2,7 +2,6 @@
 //! value and as human-readable tables (`pedsynth plan`).
 
 use std::collections::BTreeMap;
-use std::fmt::Write;
 
 use serde::Serialize;
 
@@ -322,113 +321,116 @@ fn share(n: usize, total: usize) -> String {
     }
 }
 
-/// Renders the statistics as human-readable tables.
-pub fn render_text(stats: &PlanStats) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "plan for dataset `{}` (spec {})",
-        stats.dataset,
-        &stats.spec_hash[..stats.spec_hash.len().min(12)]
-    );
-    let _ = writeln!(out);
-    // Clips per town × weather.
-    let towns: Vec<&str> = {
-        let mut t: Vec<&str> = stats.cells.iter().map(|c| c.town.as_str()).collect();
-        t.dedup();
-        t.sort();
-        t.dedup();
-        t
-    };
-    let mut weathers: Vec<&str> = stats.cells.iter().map(|c| c.weather.as_str()).collect();
-    weathers.sort();
-    weathers.dedup();
-    let width = towns.iter().map(|t| t.len()).max().unwrap_or(4).max(5);
-    let _ = write!(out, "clips per town × weather\n{:width$}", "");
-    for w in &weathers {
-        let _ = write!(out, " {:>w$}", w, w = w.len().max(4));
-    }
-    let _ = writeln!(out, " {:>5}", "total");
-    for t in &towns {
-        let _ = write!(out, "{t:width$}");
-        let mut total = 0;
-        for w in &weathers {
-            let n = stats
-                .cells
-                .iter()
-                .find(|c| c.town == *t && c.weather == *w)
-                .map_or(0, |c| c.clips);
-            total += n;
-            let _ = write!(out, " {:>w$}", n, w = w.len().max(4));
-        }
-        let _ = writeln!(out, " {total:>5}");
-    }
-    let _ = writeln!(out);
-    let _ = writeln!(out, "clips                 {}", stats.clips);
-    let _ = writeln!(
-        out,
-        "frames                {} ({:.1} per clip, {:.1} s in all)",
-        stats.frames, stats.mean_frames_per_clip, stats.duration_s
-    );
-    let _ = writeln!(out, "pedestrians           {}", stats.pedestrians);
-    let _ = writeln!(
-        out,
-        "planned crossers      {} (allocated {}, baseline {})",
-        stats.crossers,
-        stats.crossers_by_source.get("allocated").copied().unwrap_or(0),
-        stats.crossers_by_source.get("baseline").copied().unwrap_or(0)
-    );
-    let _ = writeln!(
-        out,
-        "planned crossing ratio {:.3}: expected labelled crossing ratio {:.3} (target {:.3})",
-        stats.planned_crossing_ratio, stats.expected_crossing_ratio, stats.target_crossing_ratio
-    );
-    let _ = writeln!(out, "vehicles              {}", stats.vehicles);
-    let _ = writeln!(
-        out,
-        "pedestrian-frames     {} (≈ {} annotated samples)",
-        stats.pedestrian_frames, stats.estimated_annotated_samples
-    );
-    let section = |out: &mut String, title: &str, map: &BTreeMap<String, usize>, total: usize| {
-        let _ = writeln!(out, "\n{title}");
-        for (k, v) in map {
-            let _ = writeln!(out, "  {k:<20} {v:>7} {}", share(*v, total));
-        }
-    };
-    section(&mut out, "archetypes", &stats.archetypes, stats.pedestrians);
-    section(&mut out, "behaviours", &stats.behaviours, stats.pedestrians);
-    section(&mut out, "speed profiles", &stats.speed_profiles, stats.pedestrians);
-    section(&mut out, "driving profiles", &stats.driving_profiles, stats.vehicles);
-    let g = &stats.groups;
-    let _ = writeln!(
-        out,
-        "\ngroups\n  {} groups ({} pairs, {} triples), {} grouped pedestrians",
-        g.groups, g.pairs, g.triples, g.grouped_pedestrians
-    );
-    let _ = writeln!(out, "\nsplits");
-    for (name, s) in &stats.splits {
-        let _ = writeln!(
+/// The statistics as human-readable tables.
+impl std::fmt::Display for PlanStats {
+    fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let stats = self;
+        writeln!(
             out,
-            "  {name:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers",
-            s.clips, s.frames, s.pedestrians, s.crossers
-        );
+            "plan for dataset `{}` (spec {})",
+            stats.dataset,
+            &stats.spec_hash[..stats.spec_hash.len().min(12)]
+        )?;
+        writeln!(out)?;
+        // Clips per town × weather.
+        let towns: Vec<&str> = {
+            let mut t: Vec<&str> = stats.cells.iter().map(|c| c.town.as_str()).collect();
+            t.dedup();
+            t.sort();
+            t.dedup();
+            t
+        };
+        let mut weathers: Vec<&str> = stats.cells.iter().map(|c| c.weather.as_str()).collect();
+        weathers.sort();
+        weathers.dedup();
+        let width = towns.iter().map(|t| t.len()).max().unwrap_or(4).max(5);
+        write!(out, "clips per town × weather\n{:width$}", "")?;
+        for w in &weathers {
+            write!(out, " {:>w$}", w, w = w.len().max(4))?;
+        }
+        writeln!(out, " {:>5}", "total")?;
+        for t in &towns {
+            write!(out, "{t:width$}")?;
+            let mut total = 0;
+            for w in &weathers {
+                let n = stats
+                    .cells
+                    .iter()
+                    .find(|c| c.town == *t && c.weather == *w)
+                    .map_or(0, |c| c.clips);
+                total += n;
+                write!(out, " {:>w$}", n, w = w.len().max(4))?;
+            }
+            writeln!(out, " {total:>5}")?;
+        }
+        writeln!(out)?;
+        writeln!(out, "clips                 {}", stats.clips)?;
+        writeln!(
+            out,
+            "frames                {} ({:.1} per clip, {:.1} s in all)",
+            stats.frames, stats.mean_frames_per_clip, stats.duration_s
+        )?;
+        writeln!(out, "pedestrians           {}", stats.pedestrians)?;
+        writeln!(
+            out,
+            "planned crossers      {} (allocated {}, baseline {})",
+            stats.crossers,
+            stats.crossers_by_source.get("allocated").copied().unwrap_or(0),
+            stats.crossers_by_source.get("baseline").copied().unwrap_or(0)
+        )?;
+        writeln!(
+            out,
+            "planned crossing ratio {:.3}: expected labelled crossing ratio {:.3} (target {:.3})",
+            stats.planned_crossing_ratio, stats.expected_crossing_ratio, stats.target_crossing_ratio
+        )?;
+        writeln!(out, "vehicles              {}", stats.vehicles)?;
+        writeln!(
+            out,
+            "pedestrian-frames     {} (≈ {} annotated samples)",
+            stats.pedestrian_frames, stats.estimated_annotated_samples
+        )?;
+        for (title, map, total) in [
+            ("archetypes", &stats.archetypes, stats.pedestrians),
+            ("behaviours", &stats.behaviours, stats.pedestrians),
+            ("speed profiles", &stats.speed_profiles, stats.pedestrians),
+            ("driving profiles", &stats.driving_profiles, stats.vehicles),
+        ] {
+            writeln!(out, "\n{title}")?;
+            for (k, v) in map {
+                writeln!(out, "  {k:<20} {v:>7} {}", share(*v, total))?;
+            }
+        }
+        let g = &stats.groups;
+        writeln!(
+            out,
+            "\ngroups\n  {} groups ({} pairs, {} triples), {} grouped pedestrians",
+            g.groups, g.pairs, g.triples, g.grouped_pedestrians
+        )?;
+        writeln!(out, "\nsplits")?;
+        for (name, s) in &stats.splits {
+            writeln!(
+                out,
+                "  {name:<6} {:>6} clips {:>9} frames {:>7} pedestrians {:>7} crossers",
+                s.clips, s.frames, s.pedestrians, s.crossers
+            )?;
+        }
+        writeln!(
+            out,
+            "\nestimated generation time {:.1} s on one core, {:.1} s on two (annotation tables; sensors are not rendered yet)",
+            stats.estimated_generation_cpu_s,
+            stats.estimated_generation_cpu_s / 2.0
+        )?;
+        writeln!(
+            out,
+            "\nestimated output size (total {})",
+            human_bytes(stats.estimated_bytes.total)
+        )?;
+        for (k, v) in &stats.estimated_bytes.tables {
+            writeln!(out, "  table  {k:<12} {:>10}", human_bytes(*v))?;
+        }
+        for (k, v) in &stats.estimated_bytes.sensors {
+            writeln!(out, "  sensor {k:<12} {:>10}", human_bytes(*v))?;
+        }
+        Ok(())
     }
-    let _ = writeln!(
-        out,
-        "\nestimated generation time {:.1} s on one core, {:.1} s on two (annotation tables; sensors are not rendered yet)",
-        stats.estimated_generation_cpu_s,
-        stats.estimated_generation_cpu_s / 2.0
-    );
-    let _ = writeln!(
-        out,
-        "\nestimated output size (total {})",
-        human_bytes(stats.estimated_bytes.total)
-    );
-    for (k, v) in &stats.estimated_bytes.tables {
-        let _ = writeln!(out, "  table  {k:<12} {:>10}", human_bytes(*v));
-    }
-    for (k, v) in &stats.estimated_bytes.sensors {
-        let _ = writeln!(out, "  sensor {k:<12} {:>10}", human_bytes(*v));
-    }
-    out
 }

@@ -21,7 +21,7 @@ use progress::Progress;
 #[derive(Clone, Debug, Default)]
 pub struct GenerateOptions {
     /// Output directory.
-    pub out_dir: PathBuf,
+    pub out: PathBuf,
     /// Worker threads (None: one per core).
     pub jobs: Option<usize>,
     /// Generate only this clip.
@@ -45,7 +45,7 @@ pub struct GenerateReport {
     pub samples: u64,
 }
 
-/// Generates the dataset of `plan` into `options.out_dir`.
+/// Generates the dataset of `plan` into `options.out`.
 pub fn generate(
     plan: &Plan,
     towns: &BTreeMap<String, TownContext>,
@@ -70,7 +70,7 @@ pub fn generate(
             ));
         }
     }
-    let writer = DatasetWriter::open(&options.out_dir, plan)?;
+    let writer = DatasetWriter::open(&options.out, plan)?;
     let selected: Vec<&ClipScript> = plan
         .clips
         .iter()

@@ -231,9 +231,8 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
     Ok(net)
 }
 
-fn parse_link(cx: &Ctx, n: Node) -> Option<RoadLink> {
+fn parse_link(n: Node) -> Option<RoadLink> {
     let element_id = n.attribute("elementId")?.to_string();
-    let _ = cx;
     Some(RoadLink {
         element_type: n.attribute("elementType").unwrap_or("road").to_string(),
         element_id,
@@ -266,8 +265,8 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
         objects: Vec::new(),
     };
     if let Some(link) = child(n, "link") {
-        road.predecessor = child(link, "predecessor").and_then(|p| parse_link(cx, p));
-        road.successor = child(link, "successor").and_then(|p| parse_link(cx, p));
+        road.predecessor = child(link, "predecessor").and_then(parse_link);
+        road.successor = child(link, "successor").and_then(parse_link);
     }
     for t in children(n, "type") {
         let s = cx.num_or(t, "s", 0.0)?;
