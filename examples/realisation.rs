@@ -1,27 +1,43 @@
 //! Measures the crossing realisation that `src/calibration.rs` records: the share of planned crossers (layer 1)
 //! that end up labelled crossers (C = 1 in at least one annotated frame), per spec.
 //!
-//! Run: `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml`
+//! Run: `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml [--set KEY=VALUE]...`
 
 use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::observe::{annotate, rig::Camera};
+use pedsynth::exec::observe::{self, rig::Rig};
 use pedsynth::exec::simulate;
 use pedsynth::planner::{CrosserSource, Role};
 use pedsynth::world::LaneType;
 use rayon::prelude::*;
 
 fn main() {
-    for spec in std::env::args().skip(1) {
-        let (_, towns, plan) = match pedsynth::commands::plan_spec_file(Path::new(&spec), &LoadOptions::default()) {
+    // `--set KEY=VALUE` arguments apply to every spec.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let overrides: Vec<String> = args
+        .windows(2)
+        .filter(|w| w[0] == "--set")
+        .map(|w| w[1].clone())
+        .collect();
+    let specs = args
+        .iter()
+        .enumerate()
+        .filter(|(i, a)| *a != "--set" && (*i == 0 || args[i - 1] != "--set"))
+        .map(|(_, a)| a.clone());
+    let options = LoadOptions {
+        overrides,
+        allow_large: false,
+    };
+    for spec in specs {
+        let (_, towns, plan) = match pedsynth::commands::plan_spec_file(Path::new(&spec), &options) {
             Ok(x) => x,
             Err(e) => {
                 eprintln!("{e}");
                 std::process::exit(2);
             }
         };
-        let camera = Camera::from_spec(&plan.spec.sensors.rgb);
+        let rig = Rig::from_spec(&plan.spec.sensors);
         // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled)
         let counts: Vec<[usize; 6]> = plan
             .clips
@@ -29,7 +45,7 @@ fn main() {
             .map(|clip| {
                 let net = &towns[&clip.town].network;
                 let trace = simulate::simulate(clip, &plan.sim, net);
-                let ann = annotate::annotate(clip, &trace, &plan.spec.annotations, &camera, net);
+                let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
                 let mut c = [0usize; 6];
                 for (i, p) in clip.pedestrians.iter().enumerate() {
                     c[0] += 1;

@@ -9,7 +9,11 @@
 //! `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml` and update the
 //! constant (and BENCHMARKS.md's "Crossing-rate calibration" section).
 
-/// Share of crossers planned by layer 1 that are labelled crossers in the dataset. Measured 2026-11-21 with the
-/// command above: 0.919 on specs/balanced_50.yaml (929 allocated crossers), 0.905 on specs/pedsynth_pp.yaml
-/// (2,880); 98–99% of them step onto a driving lane, the rest cross unseen (after the ego passed, or too far).
-pub const CROSSER_REALISATION: f64 = 0.90;
+/// Share of crossers planned by layer 1 that are labelled crossers in the dataset. Measured 2026-11-23 with the
+/// command above at a 0.6 target, after the pre-crossing timeline (crossers step out once the ego's camera has
+/// seen them; the ego eases off and yields): 0.829 on specs/pedsynth_pp.yaml (3,122 allocated crossers), 0.787
+/// on specs/balanced_50.yaml (1,250); 0.794 on the held-out tests/data/specs/heldout_crossing.yaml (906), which
+/// is not used to set it. 84–89% step onto a driving lane in view; the rest cross after the ego has passed, or
+/// not within the clip. The spread between specs (clips are few and crossers within a clip interact) is why the
+/// crossing-rate test allows ±3 percentage points.
+pub const CROSSER_REALISATION: f64 = 0.81;

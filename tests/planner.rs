@@ -22,7 +22,7 @@ fn compile(spec: &str, overrides: &[String]) -> (dsl::LoadedSpec, BTreeMap<Strin
         overrides: overrides.to_vec(),
         allow_large: true,
     };
-    pedsynth::commands::plan_spec_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{e}"))
+    pedsynth::commands::plan_spec_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{}", e.render()))
 }
 
 const CARLA: &str = "tests/data/specs/carla_town01.yaml";
@@ -290,7 +290,7 @@ proptest! {
     /// Planned proportions match every mix within one unit of rounding per stratum, whatever the seed, target
     /// and mixes.
     #[test]
-    fn quotas_hold_for_any_mix(seed in any::<u64>(), target in 0.2f64..0.8, normal in 0.0f64..1.0, groups in any::<bool>(), l2 in any::<bool>()) {
+    fn quotas_hold_for_any_mix(seed in any::<u64>(), target in 0.2f64..0.75, normal in 0.0f64..1.0, groups in any::<bool>(), l2 in any::<bool>()) {
         let sudden = (1.0 - normal) / 2.0;
         let overrides = vec![
             format!("dataset.seed={seed}"),

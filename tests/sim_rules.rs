@@ -77,6 +77,12 @@ fn ego_at(net: &RoadNetwork, x: f64, speed_below_limit_pct: f64) -> EgoScript {
         min_gap_m: 2.5,
         brake_ahead_m: 15.0,
         brake_lateral_m: 5.0,
+        // No courtesy in the rule tests (its own tests switch it on): no easing off, no stopping short.
+        courtesy_speed_mps: 100.0,
+        courtesy_ahead_m: 35.0,
+        courtesy_lateral_m: 10.0,
+        courtesy_stop_short_m: 8.0,
+        courtesy_patience_s: 0.0,
     }
 }
 
@@ -131,6 +137,8 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
             direction: c.direction,
             carriageway_width_m: c.carriageway_width_m,
         }),
+        in_view_before_crossing_s: None,
+        curb_wait_s: None,
         identity: pedsynth::planner::identity::identities(1, id, "casual_person", Body::Adult).0,
         child: None,
     }
@@ -159,6 +167,7 @@ fn clip(
         ego,
         vehicles,
         pedestrians,
+        timeline_extension_s: 0.0,
     }
 }
 

@@ -556,6 +556,31 @@ impl Validator<'_> {
             200.0,
             "a distance to the ego in metres",
         );
+        self.range(
+            "crossing.timeline.in_view_before_crossing_s",
+            c.timeline.in_view_before_crossing_s,
+            0.0,
+            60.0,
+            "a time in view of the camera in seconds",
+        );
+        self.range(
+            "crossing.timeline.approach_m",
+            c.timeline.approach_m,
+            0.0,
+            100.0,
+            "a walking distance in metres",
+        );
+        self.probability(
+            "crossing.hard_negatives.share_of_non_crossers",
+            c.hard_negatives.share_of_non_crossers,
+        );
+        self.range(
+            "crossing.hard_negatives.wait_at_curb_s",
+            c.hard_negatives.wait_at_curb_s,
+            0.0,
+            600.0,
+            "a waiting time in seconds",
+        );
 
         let before = self.problems.len();
         let (lo, hi) = reachable_crossing_ratio(c);
@@ -682,6 +707,41 @@ impl Validator<'_> {
             0.0,
             1000.0,
             "a distance in metres",
+        );
+        self.range(
+            "traffic.ego.courtesy_speed_mps",
+            t.ego.courtesy_speed_mps,
+            0.0,
+            40.0,
+            "a speed in m/s",
+        );
+        self.num(
+            "traffic.ego.courtesy_ahead_m",
+            t.ego.courtesy_ahead_m,
+            0.0,
+            200.0,
+            "a distance in metres",
+        );
+        self.num(
+            "traffic.ego.courtesy_lateral_m",
+            t.ego.courtesy_lateral_m,
+            0.0,
+            50.0,
+            "a distance in metres",
+        );
+        self.num(
+            "traffic.ego.courtesy_stop_short_m",
+            t.ego.courtesy_stop_short_m,
+            0.0,
+            50.0,
+            "a distance in metres",
+        );
+        self.range(
+            "traffic.ego.courtesy_patience_s",
+            t.ego.courtesy_patience_s,
+            0.0,
+            120.0,
+            "a waiting time in seconds",
         );
         self.probability("traffic.emergency.clip_share", t.emergency.clip_share);
     }

@@ -409,6 +409,18 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
             }
         }
     }
+
+    // Hard negatives: an exact share of the non-crossers, chosen at random.
+    let non_crossers: Vec<usize> = (0..n).filter(|&i| out[i].source == CrosserSource::None).collect();
+    let h = c.hard_negatives.share_of_non_crossers.clamp(0.0, 1.0);
+    let hard = quota::largest_remainder(non_crossers.len(), &[h, 1.0 - h])[0];
+    let mut hard_rng = seeds::rng_for(seed, &tag("hard_negatives"));
+    let chosen = quota::weighted_choice(hard, &vec![1.0; non_crossers.len()], &mut hard_rng);
+    for (k, &i) in non_crossers.iter().enumerate() {
+        if chosen[k] {
+            out[i].behaviour = Behaviour::HardNegative;
+        }
+    }
     out
 }
 
@@ -450,6 +462,11 @@ fn plan_clip(
             min_gap_m: ego_spec.min_gap_m,
             brake_ahead_m: ego_spec.brake_ahead_m,
             brake_lateral_m: ego_spec.brake_lateral_m,
+            courtesy_speed_mps: draw(&mut rng, ego_spec.courtesy_speed_mps),
+            courtesy_ahead_m: ego_spec.courtesy_ahead_m,
+            courtesy_lateral_m: ego_spec.courtesy_lateral_m,
+            courtesy_stop_short_m: ego_spec.courtesy_stop_short_m,
+            courtesy_patience_s: draw(&mut rng, ego_spec.courtesy_patience_s),
         };
         let placed = plan_pedestrians(
             spec,
@@ -477,6 +494,18 @@ fn plan_clip(
     let Some((ego, pedestrians, vehicles)) = planned else {
         return Err(format!("{last_error} (tried {ROUTE_ATTEMPTS} ego routes)"));
     };
+    // The clip lasts at least as long as its crossers' timelines, up to a cap.
+    let cruise_mps = ego_cruise_mps(net, &ego);
+    let needed_s = pedestrians
+        .iter()
+        .filter_map(|p| timeline_duration_s(p, cruise_mps))
+        .fold(0.0, f64::max);
+    let extension_s = (needed_s - duration_s).clamp(0.0, (MAX_TIMELINE_EXTENSION - 1.0) * duration_s);
+    let frame_count = if extension_s > 0.0 {
+        ((duration_s + extension_s) * f64::from(fps)).round() as u32
+    } else {
+        basics.frame_count
+    };
 
     Ok(ClipScript {
         clip_id: basics.clip_id.clone(),
@@ -491,11 +520,49 @@ fn plan_clip(
             .copied()
             .unwrap_or(spec.dataset.default_split),
         fps,
-        frame_count: basics.frame_count,
+        frame_count,
         ego,
         vehicles,
         pedestrians,
+        timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
     })
+}
+
+/// A clip is lengthened to at most this multiple of its drawn duration for its crossers' timelines.
+const MAX_TIMELINE_EXTENSION: f64 = 2.0;
+/// Distance at which the planner estimates that the ego's camera starts to see a pedestrian, metres (the
+/// visibility gate admits an adult within about 30–35 m; the simulation decides the real moment).
+const VIEW_DISTANCE_ESTIMATE_M: f64 = 30.0;
+/// Time after a crossing for the crosser to reach the far sidewalk in view, seconds.
+const CROSSING_MARGIN_S: f64 = 1.5;
+
+/// The ego's cruising speed at its start, m/s.
+fn ego_cruise_mps(net: &RoadNetwork, ego: &EgoScript) -> f64 {
+    let limit = ego
+        .route
+        .lanes
+        .first()
+        .and_then(|&l| net.lanes.get(l as usize))
+        .map_or(30.0 / 3.6, |l| {
+            if l.speed_limit_mps > 0.5 {
+                l.speed_limit_mps
+            } else {
+                30.0 / 3.6
+            }
+        });
+    (limit * (1.0 - ego.speed_below_limit_pct / 100.0)).max(1.0)
+}
+
+/// The time a crosser's timeline needs from the clip's start, seconds: until it is in view (the ego comes within
+/// view, or it walks to its curb), its time in view, and the crossing.
+fn timeline_duration_s(p: &PedestrianScript, cruise_mps: f64) -> Option<f64> {
+    let in_view_s = p.in_view_before_crossing_s?;
+    let crossing = p.crossing.as_ref()?;
+    let speed = p.base_speed_mps.max(0.3);
+    let curb = crossing.near_curb - crossing.direction * CURB_STANDOFF_M;
+    let approach_s = p.spawn.distance(curb) / speed;
+    let into_view_s = (p.ahead_of_ego_m - VIEW_DISTANCE_ESTIMATE_M).max(0.0) / cruise_mps;
+    Some(approach_s.max(into_view_s) + in_view_s + crossing.carriageway_width_m / speed + CROSSING_MARGIN_S)
 }
 
 fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
@@ -515,6 +582,16 @@ fn route_script(route: &Route, start_s_m: f64) -> RouteScript {
     }
 }
 
+/// The ego's speed while easing off for a waiting pedestrian, as the planner estimates it when placing crossers,
+/// m/s (within the default courtesy speeds; the simulation decides the real speed).
+const COURTESY_SPEED_ESTIMATE_MPS: f64 = 2.5;
+/// The distance the ego covers while easing off from its cruising speed, as the planner estimates it, metres.
+const EGO_BRAKING_ESTIMATE_M: f64 = 10.0;
+
+/// A crosser's sidewalk is at most this far to the side of the ego's route, metres: farther (across a junction,
+/// beside a wide road) the ego's camera loses it before it crosses.
+const MAX_CROSSER_LATERAL_M: f64 = 12.0;
+
 /// Ego routes tried before a clip is declared infeasible.
 const ROUTE_ATTEMPTS: usize = 8;
 /// Mid-road jaywalkers start at most this far ahead of the ego, metres: they cross at once, and farther away
@@ -522,8 +599,9 @@ const ROUTE_ATTEMPTS: usize = 8;
 const MIDROAD_MAX_AHEAD_M: f64 = 30.0;
 /// How far from the curb a crosser starts, metres.
 pub const CURB_STANDOFF_M: f64 = 0.3;
-/// Minimum distance between two pedestrians' spawn points, metres.
-const PED_SPACING_M: f64 = 1.0;
+/// Minimum distance between two pedestrians' spawn and curb points, metres (beyond the avoidance radius, so that
+/// two waiting pedestrians do not push each other away from their spots).
+const PED_SPACING_M: f64 = 1.2;
 /// Attempts to place one pedestrian before the clip is declared infeasible.
 const PLACEMENT_ATTEMPTS: usize = 60;
 
@@ -556,13 +634,6 @@ fn plan_pedestrians(
             .get(alloc.archetype)
             .map_or("casual_person", |s| s.as_str());
         let a = p.archetypes.get(name).cloned().unwrap_or_default();
-        let draw = |rng: &mut ChaCha20Rng, r: crate::dsl::types::Range| {
-            if r.max() > r.min() {
-                rng.random_range(r.min()..=r.max())
-            } else {
-                r.min()
-            }
-        };
         let base_speed_mps = draw(rng, a.speed_mps);
         let hesitation_s = draw(rng, a.hesitation_s);
         let ttc_threshold_s = draw(rng, a.ttc_threshold_s);
@@ -585,6 +656,14 @@ fn plan_pedestrians(
             Role::Crosser
         };
 
+        // The timeline: crossers that start on a sidewalk are in view for a planned time before stepping out;
+        // hard negatives wait at the curb for a planned time.
+        let timeline = &c.timeline;
+        let in_view_before_crossing_s = (role == Role::Crosser && alloc.behaviour != Behaviour::MidroadJaywalker)
+            .then(|| draw(rng, timeline.in_view_before_crossing_s));
+        let curb_wait_s =
+            (alloc.behaviour == Behaviour::HardNegative).then(|| draw(rng, c.hard_negatives.wait_at_curb_s));
+
         // Placement.
         let leader = group
             .filter(|g| g.leader != id)
@@ -604,10 +683,17 @@ fn plan_pedestrians(
                     &scripts,
                     rng,
                 ),
-                (Role::Crosser, _) => {
-                    // Allocated and baseline crossers alike start within the spawn range ahead of the ego.
-                    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max());
-                    let placed = place_crosser(net, route, lo, hi.min(far_m), crosser_side, &scripts, rng);
+                (Role::Crosser, _) | (_, Behaviour::HardNegative) => {
+                    // Allocated and baseline crossers, and hard negatives, start within the spawn range ahead of
+                    // the ego, far enough that the ego (easing off for them) cannot pass before their time in
+                    // view is up.
+                    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max().min(far_m));
+                    let lo = (c.decision_window_m.min()
+                        + EGO_BRAKING_ESTIMATE_M
+                        + COURTESY_SPEED_ESTIMATE_MPS * in_view_before_crossing_s.unwrap_or(0.0))
+                    .clamp(lo, hi);
+                    let approach_m = draw(rng, timeline.approach_m);
+                    let placed = place_crosser(net, route, lo, hi, crosser_side, approach_m, &scripts, rng);
                     crosser_side = if crosser_side == Side::Left {
                         Side::Right
                     } else {
@@ -615,7 +701,9 @@ fn plan_pedestrians(
                     };
                     placed
                 }
-                (Role::NonCrosser, _) => place_sidewalk(net, route, 0.0, far_m, &scripts, rng),
+                // Walkers too start within the spawn range, so that the camera sees them about as long as crossers
+                // (the benchmark protocol counts a track only when it is long enough).
+                (Role::NonCrosser, _) => place_sidewalk(net, route, spawn_ahead.min(), far_m, &scripts, rng),
             }
         };
         let (spawn, heading, ahead, crossing, place) = placed.ok_or_else(|| {
@@ -630,8 +718,9 @@ fn plan_pedestrians(
                 }
             )
         })?;
-        let crossing = if role == Role::Crosser { crossing } else { None };
-        if role == Role::Crosser && crossing.is_none() {
+        let keeps_crossing = role == Role::Crosser || alloc.behaviour == Behaviour::HardNegative;
+        let crossing = if keeps_crossing { crossing } else { None };
+        if keeps_crossing && crossing.is_none() {
             return Err(format!("pedestrian {id} is a crosser but has no road to cross"));
         }
         let (identity, child) = identity::identities(clip_seed, id, name, a.body);
@@ -656,6 +745,8 @@ fn plan_pedestrians(
             spawn_heading_rad: heading,
             ahead_of_ego_m: ahead,
             crossing,
+            in_view_before_crossing_s,
+            curb_wait_s,
             identity,
             child,
         });
@@ -665,8 +756,23 @@ fn plan_pedestrians(
 
 type Placement = (DVec2, f64, f64, Option<CrossingScript>, SpawnPlace);
 
+fn draw(rng: &mut ChaCha20Rng, r: crate::dsl::types::Range) -> f64 {
+    if r.max() > r.min() {
+        rng.random_range(r.min()..=r.max())
+    } else {
+        r.min()
+    }
+}
+
+/// Whether `p` is at least [`PED_SPACING_M`] from every earlier pedestrian's spawn point and curb point (two
+/// pedestrians bound for the same spot would block each other there).
 fn far_from_others(p: DVec2, scripts: &[PedestrianScript]) -> bool {
-    scripts.iter().all(|s| s.spawn.distance(p) >= PED_SPACING_M)
+    scripts.iter().all(|s| {
+        s.spawn.distance(p) >= PED_SPACING_M
+            && s.crossing
+                .as_ref()
+                .is_none_or(|c| (c.near_curb - c.direction * CURB_STANDOFF_M).distance(p) >= PED_SPACING_M)
+    })
 }
 
 fn crossing_script(c: &crate::world::Crossing) -> CrossingScript {
@@ -683,12 +789,14 @@ fn is_lane(net: &RoadNetwork, p: DVec2, kind: LaneType) -> bool {
     net.lane_at(p).is_some_and(|h| h.lane_type == kind)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn place_crosser(
     net: &RoadNetwork,
     route: &Route,
     lo: f64,
     hi: f64,
     side: Side,
+    approach_m: f64,
     scripts: &[PedestrianScript],
     rng: &mut ChaCha20Rng,
 ) -> Option<Placement> {
@@ -704,7 +812,10 @@ fn place_crosser(
         let Some(sample) = net.sidewalk_beside(route, s, side) else {
             continue;
         };
-        if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
+        if !far_from_others(sample.pos, scripts)
+            || !is_lane(net, sample.pos, LaneType::Sidewalk)
+            || sample.pos.distance(route.pose_at(s).pos) > MAX_CROSSER_LATERAL_M
+        {
             continue;
         }
         let Some(crossing) = net.crossing_at(sample.pos) else {
@@ -713,18 +824,61 @@ fn place_crosser(
         if crossing.carriageway_width_m < 2.0 {
             continue;
         }
-        // A crosser starts at its curb, facing the road (if that spot is free sidewalk).
+        // The curb point, facing the road (if that spot is free sidewalk); the pedestrian starts up to
+        // `approach_m` along the curb from it and walks there.
         let heading = crossing.direction.to_angle();
         let at_curb = crossing.near_curb - crossing.direction * CURB_STANDOFF_M;
         let free = is_lane(net, at_curb, LaneType::Sidewalk) && far_from_others(at_curb, scripts);
-        let spawn = if free { at_curb } else { sample.pos };
+        if !free {
+            return Some((
+                sample.pos,
+                heading,
+                s,
+                Some(crossing_script(&crossing)),
+                SpawnPlace::Sidewalk,
+            ));
+        }
+        let first = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        let (spawn, spawn_heading) =
+            approach_start(net, at_curb, crossing.direction.perp(), approach_m, first, scripts)
+                .unwrap_or((at_curb, heading));
         return Some((
             spawn,
-            heading,
+            spawn_heading,
             s,
             Some(crossing_script(&crossing)),
             SpawnPlace::Sidewalk,
         ));
+    }
+    None
+}
+
+/// Where a pedestrian bound for `curb` starts when it walks `approach_m` along the curb (direction `along`,
+/// trying `first` then the other way, then half the distance): the start and its heading, if the whole walk is
+/// on free sidewalk.
+fn approach_start(
+    net: &RoadNetwork,
+    curb: DVec2,
+    along: DVec2,
+    approach_m: f64,
+    first: f64,
+    scripts: &[PedestrianScript],
+) -> Option<(DVec2, f64)> {
+    if approach_m < 0.5 {
+        return None;
+    }
+    for distance in [approach_m, 0.5 * approach_m] {
+        for sign in [first, -first] {
+            let start = curb + along * (sign * distance);
+            let steps = distance.ceil() as usize;
+            let on_sidewalk = (1..=steps).all(|k| {
+                let p = curb + along * (sign * distance * k as f64 / steps as f64);
+                is_lane(net, p, LaneType::Sidewalk)
+            });
+            if on_sidewalk && far_from_others(start, scripts) {
+                return Some((start, (curb - start).to_angle()));
+            }
+        }
     }
     None
 }
@@ -806,11 +960,17 @@ fn place_follower(
     scripts: &[PedestrianScript],
     rng: &mut ChaCha20Rng,
 ) -> Option<Placement> {
-    let along = DVec2::from_angle(leader.spawn_heading_rad).perp();
+    // Beside the leader along the curb (the leader's crossing line, shifted), walking with it.
+    let along = leader
+        .crossing
+        .as_ref()
+        .map_or(DVec2::from_angle(leader.spawn_heading_rad).perp(), |c| {
+            c.direction.perp()
+        });
     for _ in 0..PLACEMENT_ATTEMPTS {
-        let offset = rng.random_range(1.0..2.5) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-        let back = 0.0; // side by side with the leader, at the same distance from the curb
-        let p = leader.spawn + along * offset + DVec2::from_angle(leader.spawn_heading_rad) * back;
+        let offset = rng.random_range(PED_SPACING_M..2.5) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        let shift = along * offset;
+        let p = leader.spawn + shift;
         let kind = if leader.spawn_place == SpawnPlace::DrivingLane {
             LaneType::Driving
         } else {
@@ -819,12 +979,17 @@ fn place_follower(
         if !is_lane(net, p, kind) || !far_from_others(p, scripts) {
             continue;
         }
-        let crossing = if kind == LaneType::Sidewalk {
-            net.crossing_at(p).map(|c| crossing_script(&c))
-        } else {
-            leader.crossing.clone()
-        };
-        if crossing.is_none() {
+        let crossing = leader.crossing.clone().map(|c| CrossingScript {
+            near_curb: c.near_curb + shift,
+            far_curb: c.far_curb + shift,
+            end: c.end + shift,
+            ..c
+        });
+        if crossing.as_ref().is_none_or(|c| {
+            kind == LaneType::Sidewalk
+                && !(is_lane(net, c.near_curb - c.direction * CURB_STANDOFF_M, LaneType::Sidewalk)
+                    && is_lane(net, c.end, LaneType::Sidewalk))
+        }) {
             continue;
         }
         return Some((

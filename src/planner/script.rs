@@ -8,11 +8,12 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::dsl::types::{
-    Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Spec, SpeedProfiles, Split, WeatherParams,
+    Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Rgb, Spec, SpeedProfiles, Split, Visibility,
+    WeatherParams,
 };
 
 /// Version of the plan format.
-pub const PLAN_FORMAT_VERSION: u32 = 1;
+pub const PLAN_FORMAT_VERSION: u32 = 2;
 
 /// A compiled dataset: the clip scripts in a stable order (town, weather, index).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -58,6 +59,10 @@ pub struct SimParams {
     pub idm: Idm,
     /// Situational speed profiles (multipliers, switching).
     pub speed_profiles: SpeedProfiles,
+    /// The ego's camera (the pedestrians' timelines count the time they are in its view).
+    pub camera: Rgb,
+    /// The visibility gate, as the simulation estimates what the camera sees.
+    pub visibility: Visibility,
 }
 
 impl SimParams {
@@ -71,6 +76,8 @@ impl SimParams {
             decision_window_m: spec.crossing.decision_window_m,
             idm: spec.traffic.idm.clone(),
             speed_profiles: spec.pedestrians.speed_profiles.clone(),
+            camera: spec.sensors.rgb.clone(),
+            visibility: spec.annotations.visibility.clone(),
         }
     }
 }
@@ -100,6 +107,8 @@ pub struct ClipScript {
     pub vehicles: Vec<VehicleScript>,
     /// Pedestrians.
     pub pedestrians: Vec<PedestrianScript>,
+    /// How much the clip was lengthened beyond its drawn duration so that its crossers' timelines fit, seconds.
+    pub timeline_extension_s: f64,
 }
 
 impl ClipScript {
@@ -138,6 +147,16 @@ pub struct EgoScript {
     pub brake_ahead_m: f64,
     /// ... and within this lateral distance, metres.
     pub brake_lateral_m: f64,
+    /// Courtesy: it eases off to this speed for a pedestrian heading for, or waiting at, the curb ahead, m/s.
+    pub courtesy_speed_mps: f64,
+    /// ... up to this far ahead along its route, metres ...
+    pub courtesy_ahead_m: f64,
+    /// ... and this far to the side, metres; it stops this far short of a pedestrian waiting at the curb ...
+    pub courtesy_lateral_m: f64,
+    /// ... this far short of it, metres ...
+    pub courtesy_stop_short_m: f64,
+    /// ... for at most this long, seconds.
+    pub courtesy_patience_s: f64,
 }
 
 /// Driving profiles.
@@ -208,17 +227,20 @@ pub enum Behaviour {
     Jaywalk,
     /// Injected directly in a driving lane (layer 3).
     MidroadJaywalker,
+    /// A non-crosser that walks to the curb, stops, looks and checks the traffic, and then does not cross.
+    HardNegative,
     /// A non-crosser.
     None,
 }
 
 impl Behaviour {
     /// All behaviour types.
-    pub const ALL: [Behaviour; 5] = [
+    pub const ALL: [Behaviour; 6] = [
         Self::Normal,
         Self::Sudden,
         Self::Jaywalk,
         Self::MidroadJaywalker,
+        Self::HardNegative,
         Self::None,
     ];
     /// The behaviour's name.
@@ -228,6 +250,7 @@ impl Behaviour {
             Self::Sudden => "sudden",
             Self::Jaywalk => "jaywalk",
             Self::MidroadJaywalker => "midroad_jaywalker",
+            Self::HardNegative => "hard_negative",
             Self::None => "none",
         }
     }
@@ -348,8 +371,13 @@ pub struct PedestrianScript {
     pub spawn_heading_rad: f64,
     /// Distance ahead of the ego's start along its route, metres.
     pub ahead_of_ego_m: f64,
-    /// The planned crossing (crossers only).
+    /// The planned crossing (crossers), or the curb a hard negative walks to.
     pub crossing: Option<CrossingScript>,
+    /// Time the pedestrian must have been in view of the ego's camera before it steps onto the road, seconds
+    /// (crossers that start on a sidewalk; `crossing.timeline`).
+    pub in_view_before_crossing_s: Option<f64>,
+    /// How long a hard negative waits at the curb before walking on, seconds.
+    pub curb_wait_s: Option<f64>,
     /// Who the pedestrian is: body height and looks, the same for every sensor and label.
     pub identity: Identity,
     /// The child walking beside a parent (`parent_with_child` bodies).

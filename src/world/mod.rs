@@ -59,6 +59,60 @@ pub fn segment_projection(a: DVec2, b: DVec2, p: DVec2) -> (f64, f64, f64) {
     (t, (a + ab * t - p).length_squared(), len2)
 }
 
+/// Whether the segment `from + t·d`, t ∈ (1e-6, `t_max`), passes through a box turned about z: centre `centre`,
+/// `yaw.sin_cos()` as `sin_cos`, half extents `half` (along its heading, across, up). A slab test.
+#[inline]
+pub fn segment_hits_box(from: DVec3, d: DVec3, t_max: f64, centre: DVec3, sin_cos: (f64, f64), half: DVec3) -> bool {
+    let (s, c) = sin_cos;
+    let rel = from - centre;
+    let o = DVec3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
+    let v = DVec3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
+    let (mut t0, mut t1): (f64, f64) = (1e-6, t_max);
+    for k in 0..3 {
+        if v[k].abs() < 1e-12 {
+            if o[k].abs() > half[k] {
+                return false;
+            }
+        } else {
+            let a = (-half[k] - o[k]) / v[k];
+            let b = (half[k] - o[k]) / v[k];
+            t0 = t0.max(a.min(b));
+            t1 = t1.min(a.max(b));
+            if t0 > t1 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the segment `from + t·d`, t ∈ (1e-6, `t_max`), passes through the upright cylinder of `radius_m` and
+/// `height_m` standing at `ground`.
+#[inline]
+pub fn segment_hits_cylinder(from: DVec3, d: DVec3, t_max: f64, ground: DVec3, radius_m: f64, height_m: f64) -> bool {
+    let o = (from - ground).truncate();
+    let v = d.truncate();
+    let a = v.length_squared();
+    if a < 1e-12 {
+        return false;
+    }
+    let b = o.dot(v);
+    let c = o.length_squared() - radius_m * radius_m;
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return false;
+    }
+    let sq = disc.sqrt();
+    let (lo, hi) = (((-b - sq) / a).max(1e-6), ((-b + sq) / a).min(t_max));
+    if lo > hi {
+        return false;
+    }
+    // Inside the cylinder's height anywhere on [lo, hi] (z is linear in t).
+    let z0 = from.z + d.z * lo - ground.z;
+    let z1 = from.z + d.z * hi - ground.z;
+    z0.min(z1) <= height_m && z0.max(z1) >= 0.0
+}
+
 /// The axis-aligned bounding box `(lo, hi)` of `points`, or `None` when there are none.
 pub fn bounding_box(points: impl IntoIterator<Item = DVec2>) -> Option<(DVec2, DVec2)> {
     let mut points = points.into_iter();

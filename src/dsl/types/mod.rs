@@ -153,7 +153,7 @@ mod tests {
                 c.layers.crosser_allocation.max_crosser_ratio,
                 c.layers.groups.probability
             ),
-            (0.9, 0.4)
+            (1.0, 0.4)
         );
         assert_eq!((c.retreat.probability, c.retreat.window_fraction), (0.15, 0.4));
         assert_eq!(c.lookahead.points_m, vec![0.5, 1.5, 2.5]);

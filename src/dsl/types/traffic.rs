@@ -146,6 +146,21 @@ pub struct Ego {
     pub brake_lateral_m: f64,
     /// Route length beyond what the clip needs, metres.
     pub route_margin_m: f64,
+    /// Courtesy: for a pedestrian ahead that heads for the curb or waits there (looking, checking the traffic,
+    /// hesitating), the ego eases off to this speed, m/s `[min, max]` drawn per clip, as drivers do when someone
+    /// looks ready to cross. Crossers and hard negatives alike get it, so the ego's speed does not give the
+    /// label away.
+    pub courtesy_speed_mps: Range,
+    /// ... for such pedestrians up to this far ahead along its route, metres.
+    pub courtesy_ahead_m: f64,
+    /// ... and this far to the side of its path, metres.
+    pub courtesy_lateral_m: f64,
+    /// For a pedestrian waiting at the curb attentively (looking, checking the traffic, hesitating) the ego stops
+    /// this far short of its crossing point, front bumper to crossing, metres ...
+    pub courtesy_stop_short_m: f64,
+    /// ... and waits at most this long, seconds `[min, max]` drawn per clip; then it drives on at its eased speed
+    /// (the pedestrian still may cross: the ego brakes for anyone crossing in its path).
+    pub courtesy_patience_s: Range,
 }
 
 impl Default for Ego {
@@ -156,6 +171,11 @@ impl Default for Ego {
             brake_ahead_m: 15.0,
             brake_lateral_m: 5.0,
             route_margin_m: 60.0,
+            courtesy_speed_mps: Range(1.5, 3.5),
+            courtesy_ahead_m: 35.0,
+            courtesy_lateral_m: 10.0,
+            courtesy_stop_short_m: 8.0,
+            courtesy_patience_s: Range(5.0, 12.0),
         }
     }
 }

@@ -136,61 +136,20 @@ enum Occluder {
 /// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
 fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
     match *occ {
-        Occluder::Vehicle {
-            centre,
-            sin_cos: (s, c),
-        } => {
-            let rel = from - centre - DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5);
-            let o = DVec3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
-            let v = DVec3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
-            let half = DVec3::new(VEHICLE_LENGTH_M * 0.5, VEHICLE_WIDTH_M * 0.5, VEHICLE_HEIGHT_M * 0.5);
-            let (mut t0, mut t1): (f64, f64) = (1e-6, t_max);
-            for k in 0..3 {
-                if v[k].abs() < 1e-12 {
-                    if o[k].abs() > half[k] {
-                        return false;
-                    }
-                } else {
-                    let a = (-half[k] - o[k]) / v[k];
-                    let b = (half[k] - o[k]) / v[k];
-                    t0 = t0.max(a.min(b));
-                    t1 = t1.min(a.max(b));
-                    if t0 > t1 {
-                        return false;
-                    }
-                }
-            }
-            true
-        }
+        Occluder::Vehicle { centre, sin_cos } => crate::world::segment_hits_box(
+            from,
+            d,
+            t_max,
+            centre + DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5),
+            sin_cos,
+            DVec3::new(VEHICLE_LENGTH_M * 0.5, VEHICLE_WIDTH_M * 0.5, VEHICLE_HEIGHT_M * 0.5),
+        ),
         Occluder::Person {
             ground,
             radius_m,
             height_m,
             ..
-        } => {
-            let o = (from - ground).truncate();
-            let v = d.truncate();
-            let a = v.length_squared();
-            if a < 1e-12 {
-                return false;
-            }
-            let b = o.dot(v);
-            let c = o.length_squared() - radius_m * radius_m;
-            let disc = b * b - a * c;
-            if disc < 0.0 {
-                return false;
-            }
-            let sq = disc.sqrt();
-            let (ta, tb) = ((-b - sq) / a, (-b + sq) / a);
-            let (lo, hi) = (ta.max(1e-6), tb.min(t_max));
-            if lo > hi {
-                return false;
-            }
-            // Inside the cylinder's height anywhere on [lo, hi] (z is linear in t).
-            let z0 = from.z + d.z * lo - ground.z;
-            let z1 = from.z + d.z * hi - ground.z;
-            z0.min(z1) <= height_m && z0.max(z1) >= 0.0
-        }
+        } => crate::world::segment_hits_cylinder(from, d, t_max, ground, radius_m, height_m),
     }
 }
 
@@ -250,6 +209,39 @@ pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
         }
     }
     Some([lo.x, lo.y, hi.x, hi.y])
+}
+
+/// Half the width and depth of the walker bounding box that stage 3 of the gate measures, metres: CARLA's walker
+/// box (reference §4: adult capsule extents 0.34 × 0.34 m; children 0.25 × 0.25 m), which is what the paper's
+/// 15 × 30 px gate was applied to. The annotated box is the tight silhouette box, narrower than this one; gating
+/// the tight box at 15 px would keep a standing adult seen side-on only within about 17 m.
+pub fn gate_box_half_width_m(height_m: f64) -> f64 {
+    if height_m < CHILD_HEIGHT_LIMIT_M { 0.25 } else { 0.34 }
+}
+
+/// People shorter than this get the child's gate box, metres.
+const CHILD_HEIGHT_LIMIT_M: f64 = 1.4;
+
+/// The image size (width, height, pixels) of a walker's gate box — the box of [`gate_box_half_width_m`] around
+/// its footprint, from the ground to `height_m`, turned by `yaw_rad` — from the 8 projected corners, as CARLA
+/// users compute a 2D box. `None` when a corner is not in front of the camera.
+pub fn gate_box_size_px(cam: &CameraPose, ground: DVec3, yaw_rad: f64, height_m: f64) -> Option<(f64, f64)> {
+    let half = gate_box_half_width_m(height_m);
+    let (s, c) = yaw_rad.sin_cos();
+    let (ax, ay) = (DVec3::new(c, s, 0.0) * half, DVec3::new(-s, c, 0.0) * half);
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for corner in [ax + ay, ax - ay, -ax - ay, -ax + ay] {
+        for z in [0.0, height_m] {
+            let p = cam.project(ground + corner + DVec3::Z * z);
+            if p.depth_m <= 0.05 {
+                return None;
+            }
+            lo = lo.min(p.px);
+            hi = hi.max(p.px);
+        }
+    }
+    Some((hi.x - lo.x, hi.y - lo.y))
 }
 
 /// Stage 3 of the gate: whether a `width` × `height` box (pixels) is smaller than `min` in either dimension.
@@ -350,11 +342,14 @@ pub fn annotate(
                 out.rejections.behind += 1;
                 continue;
             };
-            let (w, hgt) = (bbox[2] - bbox[0], bbox[3] - bbox[1]);
             let min = if distance > gate.far_distance_m {
                 gate.min_box_far_px
             } else {
                 gate.min_box_px
+            };
+            let Some((w, hgt)) = gate_box_size_px(&cam, f.pos, f.yaw_rad, heights[id].0) else {
+                out.rejections.behind += 1;
+                continue;
             };
             if too_small(w, hgt, min) {
                 out.rejections.too_small += 1;

@@ -32,6 +32,7 @@ mod contacts;
 pub(crate) mod pedestrian;
 pub mod ttc;
 pub(crate) mod vehicle;
+pub(crate) mod view;
 
 use std::collections::BTreeMap;
 
@@ -43,7 +44,7 @@ use crate::planner::{ClipScript, Plan, SimParams, TownContext, seeds};
 use crate::world::RoadNetwork;
 use contacts::Contacts;
 use pedestrian::machine::{self, LeaderFacts};
-use pedestrian::params::{GROUP_LINE_MAX_WIDTH_DIFF, GROUP_LINE_MIN_COS};
+use pedestrian::params::{FOLLOWER_MAX_IN_VIEW_S, GROUP_LINE_MAX_WIDTH_DIFF, GROUP_LINE_MIN_COS};
 use pedestrian::{Group, Ped, StepCtx, motion, perceive};
 pub use pedestrian::{allowed_speed_range_mps, params as behaviour_params, profile_multiplier, state_speed_mps};
 pub use vehicle::EGO_TIME_HEADWAY_S;
@@ -110,9 +111,12 @@ struct Sim<'a> {
     /// Where each vehicle's path crosses another's (found once at set-up).
     zones: Vec<Vec<vehicle::ConflictZone>>,
     contacts: Contacts,
+    /// What the ego's camera sees (the pedestrians' timelines).
+    view: view::ViewProxy,
     // Scratch buffers, reused every step.
     probes: Vec<DVec2>,
     positions: Vec<DVec2>,
+    people: Vec<(DVec3, f64)>,
     views: Vec<PedView>,
     accels: Vec<f64>,
     leader_facts: Vec<Option<LeaderFacts>>,
@@ -174,8 +178,10 @@ impl<'a> Sim<'a> {
             trace,
             zones,
             contacts: Contacts::new(nv, np),
+            view: view::ViewProxy::new(params),
             probes: Vec::with_capacity(8),
             positions: Vec::with_capacity(np),
+            people: Vec::with_capacity(np),
             views: Vec::with_capacity(np),
             accels: Vec::with_capacity(nv),
             leader_facts: vec![None; np],
@@ -232,8 +238,24 @@ impl<'a> Sim<'a> {
         let events = &mut self.trace.events;
 
         // 2. Perceive.
-        for p in self.peds.iter_mut() {
-            perceive::perceive(p, &self.vehicles, self.params, &mut self.probes);
+        let camera = self.view.camera_at(&self.vehicles[0]);
+        self.people.clear();
+        self.people.extend(
+            self.peds
+                .iter()
+                .map(|p| (DVec3::new(p.body.pos.x, p.body.pos.y, p.body.z_m), p.traits.height_m)),
+        );
+        for (me, p) in self.peds.iter_mut().enumerate() {
+            let around = perceive::Surroundings {
+                params: self.params,
+                net: self.net,
+                view: &self.view,
+                camera: &camera,
+                people: &self.people,
+                me,
+                dt_s: self.dt_s,
+            };
+            perceive::perceive(p, &self.vehicles, &around, &mut self.probes);
         }
 
         // 3. Decide: singles and leaders, then followers.
@@ -246,12 +268,21 @@ impl<'a> Sim<'a> {
             }
             let p = &self.peds[i];
             let group_ready = p.followers().iter().all(|&j| self.peds[j].attempt.at_curb());
+            let followers_seen = p.followers().iter().all(|&j| {
+                let f = &self.peds[j];
+                f.in_view_s
+                    >= f.traits
+                        .in_view_before_crossing_s
+                        .unwrap_or(0.0)
+                        .min(FOLLOWER_MAX_IN_VIEW_S)
+            });
             let group_conflict = p.percept.conflict_vehicle.or_else(|| {
                 p.followers()
                     .iter()
                     .find_map(|&j| self.peds[j].percept.conflict_vehicle)
             });
             let p = &mut self.peds[i];
+            p.followers_seen = followers_seen;
             machine::transition(p, &ctx, group_ready, group_conflict, events);
             if !p.followers().is_empty() {
                 self.leader_facts[i] = Some(LeaderFacts::of(p, 0.0));
@@ -297,6 +328,8 @@ impl<'a> Sim<'a> {
             pos: p.body.pos,
             velocity: p.body.velocity,
             crossing: p.activity.crossing_motion(),
+            approaching_curb: p.heading_for_curb(),
+            waiting_at_curb: p.waiting_at_curb(),
         }));
         self.accels.clear();
         for i in 0..self.vehicles.len() {
@@ -308,7 +341,9 @@ impl<'a> Sim<'a> {
                 &self.params.idm,
             ));
         }
-        // 6. Integrate.
+        // 6. Integrate (and count the ego's time yielding to waiting pedestrians).
+        let yielding = self.vehicles[0].sees_waiting_pedestrian(&self.views);
+        self.vehicles[0].count_yield(yielding, self.dt_s);
         for (v, &a) in self.vehicles.iter_mut().zip(&self.accels) {
             v.integrate(a, self.dt_s);
         }

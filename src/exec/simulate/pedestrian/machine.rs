@@ -11,16 +11,17 @@ use glam::DVec2;
 use rand::RngExt;
 
 use super::params::{
-    BASELINE_CLEAR_M, BLOCKED_RETREAT_S, CHECK_MIN_S, COMMIT_MIN_TTC_S, CONFLICT_CLEAR_S, CURB_STANDOFF_M,
-    DISTRACTION_PAUSE_S, FINISH_BEYOND_CURB_M, FINISHED_ARRIVAL_M, FINISHED_MAX_S, HESITATION_CUTOFF_M,
-    JAYWALK_MIN_TTC_S, RUN_TTC_FRACTION, RUSHED_GAP_FACTOR,
+    BASELINE_CLEAR_M, BLOCKED_RETREAT_S, CHECK_MIN_S, COMFORTABLE_STOP_DECEL_MPS2, COMMIT_MIN_TTC_S, CONFLICT_CLEAR_S,
+    CURB_STANDOFF_M, CUT_SHORT_EGO_DISTANCE_M, CUT_SHORT_EGO_SPEED_MPS, CUT_SHORT_MIN_IN_VIEW_S, DISTRACTION_PAUSE_S,
+    FINISH_BEYOND_CURB_M, FINISHED_ARRIVAL_M, FINISHED_MAX_S, HESITATION_CUTOFF_M, JAYWALK_MIN_TTC_S, RUN_TTC_FRACTION,
+    RUSHED_GAP_FACTOR, STOP_MARGIN_M, SUDDEN_FROM_CURB_M, SUDDEN_MIN_EGO_M,
 };
 use super::state::{Activity, AfterPhone, Attempt, CrossMode, Distraction, PauseCause};
 use super::walker::SidewalkWalker;
 use super::{Ped, StepCtx, motion};
 use crate::exec::simulate::ttc;
 use crate::exec::trace::{Event, PedState, VehicleId};
-use crate::planner::{Behaviour, CrosserSource, SimParams, SpeedProfile};
+use crate::planner::{Behaviour, CrosserSource, Role, SimParams, SpeedProfile};
 
 /// Enters `to`: a state change (event, timer reset) when its label differs from the current one.
 fn enter(p: &mut Ped, to: Activity, frame: u32, events: &mut Vec<Event>) {
@@ -71,16 +72,16 @@ fn gap_threshold_s(p: &Ped, params: &SimParams) -> f64 {
 /// Whether the ego's position allows an allocated crosser to commit: inside the decision window while
 /// approaching, or already past.
 fn ego_in_window_or_past(p: &Ped, params: &SimParams) -> bool {
-    let w = params.decision_window_m;
-    let d = p.percept.ego_dist_m;
-    !p.percept.ego_ahead || (d >= w.min() && d <= w.max())
+    !p.percept.ego_ahead || ego_in_window(p, params)
 }
 
-/// Whether the ego approaches inside the decision window.
+/// Whether the ego approaches inside the decision window: no farther than its far edge, and no nearer than its
+/// near edge unless it is slow enough to stop comfortably before the crossing (a driver easing off for the
+/// pedestrian lets it go).
 fn ego_in_window(p: &Ped, params: &SimParams) -> bool {
     let w = params.decision_window_m;
     let d = p.percept.ego_dist_m;
-    p.percept.ego_ahead && d >= w.min() && d <= w.max()
+    p.percept.ego_ahead && d <= w.max() && (d >= w.min() || ego_can_stop(p))
 }
 
 /// Whether an allocated crosser may go now. The paper's crosser "commits to entering the road as soon as the
@@ -104,6 +105,30 @@ fn ego_reached_window(p: &Ped, params: &SimParams) -> bool {
 /// arrive (CARLA's stop-and-check).
 fn baseline_clear(p: &Ped) -> bool {
     p.percept.nearest_vehicle_m > BASELINE_CLEAR_M && p.percept.min_ttc_s > JAYWALK_MIN_TTC_S
+}
+
+/// Whether the crosser's timeline lets it step out `lead_s` seconds from now: the ego's camera has seen it (and
+/// its group's followers) for its planned time; or it has been seen briefly and the ego drives on close by (the
+/// timeline is cut short, as real observations sometimes are); or the ego has passed (then no camera sees it
+/// either way).
+fn timeline_allows(p: &Ped, lead_s: f64) -> bool {
+    let percept = &p.percept;
+    // The ego drives on close by: a crosser seen at least briefly goes now rather than cross behind it, unseen.
+    let cut_short = percept.ego_speed_mps > CUT_SHORT_EGO_SPEED_MPS
+        && percept.ego_dist_m < CUT_SHORT_EGO_DISTANCE_M
+        && p.in_view_s >= CUT_SHORT_MIN_IN_VIEW_S;
+    !percept.ego_ahead || (p.seen_long_enough(lead_s) && p.followers_seen) || cut_short
+}
+
+/// Whether the ego is so close ahead, and moving, that stepping out now would put the crosser under its wheels.
+fn ego_too_close(p: &Ped) -> bool {
+    p.percept.ego_ahead && p.percept.ego_dist_m < SUDDEN_MIN_EGO_M && !ego_can_stop(p)
+}
+
+/// Whether the ego can stop comfortably, with room to spare, before the pedestrian.
+fn ego_can_stop(p: &Ped) -> bool {
+    let v = p.percept.ego_speed_mps;
+    v * v / (2.0 * COMFORTABLE_STOP_DECEL_MPS2) + STOP_MARGIN_M < p.percept.ego_dist_m
 }
 
 /// Whether a vehicle approaches a crosser on the road so fast that it runs.
@@ -156,16 +181,18 @@ pub(crate) fn transition(
         }
     }
 
-    // Patience cap while waiting at the curb.
+    // Patience cap while waiting at the curb (for the approaching ego: the wait counts while in its view).
     if let Attempt::Undecided {
         at_curb: true,
         waited_s,
     } = p.attempt
+        && p.traits.role == Role::Crosser
         && waited_s >= p.traits.patience_s
         && matches!(
             p.activity,
             Activity::LookingAround | Activity::CheckingTraffic | Activity::Hesitating
         )
+        && !ego_too_close(p)
     {
         let sudden = p
             .rng
@@ -175,7 +202,7 @@ pub(crate) fn transition(
             pedestrian: p.traits.id,
             sudden_crossing: sudden,
         });
-        if sudden {
+        if sudden && timeline_allows(p, 0.0) {
             decide_to_cross(p, frame, events);
             switch_profile(p, params, SpeedProfile::Rushed);
             enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
@@ -204,9 +231,14 @@ pub(crate) fn transition(
 fn walking(p: &mut Ped, ctx: &StepCtx, group_ready: bool, events: &mut Vec<Event>) {
     let (params, frame) = (ctx.params, ctx.next_frame);
     if !p.attempt.over() {
-        if p.attempt.at_curb() && group_ready {
+        // A sudden crosser turns onto the road from its last steps to the curb, without stopping there.
+        let near_curb = p.traits.behaviour == Behaviour::Sudden
+            && p.traits
+                .line
+                .is_some_and(|l| l.curb_point().distance(p.body.pos) < SUDDEN_FROM_CURB_M);
+        if (p.attempt.at_curb() || near_curb) && group_ready {
             if p.traits.behaviour == Behaviour::Sudden {
-                if ego_reached_window(p, params) {
+                if ego_reached_window(p, params) && timeline_allows(p, 0.0) && !ego_too_close(p) {
                     decide_to_cross(p, frame, events);
                     switch_profile(p, params, SpeedProfile::Rushed);
                     enter(p, Activity::Crossing(CrossMode::SuddenCrossing), frame, events);
@@ -240,7 +272,7 @@ fn looking_around(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
         } else {
             p.percept.min_ttc_s
         };
-        if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S {
+        if ego_in_window_or_past(p, params) && ttc > JAYWALK_MIN_TTC_S && timeline_allows(p, 0.0) {
             decide_to_cross(p, frame, events);
             enter(p, Activity::Crossing(CrossMode::Jaywalking), frame, events);
         }
@@ -253,15 +285,24 @@ fn looking_around(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
 /// crosser) decides to cross.
 fn checking_traffic(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
     let (params, frame) = (ctx.params, ctx.next_frame);
+    if let Some(wait_s) = p.traits.curb_wait_s {
+        // A hard negative: it looks and checks like a crosser, and after its wait walks on without crossing.
+        if p.state_time_s >= wait_s {
+            abandon(p, ctx);
+            enter(p, Activity::WalkingSidewalk, frame, events);
+        }
+        return;
+    }
     if p.state_time_s < CHECK_MIN_S {
         return;
     }
     let baseline = p.traits.source == CrosserSource::Baseline;
-    let go = if baseline {
-        baseline_clear(p)
-    } else {
-        ego_in_window_or_past(p, params) && gap_ok(p, params)
-    };
+    let go = timeline_allows(p, p.traits.hesitation_s)
+        && if baseline {
+            baseline_clear(p)
+        } else {
+            ego_in_window_or_past(p, params) && gap_ok(p, params)
+        };
     if go {
         let window_commit = !baseline && ego_in_window(p, params);
         decide_to_cross(p, frame, events);
@@ -297,9 +338,10 @@ fn hesitating(p: &mut Ped, ctx: &StepCtx, events: &mut Vec<Event>) {
     let ego_closing_in = window_commit
         && p.percept.ego_ahead
         && p.percept.ego_dist_m <= params.decision_window_m.min() + HESITATION_CUTOFF_M;
-    if lost {
+    let ready = timeline_allows(p, 0.0);
+    if lost || (ego_closing_in && !ready) {
         enter(p, Activity::CheckingTraffic, frame, events);
-    } else if t >= p.traits.hesitation_s || ego_closing_in {
+    } else if ready && (t >= p.traits.hesitation_s || ego_closing_in) {
         // Closing a tight gap: rushed.
         if p.percept.min_ttc_s < RUSHED_GAP_FACTOR * threshold {
             switch_profile(p, params, SpeedProfile::Rushed);

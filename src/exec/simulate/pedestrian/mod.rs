@@ -128,6 +128,7 @@ impl Line {
 #[derive(Clone, Debug)]
 pub(crate) struct Traits {
     pub id: PedestrianId,
+    pub role: Role,
     pub behaviour: Behaviour,
     pub source: CrosserSource,
     pub base_speed_mps: f64,
@@ -148,6 +149,12 @@ pub(crate) struct Traits {
     /// Where the pedestrian stands along the ego's route, metres: "ahead of the ego" is decided along the route,
     /// which stays right where the route turns.
     pub route_s_m: f64,
+    /// Body height, metres.
+    pub height_m: f64,
+    /// A crosser steps out only after the ego's camera has seen it this long, seconds (its timeline).
+    pub in_view_before_crossing_s: Option<f64>,
+    /// A hard negative waits at the curb this long before walking on, seconds.
+    pub curb_wait_s: Option<f64>,
 }
 
 /// The body's kinematics.
@@ -198,6 +205,10 @@ pub(crate) struct Ped {
     pub walker: SidewalkWalker,
     /// Speed of the group's crossing (leaders), m/s.
     pub group_speed_mps: f64,
+    /// Time the ego's camera has seen the pedestrian so far, seconds (the simulation's estimate).
+    pub in_view_s: f64,
+    /// For a group leader: whether the camera has seen each follower for its planned time (set each step).
+    pub followers_seen: bool,
     pub percept: Percept,
     pub rng: ChaCha20Rng,
 }
@@ -225,10 +236,12 @@ impl Ped {
             dir: c.direction.normalize_or(DVec2::X),
             width_m: c.carriageway_width_m.max(0.1),
         });
-        let crosser = script.role == Role::Crosser && line.is_some();
+        // Crossers, and hard negatives (who act like crossers up to the decision), head for their curb.
+        let tries = (script.role == Role::Crosser || script.behaviour == Behaviour::HardNegative) && line.is_some();
         let mut p = Ped {
             traits: Traits {
                 id: PedestrianId(script.id),
+                role: script.role,
                 behaviour: script.behaviour,
                 source: script.crosser_source,
                 base_speed_mps: script.base_speed_mps.max(0.05),
@@ -243,6 +256,9 @@ impl Ped {
                 standing,
                 line,
                 route_s_m: script.ahead_of_ego_m,
+                height_m: script.identity.height_m,
+                in_view_before_crossing_s: script.in_view_before_crossing_s,
+                curb_wait_s: script.curb_wait_s,
             },
             body: Body {
                 pos: script.spawn,
@@ -256,7 +272,7 @@ impl Ped {
             group: Group::Single,
             activity: Activity::WalkingSidewalk,
             state_time_s: 0.0,
-            attempt: if crosser {
+            attempt: if tries {
                 Attempt::Undecided {
                     at_curb: false,
                     waited_s: 0.0,
@@ -269,6 +285,8 @@ impl Ped {
             next_scan_s,
             walker: SidewalkWalker::default(),
             group_speed_mps: 0.0,
+            in_view_s: 0.0,
+            followers_seen: true,
             percept: Percept::default(),
             rng,
         };
@@ -332,6 +350,31 @@ impl Ped {
             Group::Follower(l) => Some(l),
             _ => None,
         }
+    }
+
+    /// Whether the ego's camera has seen the pedestrian for its planned time before crossing, `lead_s` seconds
+    /// from now (always, without a timeline).
+    pub fn seen_long_enough(&self, lead_s: f64) -> bool {
+        self.traits
+            .in_view_before_crossing_s
+            .is_none_or(|t| self.in_view_s + lead_s >= t)
+    }
+
+    /// Whether it heads for its curb point or waits there (a crosser or hard negative on the sidewalk, not yet
+    /// across): what makes the ego ease off.
+    pub fn heading_for_curb(&self) -> bool {
+        self.traits.line.is_some() && !self.attempt.over() && !self.activity.crossing_motion()
+    }
+
+    /// Whether it waits at its curb point attentively (looking, checking the traffic, hesitating): what makes the
+    /// ego stop short and let it go.
+    pub fn waiting_at_curb(&self) -> bool {
+        self.attempt.at_curb()
+            && !self.attempt.over()
+            && matches!(
+                self.activity,
+                Activity::LookingAround | Activity::CheckingTraffic | Activity::Hesitating
+            )
     }
 
     /// The followers' indices (empty unless a group leader).

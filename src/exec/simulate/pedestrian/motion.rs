@@ -10,9 +10,9 @@ use rand_chacha::ChaCha20Rng;
 
 use super::machine::LeaderFacts;
 use super::params::{
-    AVOID_RADIUS_M, BRIEF_SCAN_S, CURB_ARRIVAL_M, CURB_STANDOFF_M, DISTRACTION_STANDSTILL, FOLLOWER_SPEED_SLACK,
-    FULL_SCAN_S, HEADING_MIN_STEP_M, IDLE_HEAD_SWAY, LINE_OFFSET_KEEP, LOOK_AROUND_HEAD, MAX_HEAD_TURN_RAD,
-    SCAN_INTERVAL_MEAN_S, STRIDE_M, WALKER_MAX_SKIPS, WALKER_NODE_REACHED_M,
+    AVOID_RADIUS_M, BRIEF_SCAN_S, CURB_ARRIVAL_M, CURB_SLOWDOWN_M, CURB_SLOWDOWN_MIN, CURB_STANDOFF_M,
+    DISTRACTION_STANDSTILL, FOLLOWER_SPEED_SLACK, FULL_SCAN_S, HEADING_MIN_STEP_M, IDLE_HEAD_SWAY, LINE_OFFSET_KEEP,
+    LOOK_AROUND_HEAD, MAX_HEAD_TURN_RAD, SCAN_INTERVAL_MEAN_S, STRIDE_M, WALKER_MAX_SKIPS, WALKER_NODE_REACHED_M,
 };
 use super::state::{Activity, Attempt};
 use super::{Ped, StepCtx};
@@ -49,7 +49,9 @@ fn ai_velocity(p: &mut Ped, ctx: &StepCtx, speed: f64) -> DVec2 {
             p.attempt.reach_curb();
             return DVec2::ZERO;
         }
-        return to / d * speed.min(d / ctx.dt_s);
+        // Slowing down over the last metres to the curb.
+        let slowed = speed * (d / CURB_SLOWDOWN_M).clamp(CURB_SLOWDOWN_MIN, 1.0);
+        return to / d * slowed.min(d / ctx.dt_s);
     }
     if p.traits.standing || !p.walker.active {
         return DVec2::ZERO;
@@ -176,10 +178,14 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     }
     body.gait_phase = (body.gait_phase + dist / STRIDE_M).fract();
     p.state_time_s += dt;
+    // The patience clock runs while waiting at the curb for a gap: once the crosser's timeline would let it go
+    // (seen long enough, or the ego has passed), not while it waits for the approaching ego.
+    let trying = !p.percept.ego_ahead || p.seen_long_enough(0.0);
     if let Attempt::Undecided {
         at_curb: true,
         waited_s,
     } = &mut p.attempt
+        && trying
     {
         *waited_s += dt;
     }

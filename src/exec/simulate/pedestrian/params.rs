@@ -12,8 +12,14 @@
 /// Where a crosser stands before stepping onto the road: this far behind the near curb, metres. pedsynth: one
 /// short step back from the edge (the planner places crossers there too).
 pub const CURB_STANDOFF_M: f64 = crate::planner::CURB_STANDOFF_M;
-/// A walker heading for its curb point has arrived within this distance, metres. pedsynth: below one step.
-pub const CURB_ARRIVAL_M: f64 = 0.05;
+/// A walker heading for its curb point has arrived within this distance, metres. pedsynth: its last step lands
+/// on the point (a step never overshoots), so this only absorbs rounding.
+pub const CURB_ARRIVAL_M: f64 = 0.005;
+/// A pedestrian walking to the curb slows down over this last distance, metres ... literature: pedestrians
+/// decelerate on the last step or two before the curb (Rasouli & Tsotsos 2020).
+pub const CURB_SLOWDOWN_M: f64 = 1.5;
+/// ... to at least this share of its speed.
+pub const CURB_SLOWDOWN_MIN: f64 = 0.4;
 /// Shortest traffic check before a decision, seconds. pedsynth: one glance each way takes about half a second.
 pub const CHECK_MIN_S: f64 = 0.5;
 /// A committed crosser stops hesitating when the ego comes this much closer than the decision window's near
@@ -23,12 +29,34 @@ pub const HESITATION_CUTOFF_M: f64 = 3.0;
 /// pedsynth: the paper's crosser "commits ... as soon as the ego-vehicle is within the decision window"; a
 /// vehicle two seconds away is still a hard stop for anyone.
 pub const COMMIT_MIN_TTC_S: f64 = 2.0;
+/// Inside the decision window's near edge a crosser still commits when the ego can stop before it at this
+/// deceleration, m/s² ... pedsynth: the IDM's comfortable deceleration (CARLA reference §6).
+pub const COMFORTABLE_STOP_DECEL_MPS2: f64 = 3.0;
+/// ... with this much room to spare, metres.
+pub const STOP_MARGIN_M: f64 = 4.0;
 /// A jaywalker's brief check only waits while a vehicle would arrive within this time, seconds. pedsynth, as
 /// [`COMMIT_MIN_TTC_S`].
 pub const JAYWALK_MIN_TTC_S: f64 = 2.0;
 /// A baseline (CARLA-like) crosser waits until no vehicle is this close, metres. CARLA: the walker AI's
 /// stop-and-check waits "until no vehicle is within 6 m".
 pub const BASELINE_CLEAR_M: f64 = 6.0;
+/// A sudden crosser (or one whose patience runs out) does not step out when the ego is closer than this ahead,
+/// metres. pedsynth: "sudden" is sudden for the driver, not a collision the ego cannot avoid (it still has to
+/// brake hard: its braking rule starts at 15 m).
+pub const SUDDEN_MIN_EGO_M: f64 = 8.0;
+/// A crosser's timeline is cut short when the ego drives on (faster than this, m/s) ...
+pub const CUT_SHORT_EGO_SPEED_MPS: f64 = 1.0;
+/// ... closer than this, metres ...
+pub const CUT_SHORT_EGO_DISTANCE_M: f64 = 16.0;
+/// ... and the camera has seen the crosser at least this long, seconds (so that its track starts before its
+/// crossing). pedsynth: crossing in front of the ego, seen briefly, rather than behind it, unseen.
+pub const CUT_SHORT_MIN_IN_VIEW_S: f64 = 0.5;
+/// A sudden crosser turns onto the road once within this distance of its curb point, metres (it does not stop
+/// at the curb). pedsynth.
+pub const SUDDEN_FROM_CURB_M: f64 = 3.0;
+/// A group follower needs to have been seen for at most this long before its group steps out, seconds (it is
+/// seen with its leader; a follower half hidden behind its leader still gets a track before its crossing).
+pub const FOLLOWER_MAX_IN_VIEW_S: f64 = 1.0;
 /// A gap tighter than this multiple of the crosser's gap threshold is closed rushed. paper: the rushed profile
 /// applies "when closing a tight gap"; pedsynth: 1.5× the threshold is "tight".
 pub const RUSHED_GAP_FACTOR: f64 = 1.5;

@@ -1,15 +1,18 @@
 //! Perception: what a pedestrian knows of the traffic at the start of a step (every decision of the step uses
 //! it): TTC against every vehicle in range, where the ego is, and on the road the lookahead conflict.
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use super::Ped;
 use super::params::{BLOCKING_CLEARANCE_M, CONFLICT_MIN_VEHICLE_SPEED_MPS};
 use super::state::Activity;
+use crate::exec::observe::rig::CameraPose;
 use crate::exec::simulate::vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, Vehicle};
+use crate::exec::simulate::view::ViewProxy;
 use crate::exec::simulate::{PED_RADIUS_M, ttc};
 use crate::exec::trace::VehicleId;
 use crate::planner::SimParams;
+use crate::world::RoadNetwork;
 
 /// What a pedestrian perceives of the traffic.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,11 +27,15 @@ pub(crate) struct Percept {
     pub ego_dist_m: f64,
     /// Whether the ego has yet to pass the pedestrian (along the ego's route).
     pub ego_ahead: bool,
+    /// The ego's speed, m/s.
+    pub ego_speed_mps: f64,
     /// The vehicle of a lookahead conflict this step (own probes; crossing pedestrians on the road only).
     pub conflict_vehicle: Option<VehicleId>,
     /// Whether the last lookahead conflict seen on the road was a standing vehicle blocking the way (kept until
     /// the next lookahead on the road).
     pub blocked_by_standing: bool,
+    /// Whether the ego's camera sees the pedestrian (the simulation's estimate, `view`).
+    pub in_view: bool,
 }
 
 impl Default for Percept {
@@ -39,19 +46,49 @@ impl Default for Percept {
             nearest_vehicle_m: f64::INFINITY,
             ego_dist_m: f64::INFINITY,
             ego_ahead: true,
+            ego_speed_mps: 0.0,
             conflict_vehicle: None,
             blocked_by_standing: false,
+            in_view: false,
         }
     }
 }
 
-/// Updates `p.percept` from the vehicles' state at the start of the step (`vehicles[0]` is the ego).
-/// `probes` is scratch space.
-pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, probes: &mut Vec<DVec2>) {
+/// What a pedestrian perceives needs of the world beyond itself and the vehicles.
+pub(crate) struct Surroundings<'a> {
+    pub params: &'a SimParams,
+    pub net: &'a RoadNetwork,
+    pub view: &'a ViewProxy,
+    /// The ego's camera this step.
+    pub camera: &'a CameraPose,
+    /// Every pedestrian's ground point and height at the start of the step (occluders).
+    pub people: &'a [(DVec3, f64)],
+    /// This pedestrian's index in `people`.
+    pub me: usize,
+    pub dt_s: f64,
+}
+
+/// Updates `p.percept` from the vehicles' state at the start of the step (`vehicles[0]` is the ego), and the
+/// time the camera has seen the pedestrian. `probes` is scratch space.
+pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings, probes: &mut Vec<DVec2>) {
     let Some((ego, traffic)) = vehicles.split_first() else {
         return;
     };
+    let params = around.params;
     let pos = p.body.pos;
+    p.percept.in_view = around.view.sees(
+        around.camera,
+        DVec3::new(pos.x, pos.y, p.body.z_m),
+        p.body.yaw_rad,
+        p.traits.height_m,
+        vehicles,
+        around.people,
+        around.me,
+        around.net,
+    );
+    if p.percept.in_view {
+        p.in_view_s += around.dt_s;
+    }
     let range_m = params.gap_acceptance.vehicle_range_m;
     let percept = &mut p.percept;
     percept.min_ttc_s = ttc::min_ttc_s(pos, vehicles.iter().map(|v| (v.pose.pos, v.velocity())), range_m);
@@ -61,6 +98,7 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], params: &SimParams, pr
         .map(|v| v.pose.pos.distance(pos))
         .fold(f64::INFINITY, f64::min);
     percept.ego_dist_m = ego.pose.pos.distance(pos);
+    percept.ego_speed_mps = ego.speed_mps;
     percept.ego_ahead = ego.s_m < p.traits.route_s_m;
     percept.conflict_vehicle = None;
     let Some(line) = p.traits.line else {

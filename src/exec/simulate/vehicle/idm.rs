@@ -10,6 +10,11 @@ use crate::exec::simulate::{PED_RADIUS_M, VEHICLE_LENGTH_M};
 const VEHICLE_CORRIDOR_MARGIN_M: f64 = 0.4;
 /// Lateral margin of the corridor for pedestrians, metres.
 const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
+/// The ego stops at least this many metres short of a waiting pedestrian per metre it stands to the side (1.4:
+/// about 35° off the heading, inside the camera's 45° half field of view).
+const COURTESY_STOP_PER_LATERAL: f64 = 1.4;
+/// Time constant of the ego's easing off to its courtesy speed, seconds.
+const COURTESY_RESPONSE_S: f64 = 1.5;
 
 /// IDM acceleration towards a leader `gap_m` ahead moving at `lead_speed_mps` (`None`: free road).
 pub(crate) fn idm_accel_mps2(
@@ -123,6 +128,32 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             } else if in_path {
                 accel = -idm.max_decel_mps2;
             }
+        }
+    }
+
+    // The ego's courtesy: it eases off, at a comfortable rate, for a pedestrian heading for the curb ahead, and
+    // stops short of one waiting there attentively, until its patience for waiting runs out.
+    if let Some(c) = me.courtesy {
+        let mut approaching = false;
+        for p in peds.iter().filter(|p| p.approaching_curb) {
+            let Some((s_p, lateral, _)) = me.path.project(p.pos, me.s_m, me.s_m + c.ahead_m, c.lateral_m) else {
+                continue;
+            };
+            if s_p <= me.s_m {
+                continue;
+            }
+            approaching = true;
+            if p.waiting_at_curb && !c.patience_spent() {
+                // Far enough back that the pedestrian stays in the driver's (and the camera's) view.
+                let stop_short = c.stop_short_m.max(COURTESY_STOP_PER_LATERAL * lateral);
+                let gap = s_p - me.s_m - HALF_LENGTH_M - stop_short;
+                accel = accel.min(idm_to(gap.max(0.0), 0.0));
+            }
+        }
+        if approaching {
+            let target = me.target_speed_mps().min(c.speed_mps);
+            let ease = ((target - v) / COURTESY_RESPONSE_S).clamp(-idm.comfortable_decel_mps2, idm.max_accel_mps2);
+            accel = accel.min(ease);
         }
     }
     accel

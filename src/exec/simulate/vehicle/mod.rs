@@ -47,6 +47,8 @@ pub(crate) struct Vehicle {
     pub ignores_walkers: bool,
     /// The ego's braking rule: (ahead, lateral) metres.
     pub ego_brake_m: Option<(f64, f64)>,
+    /// The ego's courtesy for pedestrians waiting at the curb.
+    pub courtesy: Option<Courtesy>,
     /// Cached pose at `s_m`.
     pub pose: PathPose,
 }
@@ -65,6 +67,19 @@ impl Vehicle {
             false,
             Some((script.brake_ahead_m, script.brake_lateral_m)),
         )
+        .with_courtesy(Courtesy {
+            speed_mps: script.courtesy_speed_mps,
+            ahead_m: script.courtesy_ahead_m,
+            lateral_m: script.courtesy_lateral_m,
+            stop_short_m: script.courtesy_stop_short_m,
+            patience_s: script.courtesy_patience_s,
+            yielded_s: 0.0,
+        })
+    }
+
+    fn with_courtesy(mut self, courtesy: Courtesy) -> Vehicle {
+        self.courtesy = Some(courtesy);
+        self
     }
 
     /// A traffic vehicle, at its route start, at its target speed.
@@ -106,6 +121,7 @@ impl Vehicle {
             time_headway_s: time_headway_s.max(0.1),
             ignores_walkers,
             ego_brake_m,
+            courtesy: None,
             pose,
             path,
         }
@@ -131,11 +147,51 @@ impl Vehicle {
         self.pose = self.path.pose_at(self.s_m);
     }
 
+    /// Counts the time the ego yields: while an attentive pedestrian waits at the curb ahead (`yielding`), for
+    /// `dt_s` more; the count starts over once none does.
+    pub fn count_yield(&mut self, yielding: bool, dt_s: f64) {
+        if let Some(c) = self.courtesy.as_mut() {
+            c.yielded_s = if yielding { c.yielded_s + dt_s } else { 0.0 };
+        }
+    }
+
+    /// Whether a pedestrian waiting attentively at the curb is ahead within the courtesy zone.
+    pub fn sees_waiting_pedestrian(&self, peds: &[PedView]) -> bool {
+        self.courtesy.is_some_and(|c| {
+            peds.iter().filter(|p| p.waiting_at_curb).any(|p| {
+                self.path
+                    .project(p.pos, self.s_m, self.s_m + c.ahead_m, c.lateral_m)
+                    .is_some_and(|(s_p, _, _)| s_p > self.s_m)
+            })
+        })
+    }
+
     /// Moves the vehicle back along its path by `ds_m` and stops it (contact resolution).
     pub fn back_off_and_stop(&mut self, ds_m: f64) {
         self.s_m = (self.s_m - ds_m).max(0.0);
         self.speed_mps = 0.0;
         self.pose = self.path.pose_at(self.s_m);
+    }
+}
+
+/// The ego's courtesy: it eases off to `speed_mps` for a pedestrian heading for the curb up to `ahead_m` ahead
+/// along its path and `lateral_m` to the side, and stops `stop_short_m` before one waiting there attentively —
+/// for `patience_s` at most; then it drives on (at the eased speed) until no waiting pedestrian is ahead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Courtesy {
+    pub speed_mps: f64,
+    pub ahead_m: f64,
+    pub lateral_m: f64,
+    pub stop_short_m: f64,
+    pub patience_s: f64,
+    /// Time it has yielded (a waiting pedestrian ahead), seconds.
+    pub yielded_s: f64,
+}
+
+impl Courtesy {
+    /// Whether the ego has waited long enough and drives on.
+    pub fn patience_spent(&self) -> bool {
+        self.yielded_s >= self.patience_s
     }
 }
 
@@ -146,4 +202,8 @@ pub(crate) struct PedView {
     pub velocity: DVec2,
     /// In a crossing-type state or retreating (the ego's braking rule applies).
     pub crossing: bool,
+    /// Heading for the curb (or standing there) to cross, or as if to: the ego eases off.
+    pub approaching_curb: bool,
+    /// Waiting at the curb attentively (looking, checking the traffic, hesitating): the ego stops short.
+    pub waiting_at_curb: bool,
 }
