@@ -284,8 +284,23 @@ pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &
     )
 }
 
-/// `pedsynth stats DIR [--json]`: statistics computed from the written tables.
-pub fn stats(dir: &Path, json: bool, out: &mut dyn Write) -> Result<(), Error> {
+/// `pedsynth stats DIR [--json] [--protocol pab ...]`: statistics computed from the written tables, or, with a
+/// protocol, what a benchmark's sampling gets from them.
+pub fn stats(
+    dir: &Path,
+    json: bool,
+    protocol: Option<&crate::exec::read::protocol::PabOptions>,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    if let Some(options) = protocol {
+        let stats = crate::exec::read::protocol::compute(dir, options)?;
+        let text = if json {
+            crate::error::to_json(&stats, true)? + "\n"
+        } else {
+            stats.to_string()
+        };
+        return emit(out, &text);
+    }
     let stats = crate::exec::read::stats::compute(dir)?;
     let text = if json {
         crate::error::to_json(&stats, true)? + "\n"

@@ -55,6 +55,8 @@ pub mod code {
     pub const DATASET_REFUSED: &str = "pedsynth::dataset::refused";
     /// A dataset that cannot be read as a pedsynth dataset (missing or malformed tables or manifest).
     pub const DATASET_INVALID: &str = "pedsynth::dataset::invalid";
+    /// Options of `stats --protocol` that the protocol does not define.
+    pub const PROTOCOL_OPTIONS: &str = "pedsynth::dataset::protocol_options";
     /// A file or directory that cannot be read.
     pub const IO_READ: &str = "pedsynth::io::read";
     /// A file or directory that cannot be written (disk full, permissions, read-only file system).
@@ -173,6 +175,10 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::DATASET_INVALID,
         "a directory that cannot be read as a pedsynth dataset (missing or malformed manifest or tables)",
+    ),
+    input(
+        code::PROTOCOL_OPTIONS,
+        "`stats --protocol` options that the benchmark's sampling does not define (a track shorter than its windows)",
     ),
     environment(code::IO_READ, "a file or directory cannot be read"),
     environment(

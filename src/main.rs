@@ -74,13 +74,29 @@ enum Command {
         #[command(flatten)]
         spec_args: SpecArgs,
     },
-    /// Dataset statistics computed from the written tables.
+    /// Dataset statistics computed from the written tables (or a benchmark's sampling of them, --protocol).
     Stats {
         /// Dataset directory.
         dir: PathBuf,
         /// Print JSON instead of tables.
         #[arg(long)]
         json: bool,
+        /// Report what a benchmark's sampling gets from the dataset: `pab` (PedestrianActionBenchmark:
+        /// tracks up to the crossing point, observation windows before it), per class and split.
+        #[arg(long, value_enum)]
+        protocol: Option<Protocol>,
+        /// Frames per observation window (PAB's obs_length).
+        #[arg(long, value_name = "FRAMES", default_value_t = 16, requires = "protocol")]
+        obs_length: usize,
+        /// Frames from a window's end to the event, `MIN,MAX` (PAB's time_to_event).
+        #[arg(long, value_name = "MIN,MAX", default_value = "30,60", value_parser = parse_pair, requires = "protocol")]
+        tte: (usize, usize),
+        /// Overlap of consecutive windows (0.6 PIE, 0.8 JAAD).
+        #[arg(long, default_value_t = 0.6, requires = "protocol")]
+        overlap: f64,
+        /// Shortest eligible track, frames (default: obs length + largest TTE).
+        #[arg(long, value_name = "FRAMES", requires = "protocol")]
+        min_track: Option<usize>,
     },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
@@ -89,6 +105,22 @@ enum Command {
         #[command(subcommand)]
         command: TownCommand,
     },
+}
+
+/// Benchmark protocols of `stats --protocol`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Protocol {
+    /// PedestrianActionBenchmark (Kotseruba et al., WACV 2021).
+    Pab,
+}
+
+/// Parses `A,B` into two counts.
+fn parse_pair(text: &str) -> Result<(usize, usize), String> {
+    let (a, b) = text
+        .split_once(',')
+        .ok_or_else(|| format!("expected MIN,MAX, found `{text}`"))?;
+    let parse = |x: &str| x.trim().parse::<usize>().map_err(|e| format!("`{x}`: {e}"));
+    Ok((parse(a)?, parse(b)?))
 }
 
 #[derive(Subcommand)]
@@ -164,7 +196,23 @@ fn main() -> ExitCode {
             };
             commands::generate(&input, &load_options(spec_args), &args, &mut out)
         }
-        Command::Stats { dir, json } => commands::stats(&dir, json, &mut out),
+        Command::Stats {
+            dir,
+            json,
+            protocol,
+            obs_length,
+            tte,
+            overlap,
+            min_track,
+        } => {
+            let options = protocol.map(|Protocol::Pab| pedsynth::exec::read::protocol::PabOptions {
+                obs_length,
+                tte_frames: tte,
+                overlap,
+                min_track: min_track.unwrap_or(obs_length + tte.1),
+            });
+            commands::stats(&dir, json, options.as_ref(), &mut out)
+        }
         Command::Schema => commands::schema(&mut out),
         Command::Town {
             command: TownCommand::List,

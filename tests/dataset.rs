@@ -968,3 +968,30 @@ fn generate_refuses_directories_it_must_not_write_into() {
         .collect();
     assert_eq!(names, ["notes.txt"], "nothing written");
 }
+
+#[test]
+fn stats_protocol_pab_reads_the_tables_and_refuses_undefined_options() {
+    use pedsynth::exec::read::protocol::PabOptions;
+    let tmp = TempDir::new("pab");
+    let out = tmp.join("out");
+    generate_ok(&spec("quickstart.yaml"), &[], &out, 1);
+    let (mut o, mut e) = (Vec::new(), Vec::new());
+    let pab = PabOptions::default();
+    let code = commands::finish(commands::stats(&out, true, Some(&pab), &mut o), &mut e);
+    assert_eq!(code, 0, "{}", String::from_utf8_lossy(&e));
+    let json: serde_json::Value = serde_json::from_slice(&o).expect("JSON");
+    assert_eq!(json["stride"], 6);
+    let d = read_dataset(&out);
+    let tracks =
+        json["all"]["crossing"]["tracks"].as_u64().unwrap() + json["all"]["not_crossing"]["tracks"].as_u64().unwrap();
+    let annotated: std::collections::BTreeSet<_> =
+        d.annotations.iter().map(|a| (a.clip.clone(), a.ped)).collect();
+    assert_eq!(tracks, annotated.len() as u64, "one track per annotated pedestrian");
+
+    // A minimum track shorter than a window's reach is not the benchmark's sampling: a clear input error.
+    let short = PabOptions { min_track: 50, ..pab };
+    let (mut o, mut e) = (Vec::new(), Vec::new());
+    let code = commands::finish(commands::stats(&out, false, Some(&short), &mut o), &mut e);
+    assert_eq!(code, 2);
+    assert!(String::from_utf8_lossy(&e).contains("pedsynth::dataset::protocol_options"));
+}

@@ -697,3 +697,132 @@ fn vehicles_follow_without_passing_through_each_other() {
     let last = trace.ego.last().expect("frames");
     assert!((last.speed_mps - trace.vehicles[0].last().expect("frames").speed_mps).abs() < 0.5);
 }
+
+/// The first annotated frame of pedestrian `id` (it passes the visibility gate of the default camera).
+fn first_annotated(script: &ClipScript, trace: &ClipTrace, net: &RoadNetwork) -> Option<usize> {
+    let spec = Spec::default();
+    let camera = pedsynth::exec::observe::rig::Camera::from_spec(&spec.sensors.rgb);
+    let obs = pedsynth::exec::observe::annotate::annotate(script, trace, &spec.annotations, &camera, net);
+    obs.rows.iter().find(|r| r.pedestrian == 0).map(|r| r.frame as usize)
+}
+
+/// A crosser at its curb with the ego 40 m away and slow (1.7 m/s): without a timeline it decides at once;
+/// with `in_view_before_crossing_s` = 4 s it steps out only after the camera has seen it for 4 s (measured
+/// with the annotation's visibility gate, which the simulation's view estimate approximates).
+#[test]
+fn a_crosser_steps_out_only_after_the_camera_has_seen_it_for_its_planned_time() {
+    let net = road();
+    let run = |in_view_s: Option<f64>| {
+        let mut p = at_curb(crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated));
+        p.in_view_before_crossing_s = in_view_s;
+        let script = clip(ego_at(&net, 110.0, 80.0), vec![], vec![p], 12);
+        let trace = simulate::simulate(&script, &params(), &net);
+        assert_no_interpenetration(&trace);
+        let seen = first_annotated(&script, &trace, &net).expect("the camera sees it");
+        let entered = first_in_road(&trace, 0).expect("crosses");
+        (entered as f64 - seen as f64) / 30.0
+    };
+    let without = run(None);
+    let with = run(Some(4.0));
+    assert!(
+        without < 2.5,
+        "without a timeline it steps out {without:.2} s after it is first seen"
+    );
+    assert!(
+        (3.8..6.0).contains(&with),
+        "with a 4 s timeline it steps out {with:.2} s after it is first seen"
+    );
+}
+
+/// A hard negative walks to its curb, stops and checks traffic for its planned wait, and walks on without
+/// ever stepping onto the road.
+#[test]
+fn a_hard_negative_waits_at_the_curb_and_walks_on_without_crossing() {
+    let net = road();
+    let mut p = crosser(&net, 0, 150.0, Behaviour::HardNegative, CrosserSource::None);
+    p.role = Role::NonCrosser;
+    p.curb_wait_s = Some(5.0);
+    let script = clip(ego_at(&net, 0.0, 0.0), vec![], vec![p], 15);
+    let trace = simulate::simulate(&script, &params(), &net);
+    assert!(
+        trace.pedestrians[0]
+            .iter()
+            .all(|f| f.lane_type != Some(LaneType::Driving)),
+        "it never steps onto the road"
+    );
+    let s = states(&trace, 0);
+    assert!(s.contains(&PedState::CheckingTraffic), "{s:?}");
+    assert_eq!(s.last(), Some(&PedState::WalkingSidewalk), "{s:?}");
+    let checking_s = trace.pedestrians[0]
+        .iter()
+        .filter(|f| f.state == PedState::CheckingTraffic)
+        .count() as f64
+        / 30.0;
+    assert!(
+        (4.9..5.5).contains(&checking_s),
+        "checked traffic for {checking_s:.2} s"
+    );
+    let near_curb = trace.pedestrians[0].iter().map(|f| f.pos.y).fold(f64::MIN, f64::max);
+    assert!(near_curb > -3.9, "it reached the curb (y = {near_curb:.2})");
+}
+
+/// The ego eases off for a pedestrian waiting at the curb ahead, stops short of it, and drives on once it has
+/// yielded for its patience (counted from when the waiting pedestrian enters its courtesy zone); without
+/// courtesy it keeps its speed.
+#[test]
+fn the_ego_eases_off_and_stops_short_for_a_pedestrian_waiting_at_the_curb() {
+    let net = road();
+    let run = |courtesy: bool| {
+        let mut p = at_curb(crosser(&net, 0, 150.0, Behaviour::HardNegative, CrosserSource::None));
+        p.role = Role::NonCrosser;
+        p.curb_wait_s = Some(30.0);
+        let mut ego = ego_at(&net, 60.0, 0.0);
+        if courtesy {
+            ego.courtesy_speed_mps = 2.5;
+            ego.courtesy_patience_s = 12.0;
+        }
+        let script = clip(ego, vec![], vec![p], 30);
+        simulate::simulate(&script, &params(), &net)
+    };
+    let plain = run(false);
+    let slowest = |t: &ClipTrace| {
+        t.ego
+            .iter()
+            .filter(|f| f.pos.x < 150.0)
+            .map(|f| f.speed_mps)
+            .fold(f64::MAX, f64::min)
+    };
+    assert!(
+        slowest(&plain) > 7.0,
+        "without courtesy: slowest {:.2} m/s",
+        slowest(&plain)
+    );
+    let kind = run(true);
+    // It eases off from the moment the waiting pedestrian is 35 m ahead (its centre's distance), with a 1.5 s
+    // response: 5 s later it is within 0.3 m/s of its courtesy speed, until it has passed the pedestrian.
+    let zone = kind.ego.iter().position(|f| f.pos.x >= 115.0).expect("zone");
+    let eased: Vec<f64> = kind.ego[zone + 150..]
+        .iter()
+        .take_while(|f| f.pos.x < 150.0)
+        .map(|f| f.speed_mps)
+        .collect();
+    assert!(eased.len() > 30);
+    let fastest = eased.iter().fold(0.0f64, |a, &b| a.max(b));
+    assert!(fastest <= 2.5 + 0.3, "eased to only {fastest:.2} m/s");
+    // It stops short of the pedestrian, about 8 m before.
+    let stop = kind.ego.iter().position(|f| f.speed_mps < 0.1).expect("it stops");
+    let gap_m = 150.0 - (kind.ego[stop].pos.x + VEHICLE_LENGTH_M / 2.0);
+    assert!((5.0..12.0).contains(&gap_m), "stopped {gap_m:.1} m short");
+    // Then, its patience spent (12 s after the pedestrian entered the zone), it drives on past the pedestrian,
+    // which still waits.
+    let moves_on = stop
+        + kind.ego[stop..]
+            .iter()
+            .position(|f| f.speed_mps > 0.5)
+            .expect("drives on");
+    let yielded_s = (moves_on - zone) as f64 / 30.0;
+    assert!((11.5..13.5).contains(&yielded_s), "yielded for {yielded_s:.2} s");
+    assert!(kind.ego.last().expect("frames").pos.x > 155.0, "drives on");
+    assert_eq!(kind.pedestrians[0][moves_on].state, PedState::CheckingTraffic);
+    assert_no_interpenetration(&kind);
+}

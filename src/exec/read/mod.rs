@@ -1,4 +1,8 @@
 //! Reading a written dataset (never re-simulating).
 //!
+//! - [`tables`] — reading tables: files, columns, typed access that reports bad input as errors.
 //! - [`stats`] — `pedsynth stats`: statistics computed from the written tables.
+//! - [`protocol`] — `pedsynth stats --protocol pab`: PedestrianActionBenchmark's sampling of the tables.
+pub mod protocol;
 pub mod stats;
+pub mod tables;

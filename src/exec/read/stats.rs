@@ -2,16 +2,12 @@
 //! target vs achieved crossing ratio, state shares, per-archetype crossing rates and speeds, per-split counts).
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, UInt32Type, UInt64Type};
-use arrow_array::{Array, RecordBatch};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde::Serialize;
 
-use crate::error::{Error, code};
+use super::tables;
+use crate::error::Error;
 use crate::exec::write::Layout;
 
 /// Counts of one split.
@@ -93,49 +89,6 @@ pub struct DatasetStats {
     pub contacts: u64,
 }
 
-fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<RecordBatch>, Error> {
-    let invalid = |e: &dyn std::fmt::Display| Error::new(code::DATASET_INVALID, format!("{}: {e}", path.display()));
-    let file = File::open(path).map_err(|e| Error::read(path, e))?;
-    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| invalid(&e))?;
-    let schema = builder.parquet_schema();
-    let indices: Vec<usize> = columns
-        .iter()
-        .map(|c| {
-            schema
-                .columns()
-                .iter()
-                .position(|col| col.path().parts()[0] == *c)
-                .ok_or_else(|| invalid(&format!("no column `{c}`")))
-        })
-        .collect::<Result<_, _>>()?;
-    let mask = parquet::arrow::ProjectionMask::roots(schema, indices);
-    let reader = builder.with_projection(mask).build().map_err(|e| invalid(&e))?;
-    reader.collect::<Result<Vec<_>, _>>().map_err(|e| invalid(&e))
-}
-
-fn files(layout: &Layout, table: &str) -> Result<Vec<PathBuf>, Error> {
-    let d = layout.table_dir(table);
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&d)
-        .map_err(|e| {
-            Error::new(
-                code::DATASET_INVALID,
-                format!("{}: {e} (is this a pedsynth dataset?)", d.display()),
-            )
-        })?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "parquet"))
-        .collect();
-    out.sort();
-    Ok(out)
-}
-
-fn col<'a>(batch: &'a RecordBatch, name: &str) -> &'a dyn Array {
-    batch
-        .column_by_name(name)
-        .map(|c| c.as_ref())
-        .expect("projected column")
-}
-
 /// Computes the statistics of the dataset in `dir` from its tables.
 pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     let layout = Layout::new(dir);
@@ -149,9 +102,9 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     let mut duration_s = 0.0;
     let mut states: BTreeMap<String, u64> = BTreeMap::new();
     let mut speed_sums: BTreeMap<String, (f64, u64)> = BTreeMap::new();
-    for path in files(&layout, "clips")? {
+    for path in tables::files(&layout, "clips")? {
         let mut split = String::new();
-        for b in read_table(
+        for b in tables::read(
             &path,
             &[
                 "town",
@@ -168,30 +121,28 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 "contacts",
             ],
         )? {
-            for i in 0..b.num_rows() {
-                let town = col(&b, "town").as_string::<i32>().value(i).to_owned();
-                let weather = col(&b, "weather").as_string::<i32>().value(i).to_owned();
-                split = col(&b, "split").as_string::<i32>().value(i).to_owned();
-                let frames = u64::from(col(&b, "frame_count").as_primitive::<UInt32Type>().value(i));
-                let samples = col(&b, "annotated_samples").as_primitive::<UInt64Type>().value(i);
+            let (town, weather, splits) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
+            let (frame_count, samples_col) = (b.u32s("frame_count")?, b.u64s("annotated_samples")?);
+            let (durations, contacts) = (b.f64s("duration_s")?, b.u32s("contacts")?);
+            for i in 0..b.rows() {
+                split = splits[i].to_owned();
+                let frames = u64::from(frame_count.value(i));
+                let samples = samples_col.value(i);
                 s.clips += 1;
                 s.frames += frames;
                 s.annotated_samples += samples;
-                duration_s += col(&b, "duration_s")
-                    .as_primitive::<arrow_array::types::Float64Type>()
-                    .value(i);
-                s.contacts += u64::from(col(&b, "contacts").as_primitive::<UInt32Type>().value(i));
+                duration_s += durations.value(i);
+                s.contacts += u64::from(contacts.value(i));
                 for reason in ["too_far", "behind", "too_small", "outside_image", "occluded"] {
-                    *s.rejected.entry(reason.to_owned()).or_default() += col(&b, &format!("rejected_{reason}"))
-                        .as_primitive::<UInt64Type>()
-                        .value(i);
+                    *s.rejected.entry(reason.to_owned()).or_default() +=
+                        b.u64s(&format!("rejected_{reason}"))?.value(i);
                 }
                 let sp = s.splits.entry(split.clone()).or_default();
                 sp.clips += 1;
                 sp.frames += frames;
                 sp.samples += samples;
-                towns.insert(town);
-                weathers.insert(weather);
+                towns.insert(town[i].to_owned());
+                weathers.insert(weather[i].to_owned());
             }
         }
         let clip_id = path
@@ -200,14 +151,15 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
             .unwrap_or_default();
         // Pedestrians of this clip: sequence labels and archetypes.
         let mut archetype_of: Vec<String> = Vec::new();
-        for b in read_table(
+        for b in tables::read(
             &layout.table("pedestrians", &clip_id),
             &["pedestrian", "archetype", "crosser"],
         )? {
-            for i in 0..b.num_rows() {
-                let id = col(&b, "pedestrian").as_primitive::<UInt32Type>().value(i) as usize;
-                let archetype = col(&b, "archetype").as_string::<i32>().value(i).to_owned();
-                let crosser = col(&b, "crosser").as_boolean().value(i);
+            let (ids, archetypes, crossers) = (b.u32s("pedestrian")?, b.strings("archetype")?, b.bools("crosser")?);
+            for (i, archetype) in archetypes.iter().enumerate() {
+                let id = ids.value(i) as usize;
+                let archetype = (*archetype).to_owned();
+                let crosser = crossers.value(i);
                 if archetype_of.len() <= id {
                     archetype_of.resize(id + 1, String::new());
                 }
@@ -222,17 +174,16 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.crossers += u64::from(crosser);
             }
         }
-        for b in read_table(
+        for b in tables::read(
             &layout.table("annotations", &clip_id),
             &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"],
         )? {
-            let ped = col(&b, "pedestrian").as_primitive::<UInt32Type>();
-            let state = col(&b, "state").as_string::<i32>();
-            let crossing = col(&b, "crossing").as_boolean();
-            let vx = col(&b, "vx_mps").as_primitive::<Float32Type>();
-            let vy = col(&b, "vy_mps").as_primitive::<Float32Type>();
-            for i in 0..b.num_rows() {
-                *states.entry(state.value(i).to_owned()).or_default() += 1;
+            let ped = b.u32s("pedestrian")?;
+            let state = b.strings("state")?;
+            let crossing = b.bools("crossing")?;
+            let (vx, vy) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?);
+            for (i, state) in state.iter().enumerate() {
+                *states.entry((*state).to_owned()).or_default() += 1;
                 s.crossing_samples += u64::from(crossing.value(i));
                 let speed = f64::from(vx.value(i)).hypot(f64::from(vy.value(i)));
                 if speed > 0.2

@@ -139,7 +139,9 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             let Some((s_p, lateral, _)) = me.path.project(p.pos, me.s_m, me.s_m + c.ahead_m, c.lateral_m) else {
                 continue;
             };
-            if s_p <= me.s_m {
+            // Only pedestrians beside the zone: `project` clamps to the zone's end, which would make a disc
+            // of `lateral_m` beyond it count too.
+            if s_p <= me.s_m || s_p >= me.s_m + c.ahead_m {
                 continue;
             }
             approaching = true;

@@ -161,7 +161,7 @@ impl Vehicle {
             peds.iter().filter(|p| p.waiting_at_curb).any(|p| {
                 self.path
                     .project(p.pos, self.s_m, self.s_m + c.ahead_m, c.lateral_m)
-                    .is_some_and(|(s_p, _, _)| s_p > self.s_m)
+                    .is_some_and(|(s_p, _, _)| s_p > self.s_m && s_p < self.s_m + c.ahead_m)
             })
         })
     }
