@@ -984,8 +984,7 @@ fn stats_protocol_pab_reads_the_tables_and_refuses_undefined_options() {
     let d = read_dataset(&out);
     let tracks =
         json["all"]["crossing"]["tracks"].as_u64().unwrap() + json["all"]["not_crossing"]["tracks"].as_u64().unwrap();
-    let annotated: std::collections::BTreeSet<_> =
-        d.annotations.iter().map(|a| (a.clip.clone(), a.ped)).collect();
+    let annotated: std::collections::BTreeSet<_> = d.annotations.iter().map(|a| (a.clip.clone(), a.ped)).collect();
     assert_eq!(tracks, annotated.len() as u64, "one track per annotated pedestrian");
 
     // A minimum track shorter than a window's reach is not the benchmark's sampling: a clear input error.
