@@ -41,29 +41,12 @@ pub const NOT_YET: &[NotYet] = &[
         why: "no town has traffic lights yet, so there are no lights to ignore",
     },
     NotYet {
-        path: "sensors.rgb.enabled",
-        why: "camera images are not rendered yet (the camera's size, field of view and mount are used: they \
-              define the annotations' image)",
-    },
-    NotYet {
         path: "sensors.lidar",
         why: "LiDAR sweeps are not rendered yet",
     },
     NotYet {
-        path: "sensors.dvs",
-        why: "DVS events are not rendered yet",
-    },
-    NotYet {
-        path: "output.rgb_encoding",
-        why: "camera images are not rendered yet",
-    },
-    NotYet {
         path: "output.lidar_encoding",
         why: "LiDAR sweeps are not rendered yet",
-    },
-    NotYet {
-        path: "output.dvs_encoding",
-        why: "DVS events are not rendered yet",
     },
 ];
 

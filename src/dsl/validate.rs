@@ -29,6 +29,13 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
         22.0,
         "a zstd level",
     );
+    v.num(
+        "output.jpeg_quality",
+        f64::from(spec.output.jpeg_quality),
+        1.0,
+        100.0,
+        "a JPEG quality",
+    );
     if !allow_large {
         v.limits(spec);
     }
@@ -909,6 +916,13 @@ impl Validator<'_> {
             d.log_eps,
             1.0,
             "an epsilon added before the logarithm",
+        );
+        self.num(
+            "sensors.dvs.substeps",
+            f64::from(d.substeps),
+            1.0,
+            16.0,
+            "images rendered per frame interval",
         );
     }
 

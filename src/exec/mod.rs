@@ -6,8 +6,9 @@
 //!
 //! - [`simulate`] — everything that moves: vehicles, the ego, pedestrians and their 12-state behaviour machine.
 //! - [`trace`] — what the simulation produces (per-frame agent states and events).
-//! - [`observe`] — pure functions of (script, trace, frame): sensor rig, bodies, annotations.
-//! - [`write`] — the only code that touches the output directory: layout, tables, manifest.
+//! - [`observe`] — pure functions of (script, trace, frame): sensor rig, bodies, annotations, the scene and
+//!   the camera streams (handed to the writer frame by frame).
+//! - [`write`] — the only code that touches the output directory: layout, tables, sensor files, manifest.
 //! - [`generate`] — orchestration of `pedsynth generate`: clips in parallel, resume, progress.
 //! - [`read`] — code that reads a written dataset (`pedsynth stats`), never re-simulating.
 
@@ -30,6 +31,8 @@ pub struct ClipCounts {
     pub pedestrian_frames: u64,
     /// Annotated samples written.
     pub samples: u64,
+    /// Camera frames rendered.
+    pub rendered_frames: u64,
 }
 
 /// Generates one clip: simulate, observe, write. Every file it writes is a pure function of (plan, clip).
@@ -42,10 +45,23 @@ pub fn run_clip(
 ) -> Result<ClipCounts, Error> {
     let trace = simulate::simulate(script, &plan.sim, &town.network);
     let observations = observe::observe(script, &trace, &plan.spec, rig, &town.network);
-    out.write_clip(plan, script, &trace, &observations)?;
+    let sensors = &plan.spec.sensors;
+    let mut images = 0u64;
+    let sensor_rows = if observe::cameras_enabled(sensors) {
+        let mut files = out.clip_sensors(plan, script);
+        observe::render_cameras(script, &trace, sensors, rig, &town.network, |frame| {
+            images += 1;
+            files.frame(frame)
+        })?;
+        files.finish(|batch, stream| out.sensor_parquet(plan, batch, stream, &script.clip_id))?
+    } else {
+        Vec::new()
+    };
+    out.write_clip(plan, script, &trace, &observations, &sensor_rows)?;
     Ok(ClipCounts {
         frames: u64::from(script.frame_count),
         pedestrian_frames: u64::from(script.frame_count) * script.pedestrians.len() as u64,
         samples: observations.annotations.rows.len() as u64,
+        rendered_frames: images,
     })
 }

@@ -45,6 +45,10 @@ pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSampl
 /// the paper's CARLA towns but are not CARLA's maps, hence the `_like` suffix.
 pub const BUILTIN_TOWN_NAMES: [&str; 4] = ["town01_like", "town02_like", "town03_like", "town05_like"];
 
+/// Height of the curb: sidewalk surfaces stand this much above the reference line's elevation, so pedestrians
+/// step down onto the road and sensors see the curb, metres (CARLA's towns: about 15 cm).
+pub const CURB_HEIGHT_M: f64 = 0.15;
+
 /// Projection of `p` on the segment `a`–`b` (plan view): `(t, squared distance, squared segment length)` with
 /// `t` in [0, 1] the fraction along the segment of the nearest point (0 for a degenerate segment).
 #[inline]

@@ -126,6 +126,10 @@ pub struct Output {
     pub zstd_level: u32,
     /// Encoding of RGB frames.
     pub rgb_encoding: RgbEncoding,
+    /// JPEG quality (1–100) when `rgb_encoding` is `jpeg`.
+    pub jpeg_quality: u8,
+    /// Encoding of depth images.
+    pub depth_encoding: DepthEncoding,
     /// Encoding of LiDAR sweeps.
     pub lidar_encoding: LidarEncoding,
     /// Encoding of DVS events.
@@ -138,6 +142,8 @@ impl Default for Output {
             compression: Compression::Zstd,
             zstd_level: 3,
             rgb_encoding: RgbEncoding::Png,
+            jpeg_quality: 90,
+            depth_encoding: DepthEncoding::MillimetresU16,
             lidar_encoding: LidarEncoding::Parquet,
             dvs_encoding: DvsEncoding::Parquet,
         }
@@ -162,6 +168,20 @@ pub enum Compression {
 pub enum RgbEncoding {
     /// One PNG per frame (fast compression).
     Png,
+    /// One JPEG per frame (`jpeg_quality`, 4:2:0 chroma subsampling).
+    Jpeg,
+}
+
+/// Depth image encodings (both lossless).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DepthEncoding {
+    /// 16-bit grayscale PNG of millimetres along the optical axis (65535: 65.535 m or farther, and the sky).
+    #[serde(rename = "mm_u16")]
+    MillimetresU16,
+    /// CARLA's 24-bit encoding in an RGB PNG: `depth_m = 1000 (R + 256 G + 65536 B) / (2^24 − 1)`.
+    #[serde(rename = "carla_rgb24")]
+    CarlaRgb24,
 }
 
 /// LiDAR sweep encodings.

@@ -14,6 +14,26 @@ pub struct Sensors {
     pub lidar: Lidar,
     /// DVS event camera (co-located with the RGB camera, same intrinsics).
     pub dvs: Dvs,
+    /// Metric depth images from the RGB camera.
+    pub depth: LabelStream,
+    /// Semantic segmentation (CARLA's tag ids) from the RGB camera.
+    pub semantic: LabelStream,
+    /// Instance segmentation (pedestrian and vehicle ids) from the RGB camera.
+    pub instance: LabelStream,
+}
+
+/// A label stream rendered from the RGB camera's view (same intrinsics and mount, pixel-aligned with it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct LabelStream {
+    /// Whether the stream is written.
+    pub enabled: bool,
+}
+
+impl Default for LabelStream {
+    fn default() -> Self {
+        LabelStream { enabled: true }
+    }
 }
 
 /// A sensor mount in the ego vehicle's body frame (x forward, y left, z up, metres; angles in degrees).
@@ -158,6 +178,9 @@ pub struct Dvs {
     pub use_log: bool,
     /// Epsilon added before the logarithm.
     pub log_eps: f64,
+    /// Images rendered per frame interval for the event simulation (1: the frames only; more sample fast
+    /// motion between frames).
+    pub substeps: u32,
 }
 
 impl Default for Dvs {
@@ -171,6 +194,7 @@ impl Default for Dvs {
             refractory_period_ns: 0,
             use_log: true,
             log_eps: 0.001,
+            substeps: 1,
         }
     }
 }

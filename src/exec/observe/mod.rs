@@ -3,12 +3,20 @@
 //! - [`rig`] — the ego's sensor rig: mounts and intrinsics from the spec (the pinhole camera).
 //! - [`body`] — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
 //! - [`annotate`] — visibility gate, boxes, keypoints, occlusion and crossing labels.
+//! - [`scene`] — the renderable geometry of a frame (one source for cameras and LiDAR).
+//! - [`camera`] — RGB, depth, semantic, instance and DVS, rendered on the CPU.
+//!
+//! Sensor streams are too large to hold for a whole clip, so [`render_cameras`] hands each frame to a sink
+//! (the writer) as soon as it is rendered; the sink does the IO, this module none.
 
 pub mod annotate;
 pub mod body;
+pub mod camera;
 pub mod rig;
+pub mod scene;
 
 use crate::dsl::Spec;
+use crate::dsl::types::Sensors;
 use crate::exec::trace::ClipTrace;
 use crate::planner::ClipScript;
 use crate::world::RoadNetwork;
@@ -27,4 +35,88 @@ pub fn observe(script: &ClipScript, trace: &ClipTrace, spec: &Spec, rig: &Rig, t
     Observations {
         annotations: annotate::annotate(script, trace, &spec.annotations, &rig.camera, town),
     }
+}
+
+/// One rendered frame of the camera streams, as handed to the sink.
+#[derive(Debug)]
+pub struct SensorFrame<'a> {
+    /// Frame index.
+    pub frame: u32,
+    /// Simulated time of the frame, nanoseconds.
+    pub timestamp_ns: i64,
+    /// The frame's images.
+    pub images: &'a camera::CameraImages,
+    /// DVS events in (previous frame, this frame], sorted by time (empty without DVS).
+    pub events: &'a [camera::dvs::Event],
+}
+
+/// Whether any camera stream of the spec is enabled.
+pub fn cameras_enabled(sensors: &Sensors) -> bool {
+    sensors.rgb.enabled
+        || sensors.dvs.enabled
+        || sensors.depth.enabled
+        || sensors.semantic.enabled
+        || sensors.instance.enabled
+}
+
+/// The simulated time of frame `frame` plus `k / substeps` of a frame, nanoseconds.
+pub fn frame_time_ns(frame: u32, fps: u32, k: u32, substeps: u32) -> i64 {
+    let ns = i128::from(frame) * 1_000_000_000 * i128::from(substeps) + i128::from(k) * 1_000_000_000;
+    (ns / (i128::from(fps.max(1)) * i128::from(substeps.max(1)))) as i64
+}
+
+/// Renders the camera streams of a clip frame by frame and hands each frame to `sink` (in frame order).
+/// Every image is a pure function of (script, trace, frame).
+pub fn render_cameras<E>(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    sensors: &Sensors,
+    rig: &Rig,
+    town: &RoadNetwork,
+    mut sink: impl FnMut(SensorFrame) -> Result<(), E>,
+) -> Result<(), E> {
+    let stat = scene::StaticScene::build(script, trace, town);
+    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut frame_scene = scene::FrameScene::default();
+    let mut images = camera::CameraImages::default();
+    let (w, h) = (rig.camera.width_px as usize, rig.camera.height_px as usize);
+    let mut esim = sensors.dvs.enabled.then(|| camera::dvs::Esim::new(&sensors.dvs, w, h));
+    let substeps = sensors.dvs.substeps.max(1);
+    let mut events = Vec::new();
+    let frames = trace.frame_count.min(trace.ego.len() as u32);
+    let mut render = |t: scene::SceneTime, k: u32, images: &mut camera::CameraImages| {
+        frame_scene.build(&stat, script, trace, t);
+        let (pos, yaw) = scene::ego_at(trace, t);
+        let pose = rig.camera.at(pos, yaw);
+        renderer.render(&stat, &frame_scene, &pose, camera::streak_seed(script.seed, t.frame, k), images);
+    };
+    for frame in 0..frames {
+        events.clear();
+        if let Some(esim) = esim.as_mut()
+            && frame > 0
+        {
+            for k in 1..substeps {
+                let t = scene::SceneTime {
+                    frame: frame - 1,
+                    alpha: f64::from(k) / f64::from(substeps),
+                };
+                render(t, k, &mut images);
+                let now = frame_time_ns(frame - 1, script.fps, k, substeps);
+                esim.step(&images.rgb, now, camera::streak_seed(script.seed ^ 0xd75, frame - 1, k), &mut events);
+            }
+        }
+        render(scene::SceneTime::at(frame), 0, &mut images);
+        let now = frame_time_ns(frame, script.fps, 0, 1);
+        if let Some(esim) = esim.as_mut() {
+            esim.step(&images.rgb, now, camera::streak_seed(script.seed ^ 0xd75, frame, 0), &mut events);
+        }
+        sink(SensorFrame {
+            frame,
+            timestamp_ns: now,
+            images: &images,
+            events: &events,
+        })?;
+    }
+    Ok(())
 }

@@ -56,6 +56,21 @@ impl Layout {
         self.table_dir(table).join(format!("{clip_id}.parquet"))
     }
 
+    /// The directory of one stream's files of one clip: `sensors/<stream>/<clip_id>`.
+    pub fn sensor_dir(&self, stream: &str, clip_id: &str) -> PathBuf {
+        self.root.join(SENSORS_DIR).join(stream).join(clip_id)
+    }
+
+    /// One frame's file of a sensor stream: `sensors/<stream>/<clip_id>/<frame:06>.<ext>`.
+    pub fn sensor_frame(&self, stream: &str, clip_id: &str, frame: u32, ext: &str) -> PathBuf {
+        self.sensor_dir(stream, clip_id).join(format!("{frame:06}.{ext}"))
+    }
+
+    /// A clip's single file of a sensor stream: `sensors/<stream>/<clip_id>.<ext>`.
+    pub fn sensor_clip(&self, stream: &str, clip_id: &str, ext: &str) -> PathBuf {
+        self.root.join(SENSORS_DIR).join(stream).join(format!("{clip_id}.{ext}"))
+    }
+
     /// The path of a dataset file relative to the root, with `/` separators (as the manifest records it).
     pub fn relative(&self, path: &Path) -> String {
         let rel = path.strip_prefix(&self.root).unwrap_or(path);

@@ -3,14 +3,17 @@
 //! - [`layout`] — every path of the dataset, in one place.
 //! - [`manifest`] — `manifest.json`.
 //! - [`tables`] — the Parquet tables: schemas and record batches.
+//! - [`sensors`] — the camera streams' files, the DVS events and the sensor index table.
 //!
 //! A [`DatasetWriter`] opens `--out` for a plan (refusing a directory that holds anything else), writes each
 //! clip's files atomically (`fsutil::write_atomically`: a complete file or none), and derives the manifest from
-//! the files on disk. A clip is finished when all of its table files exist (`clips` is written last), which is
-//! what a resumed run skips.
+//! the files on disk. A clip's sensor files are written first, then its tables (the `sensors` index among
+//! them, `clips` last): a clip is finished when all of its table files exist, which is what a resumed run
+//! skips, so a clip interrupted while rendering is rendered again whole.
 
 pub mod layout;
 pub mod manifest;
+pub mod sensors;
 pub mod tables;
 
 use std::collections::BTreeMap;
@@ -98,6 +101,7 @@ impl DatasetWriter {
         script: &ClipScript,
         trace: &ClipTrace,
         obs: &Observations,
+        sensor_rows: &[sensors::IndexRow],
     ) -> Result<(), Error> {
         let ann = &obs.annotations;
         let batches = [
@@ -109,6 +113,7 @@ impl DatasetWriter {
             ),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
+            ("sensors", sensors::index_batch(&script.clip_id, sensor_rows)),
             ("clips", tables::clips_batch(script, trace, ann)),
         ];
         debug_assert!(batches.iter().map(|b| b.0).eq(TABLES));
@@ -118,6 +123,22 @@ impl DatasetWriter {
             write_atomically(&path, &bytes).map_err(|e| Error::write(&path, e))?;
         }
         Ok(())
+    }
+
+    /// A writer of one clip's sensor files.
+    pub fn clip_sensors<'a>(&'a self, plan: &'a Plan, script: &'a ClipScript) -> sensors::ClipSensorWriter<'a> {
+        sensors::ClipSensorWriter::new(&self.layout, &script.clip_id, &plan.spec.sensors, &plan.spec.output)
+    }
+
+    /// The Parquet bytes of a per-clip sensor file (same codec and metadata as the tables).
+    pub fn sensor_parquet(
+        &self,
+        plan: &Plan,
+        batch: &arrow_array::RecordBatch,
+        stream: &str,
+        clip_id: &str,
+    ) -> Result<Vec<u8>, Error> {
+        tables::parquet_bytes(batch, &plan.spec.output, &self.meta, stream, clip_id)
     }
 
     /// Writes the final manifest: every finished clip `done` with its files' hashes, the others `pending`.
@@ -149,11 +170,18 @@ impl DatasetWriter {
         write_atomically(&path, manifest.to_json()?.as_bytes()).map_err(|e| Error::write(&path, e))
     }
 
-    /// Removes the temporary files an interrupted run left in the dataset's own directories (the root and
-    /// `tables/<table>/`), so that a resumed dataset holds exactly the files of an uninterrupted run.
+    /// Removes the temporary files an interrupted run left in the dataset's own directories (the root,
+    /// `tables/<table>/`, `sensors/<stream>/` and every clip's `sensors/<stream>/<clip_id>/`), so that a
+    /// resumed dataset holds exactly the files of an uninterrupted run.
     fn remove_temporaries(&self) -> Result<(), Error> {
-        let dirs =
-            std::iter::once(self.layout.root().to_path_buf()).chain(TABLES.iter().map(|t| self.layout.table_dir(t)));
+        let mut dirs: Vec<std::path::PathBuf> = std::iter::once(self.layout.root().to_path_buf())
+            .chain(TABLES.iter().map(|t| self.layout.table_dir(t)))
+            .collect();
+        for stream in sensors::CAMERA_STREAMS {
+            let stream_dir = self.layout.root().join(layout::SENSORS_DIR).join(stream);
+            dirs.push(stream_dir);
+            dirs.extend(self.manifest.clips.iter().map(|c| self.layout.sensor_dir(stream, &c.clip_id)));
+        }
         for dir in dirs {
             let Ok(entries) = std::fs::read_dir(&dir) else { continue };
             for entry in entries.flatten() {
@@ -170,20 +198,51 @@ impl DatasetWriter {
 /// What the manifest records for each sensor of the spec.
 fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
     let s = &plan.spec.sensors;
+    let o = &plan.spec.output;
+    let rgb = match o.rgb_encoding {
+        crate::dsl::types::RgbEncoding::Png => "rendered: sensors/rgb/<clip_id>/<frame:06>.png".to_owned(),
+        crate::dsl::types::RgbEncoding::Jpeg => format!(
+            "rendered: sensors/rgb/<clip_id>/<frame:06>.jpg (quality {})",
+            o.jpeg_quality
+        ),
+    };
+    let depth = match o.depth_encoding {
+        crate::dsl::types::DepthEncoding::MillimetresU16 => {
+            "rendered: sensors/depth/<clip_id>/<frame:06>.png (u16 millimetres)"
+        }
+        crate::dsl::types::DepthEncoding::CarlaRgb24 => {
+            "rendered: sensors/depth/<clip_id>/<frame:06>.png (CARLA 24-bit RGB)"
+        }
+    };
     [
-        ("rgb", s.rgb.enabled),
-        ("lidar", s.lidar.enabled),
-        ("dvs", s.dvs.enabled),
+        ("rgb", s.rgb.enabled, rgb),
+        ("depth", s.depth.enabled, depth.to_owned()),
+        (
+            "semantic",
+            s.semantic.enabled,
+            "rendered: sensors/semantic/<clip_id>/<frame:06>.png (CARLA tag ids, CARLA palette)".to_owned(),
+        ),
+        (
+            "instance",
+            s.instance.enabled,
+            "rendered: sensors/instance/<clip_id>/<frame:06>.png (u16 instance ids)".to_owned(),
+        ),
+        (
+            "dvs",
+            s.dvs.enabled,
+            format!(
+                "rendered: sensors/dvs/<clip_id>.parquet (ESIM, {} image(s) per frame interval)",
+                s.dvs.substeps
+            ),
+        ),
+        (
+            "lidar",
+            s.lidar.enabled,
+            "enabled in the spec; not rendered by this pedsynth version".to_owned(),
+        ),
     ]
     .into_iter()
-    .map(|(name, on)| {
-        let status = if on {
-            "enabled in the spec; not rendered by this pedsynth version (annotations only)"
-        } else {
-            "disabled"
-        };
-        (name.to_owned(), status.to_owned())
-    })
+    .map(|(name, on, status)| (name.to_owned(), if on { status } else { "disabled".to_owned() }))
     .collect()
 }
 

@@ -26,10 +26,18 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 2;
+pub const SCHEMA_VERSION: u32 = 3;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 6] = ["frames", "pedestrians", "annotations", "vehicles", "events", "clips"];
+pub const TABLES: [&str; 7] = [
+    "frames",
+    "pedestrians",
+    "annotations",
+    "vehicles",
+    "events",
+    "sensors",
+    "clips",
+];
 
 /// Metadata every file carries.
 #[derive(Clone, Debug)]

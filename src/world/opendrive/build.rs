@@ -224,6 +224,8 @@ pub(crate) fn build_with(
                 };
                 let first_piece = pieces.len() as u32;
                 let mut length = 0.0;
+                // Sidewalks are raised by a curb (CARLA's are; OpenDRIVE's lane <height> is not read).
+                let curb = if rl.lane_type == LaneType::Sidewalk { crate::world::CURB_HEIGHT_M } else { 0.0 };
                 for k in 0..per_station.len() - 1 {
                     let (p0, n0, z0, cw0, ref b0) = per_station[k];
                     let (p1, n1, z1, cw1, ref b1) = per_station[k + 1];
@@ -239,7 +241,7 @@ pub(crate) fn build_with(
                         s_m: [st[k], st[k + 1]],
                         width_m: [w0 as f32, w1 as f32],
                         road_width_m: [cw0 as f32, cw1 as f32],
-                        z_m: (0.5 * (z0 + z1)) as f32,
+                        z_m: (0.5 * (z0 + z1) + curb) as f32,
                     });
                 }
                 lanes.push(Lane {

@@ -1,0 +1,421 @@
+//! The camera streams, rendered on the CPU: RGB, depth, semantic and instance segmentation from one
+//! rasterisation of the scene, and DVS events from the rendered luminance.
+//!
+//! - [`raster`] — the visibility buffer (nearest primitive and depth per sample).
+//! - [`light`] — lighting from the weather.
+//! - [`shade`] — textures, road paint, lights, reflections, fog.
+//! - [`dvs`] — the ESIM event simulator.
+//!
+//! A frame is drawn at `SS × SS` samples per pixel into the visibility buffer, with the same
+//! [`CameraPose`](crate::exec::observe::rig::CameraPose) (intrinsics and pose) that the annotations project
+//! with. Label streams are point samples of it (the pixel's first sample, at `(u + 0.25, v + 0.25)`);
+//! RGB shades a pixel once where its samples see one primitive and each sample where they differ (edge
+//! antialiasing), then adds rain streaks and maps to sRGB.
+
+pub mod dvs;
+pub mod light;
+pub mod raster;
+pub mod shade;
+
+use glam::{DAffine3, DVec3, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::rig::{Camera, CameraPose};
+use super::scene::{FrameScene, Material, Prim, StaticScene, mix64, tag};
+use light::Lighting;
+use raster::{EMPTY, Raster, clip_near};
+use shade::{ActiveLights, Noise, ShadeContext};
+
+/// Samples per pixel along each axis.
+pub const SS: usize = 2;
+/// Near clipping distance, metres.
+pub const NEAR_M: f32 = 0.05;
+/// Static clusters farther than this are not drawn (fog and the terrain plane take over), metres.
+const FAR_M: f32 = 450.0;
+/// Depth written for sky pixels, metres (CARLA's far plane).
+pub const SKY_DEPTH_M: f32 = 1000.0;
+/// Shadow map: resolution and half-size of the square it covers, metres.
+const SHADOW_PX: usize = 1024;
+const SHADOW_HALF_M: f32 = 60.0;
+
+/// The images of one rendered frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CameraImages {
+    /// Width, pixels.
+    pub width: usize,
+    /// Height, pixels.
+    pub height: usize,
+    /// sRGB, 3 bytes per pixel, row-major from the top-left.
+    pub rgb: Vec<u8>,
+    /// Depth along the optical axis, metres ([`SKY_DEPTH_M`] for the sky).
+    pub depth_m: Vec<f32>,
+    /// CARLA semantic tag per pixel.
+    pub semantic: Vec<u8>,
+    /// Instance id per pixel (see [`super::scene::CHILD_INSTANCE_BASE`]).
+    pub instance: Vec<u16>,
+}
+
+/// The orthographic sun camera of the shadow map.
+#[derive(Clone, Copy, Debug)]
+struct SunView {
+    centre: Vec3,
+    u: Vec3,
+    v: Vec3,
+    dir: Vec3,
+    scale: f32,
+}
+
+impl SunView {
+    fn project(&self, p: Vec3) -> DVec3 {
+        let d = p - self.centre;
+        DVec3::new(
+            f64::from(d.dot(self.u) * self.scale + SHADOW_PX as f32 * 0.5),
+            f64::from(d.dot(self.v) * self.scale + SHADOW_PX as f32 * 0.5),
+            f64::from(d.dot(self.dir)),
+        )
+    }
+}
+
+/// A camera renderer: buffers reused from frame to frame (one per worker thread).
+#[derive(Clone, Debug)]
+pub struct Renderer {
+    camera: Camera,
+    light: Lighting,
+    noise: Noise,
+    vis: Raster,
+    shadow: Raster,
+    sun: Option<SunView>,
+    lights: ActiveLights,
+    lut: Vec<u8>,
+}
+
+/// Linear → sRGB lookup: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]` with a soft shoulder.
+const LUT_LEN: usize = 4096;
+const LUT_MAX: f32 = 8.0;
+
+fn build_lut() -> Vec<u8> {
+    (0..LUT_LEN)
+        .map(|i| {
+            let s = i as f32 / (LUT_LEN - 1) as f32;
+            let x = s * s * LUT_MAX;
+            let mapped = 1.0 - (-1.1 * x).exp();
+            let srgb = if mapped <= 0.003_130_8 {
+                12.92 * mapped
+            } else {
+                1.055 * mapped.powf(1.0 / 2.4) - 0.055
+            };
+            (srgb * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+        })
+        .collect()
+}
+
+impl Renderer {
+    /// A renderer for a camera, a clip's lighting and its texture seed.
+    pub fn new(camera: &Camera, light: Lighting, seed: u64) -> Renderer {
+        let (w, h) = (camera.width_px as usize, camera.height_px as usize);
+        Renderer {
+            camera: *camera,
+            light,
+            noise: Noise::new(seed ^ 0x7e57_0000),
+            vis: Raster::new(w * SS, h * SS),
+            shadow: Raster::new(SHADOW_PX, SHADOW_PX),
+            sun: None,
+            lights: ActiveLights::default(),
+            lut: build_lut(),
+        }
+    }
+
+    /// The lighting in use.
+    pub fn lighting(&self) -> &Lighting {
+        &self.light
+    }
+
+    /// Renders one frame seen from `pose` into `out`; `streak_seed` seeds the rain streaks.
+    pub fn render(
+        &mut self,
+        scene: &StaticScene,
+        frame: &FrameScene,
+        pose: &CameraPose,
+        streak_seed: u64,
+        out: &mut CameraImages,
+    ) {
+        let (w, h) = (self.camera.width_px as usize, self.camera.height_px as usize);
+        out.width = w;
+        out.height = h;
+        out.rgb.resize(w * h * 3, 0);
+        out.depth_m.resize(w * h, 0.0);
+        out.semantic.resize(w * h, 0);
+        out.instance.resize(w * h, 0);
+        let optical_from_scene = pose.optical_from_world * DAffine3::from_translation(scene.origin);
+        self.draw_visibility(scene, frame, &optical_from_scene);
+        let cam_rel = (pose.centre - scene.origin).as_vec3();
+        self.draw_shadows(scene, frame, cam_rel, pose.forward.as_vec3());
+        self.choose_lights(scene, frame, cam_rel, pose);
+        self.resolve(scene, frame, pose, cam_rel, out);
+        if self.light.rain > 0.0 {
+            self.rain_streaks(streak_seed, out);
+        }
+    }
+
+    fn draw_visibility(&mut self, scene: &StaticScene, frame: &FrameScene, optical_from_scene: &DAffine3) {
+        let c = &self.camera;
+        let m = optical_from_scene.matrix3.as_mat3();
+        let t = optical_from_scene.translation.as_vec3();
+        let (f, cx, cy) = (c.focal_px as f32, c.width_px as f32 * 0.5, c.height_px as f32 * 0.5);
+        let ss = SS as f32;
+        // Frustum side slopes (|x| ≤ z·sx, |y| ≤ z·sy) with the corners' secants for the sphere test.
+        let (sx, sy) = (cx / f, cy / f);
+        let (kx, ky) = ((1.0 + sx * sx).sqrt(), (1.0 + sy * sy).sqrt());
+        self.vis.clear(0.0);
+        let vis = &mut self.vis;
+        let mut draw = |tri: &super::scene::Tri| {
+            let v = tri.v.map(|p| m * p + t);
+            if v.iter().all(|p| p.z < NEAR_M) {
+                return;
+            }
+            let mut poly = [Vec3::ZERO; 4];
+            let n = clip_near(v, NEAR_M, &mut poly);
+            let proj = |p: Vec3| {
+                let inv = 1.0 / p.z;
+                DVec3::new(
+                    f64::from((f * p.x * inv + cx) * ss),
+                    f64::from((f * p.y * inv + cy) * ss),
+                    f64::from(inv),
+                )
+            };
+            for k in 1..n.saturating_sub(1) {
+                vis.draw([proj(poly[0]), proj(poly[k]), proj(poly[k + 1])], tri.prim);
+            }
+        };
+        for cl in &scene.clusters {
+            let o = m * cl.centre + t;
+            let r = cl.radius_m;
+            let visible = o.z + r >= NEAR_M
+                && o.x - r * kx <= o.z * sx
+                && -o.x - r * kx <= o.z * sx
+                && o.y - r * ky <= o.z * sy
+                && -o.y - r * ky <= o.z * sy
+                && (o.length() - r <= FAR_M || r > 1000.0);
+            if visible {
+                for tri in &scene.tris[cl.tris.start as usize..cl.tris.end as usize] {
+                    draw(tri);
+                }
+            }
+        }
+        for tri in &frame.tris {
+            draw(tri);
+        }
+    }
+
+    fn draw_shadows(&mut self, scene: &StaticScene, frame: &FrameScene, cam: Vec3, forward: Vec3) {
+        if !self.light.shadows {
+            self.sun = None;
+            return;
+        }
+        let dir = self.light.sun_dir;
+        let u = dir.any_orthonormal_vector();
+        let v = dir.cross(u);
+        let ahead = Vec3::new(forward.x, forward.y, 0.0).normalize_or_zero();
+        let sun = SunView {
+            centre: cam + ahead * (SHADOW_HALF_M * 0.7),
+            u,
+            v,
+            dir,
+            scale: SHADOW_PX as f32 / (2.0 * SHADOW_HALF_M),
+        };
+        self.shadow.clear(f32::NEG_INFINITY);
+        let reach = SHADOW_HALF_M * 1.5 + 60.0;
+        for cl in &scene.clusters {
+            if cl.radius_m < 1000.0 && cl.centre.distance(sun.centre) - cl.radius_m <= reach {
+                for tri in &scene.tris[cl.tris.start as usize..cl.tris.end as usize] {
+                    let p = &scene.prims[tri.prim as usize];
+                    // Ground surfaces receive shadows; casting them would only shadow themselves.
+                    if matches!(
+                        p.material,
+                        Material::Road | Material::Sidewalk | Material::Terrain | Material::Curb
+                    ) {
+                        continue;
+                    }
+                    self.shadow.draw(tri.v.map(|q| sun.project(q)), tri.prim);
+                }
+            }
+        }
+        for tri in &frame.tris {
+            self.shadow.draw(tri.v.map(|q| sun.project(q)), tri.prim);
+        }
+        self.sun = Some(sun);
+    }
+
+    /// The sun's visibility at a scene point (1 lit, 0 in shadow), 2×2 percentage-closer filtered.
+    #[inline]
+    fn sunlit(&self, p: Vec3, normal: Vec3) -> f32 {
+        let Some(sun) = &self.sun else { return 1.0 };
+        let q = sun.project(p + normal * 0.05);
+        let (x, y) = (q.x as f32 - 0.5, q.y as f32 - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
+            return 1.0;
+        }
+        let (fx, fy) = (x - x0, y - y0);
+        let i = y0 as usize * SHADOW_PX + x0 as usize;
+        let depth = q.z as f32 + 0.08;
+        let lit = |k: usize| if self.shadow.key[k] > depth { 0.0 } else { 1.0 };
+        let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
+        let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;
+        a + (b - a) * fy
+    }
+
+    fn choose_lights(&mut self, scene: &StaticScene, frame: &FrameScene, cam: Vec3, pose: &CameraPose) {
+        self.lights.lamps.clear();
+        self.lights.heads.clear();
+        if self.light.night <= 0.0 {
+            return;
+        }
+        let mut lamps: Vec<(f32, Vec3)> = scene
+            .lamps
+            .iter()
+            .map(|l| (l.pos.distance_squared(cam), l.pos))
+            .filter(|(d2, _)| *d2 < 90.0 * 90.0)
+            .collect();
+        lamps.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.lights.lamps.extend(lamps.iter().take(16).map(|l| l.1));
+        // The ego's own headlights (under the camera), then the nearest traffic's.
+        let fwd = pose.forward.as_vec3();
+        let axis = Vec3::new(fwd.x, fwd.y, -0.06).normalize();
+        self.lights.heads.push((cam + Vec3::new(fwd.x, fwd.y, 0.0) * 1.5 - Vec3::Z * 0.7, axis));
+        let mut heads: Vec<(f32, (Vec3, Vec3))> = frame
+            .head_lamps
+            .iter()
+            .map(|h| (h.0.distance_squared(cam), *h))
+            .filter(|(d2, _)| *d2 < 70.0 * 70.0)
+            .collect();
+        heads.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.lights.heads.extend(heads.iter().take(6).map(|h| h.1));
+    }
+
+    fn resolve(&self, scene: &StaticScene, frame: &FrameScene, pose: &CameraPose, cam: Vec3, out: &mut CameraImages) {
+        let c = &self.camera;
+        let (w, h) = (c.width_px as usize, c.height_px as usize);
+        let (f, cx, cy) = (c.focal_px as f32, c.width_px as f32 * 0.5, c.height_px as f32 * 0.5);
+        let (right, down, fwd) = (pose.right.as_vec3(), pose.down.as_vec3(), pose.forward.as_vec3());
+        let ctx = ShadeContext {
+            scene,
+            frame,
+            light: &self.light,
+            noise: &self.noise,
+            lights: &self.lights,
+        };
+        let sw = w * SS;
+        let inv_f = 1.0 / f;
+        let inv_ss = 1.0 / SS as f32;
+        // The colour of one sample (or of the pixel centre when all samples agree), fogged.
+        let shade_at = |prim_id: u32, key: f32, u: f32, v: f32| -> Vec3 {
+            let ray = fwd + right * ((u - cx) * inv_f) + down * ((v - cy) * inv_f);
+            if prim_id == EMPTY || key <= 0.0 {
+                let dir = ray.normalize();
+                return shade::fog(&self.light, self.light.sky(dir), 1.0e4);
+            }
+            let prim: &Prim = &frame.prims[prim_id as usize];
+            let z = 1.0 / key;
+            let p = cam + ray * z;
+            let dist = ray.length() * z;
+            let view = -ray / ray.length();
+            let shadow = if self.sun.is_some() {
+                self.sunlit(p, prim.normal)
+            } else {
+                1.0
+            };
+            shade::fog(&self.light, shade::surface(&ctx, prim, p, view, shadow), dist)
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let s0 = (y * SS) * sw + x * SS;
+                let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
+                let prims = ids.map(|i| self.vis.prim[i]);
+                let keys = ids.map(|i| self.vis.key[i]);
+                // Labels: the first sample.
+                let o = y * w + x;
+                let (u0, v0) = (x as f32 + 0.5 * inv_ss, y as f32 + 0.5 * inv_ss);
+                if prims[0] == EMPTY {
+                    out.depth_m[o] = SKY_DEPTH_M;
+                    out.semantic[o] = tag::SKY;
+                    out.instance[o] = 0;
+                } else {
+                    let prim = &frame.prims[prims[0] as usize];
+                    let z = 1.0 / keys[0];
+                    out.depth_m[o] = z.min(SKY_DEPTH_M);
+                    out.instance[o] = prim.instance;
+                    out.semantic[o] = if prim.material == Material::Road {
+                        let ray = fwd + right * ((u0 - cx) * inv_f) + down * ((v0 - cy) * inv_f);
+                        shade::semantic(scene, prim, cam + ray * z)
+                    } else {
+                        prim.tag
+                    };
+                }
+                let colour = if prims.iter().all(|&p| p == prims[0]) {
+                    let key = if prims[0] == EMPTY {
+                        0.0
+                    } else {
+                        (keys[0] + keys[1] + keys[2] + keys[3]) * 0.25
+                    };
+                    shade_at(prims[0], key, x as f32 + 0.5, y as f32 + 0.5)
+                } else {
+                    let mut sum = Vec3::ZERO;
+                    for (k, (&p, &key)) in prims.iter().zip(&keys).enumerate() {
+                        let (sx, sy) = ((k % SS) as f32, (k / SS) as f32);
+                        sum += shade_at(p, key, x as f32 + (sx + 0.5) * inv_ss, y as f32 + (sy + 0.5) * inv_ss);
+                    }
+                    sum * 0.25
+                };
+                let px = &mut out.rgb[o * 3..o * 3 + 3];
+                for (ch, value) in px.iter_mut().zip(colour.to_array()) {
+                    let s = (value.max(0.0) * (1.0 / LUT_MAX)).min(1.0).sqrt();
+                    *ch = self.lut[(s * (LUT_LEN - 1) as f32) as usize];
+                }
+            }
+        }
+    }
+
+    /// Rain: thin, slanted, semi-transparent streaks at seeded places, brighter against dark backgrounds.
+    fn rain_streaks(&self, seed: u64, out: &mut CameraImages) {
+        let (w, h) = (out.width as f32, out.height as f32);
+        let mut rng = ChaCha8Rng::seed_from_u64(mix64(seed ^ 0x7a1f));
+        let count = (self.light.rain * 1500.0 * (w * h) / (1280.0 * 720.0)) as usize;
+        let slant = 0.08 + 0.35 * self.light.wind;
+        let bright = 150.0 + 60.0 * (1.0 - self.light.night);
+        for _ in 0..count {
+            let x0: f32 = rng.random_range(-50.0..w + 50.0);
+            let y0: f32 = rng.random_range(-50.0..h);
+            let len: f32 = rng.random_range(0.02..0.07) * h;
+            let alpha: f32 = rng.random_range(0.08..0.22);
+            let steps = len as usize;
+            for k in 0..steps {
+                let t = k as f32;
+                let (x, y) = (x0 + t * slant, y0 + t);
+                if y < 0.0 || y >= h || x < 0.0 || x >= w - 1.0 {
+                    continue;
+                }
+                let (xi, fx) = (x.floor() as usize, x - x.floor());
+                let row = y as usize * out.width;
+                for (dx, cov) in [(0usize, 1.0 - fx), (1, fx)] {
+                    let o = (row + xi + dx) * 3;
+                    let a = alpha * cov;
+                    for ch in &mut out.rgb[o..o + 3] {
+                        *ch = (f32::from(*ch) * (1.0 - a) + bright * a) as u8;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The luminance of an 8-bit sRGB pixel (the DVS's intensity, 0–255).
+pub fn luminance(rgb: &[u8]) -> f32 {
+    0.2989 * f32::from(rgb[0]) + 0.587 * f32::from(rgb[1]) + 0.114 * f32::from(rgb[2])
+}
+
+/// A random generator for a (clip, frame, sub-step) stream.
+pub fn streak_seed(clip_seed: u64, frame: u32, substep: u32) -> u64 {
+    mix64(clip_seed ^ mix64((u64::from(frame) << 16) | u64::from(substep)))
+}

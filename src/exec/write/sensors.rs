@@ -1,0 +1,273 @@
+//! Sensor files: encoding and writing the camera streams of a clip as they are rendered, the DVS events of a
+//! clip, and the sensor index table that joins them to the annotation tables on (clip_id, frame).
+//!
+//! ```text
+//! sensors/rgb/<clip_id>/<frame:06>.png|jpg     sRGB 8-bit (PNG fast compression, or JPEG)
+//! sensors/depth/<clip_id>/<frame:06>.png       u16 millimetres (grey 16-bit), or CARLA's 24-bit RGB
+//! sensors/semantic/<clip_id>/<frame:06>.png    CARLA tag ids as an indexed PNG whose palette is CARLA's
+//! sensors/instance/<clip_id>/<frame:06>.png    u16 instance ids (grey 16-bit; see scene::CHILD_INSTANCE_BASE)
+//! sensors/dvs/<clip_id>.parquet                events: frame, t_ns, x, y, polarity
+//! tables/sensors/<clip_id>.parquet             clip_id, frame, timestamp_ns, stream, path, bytes, sha256
+//! ```
+//!
+//! Every file is written atomically (a temporary name, then a rename). Blobs are not fsynced one by one
+//! (thousands per clip); the clip's tables, written after every blob, mark it complete.
+
+use std::sync::Arc;
+
+use arrow_array::{ArrayRef, BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array};
+use arrow_schema::{DataType, Field, Schema};
+use sha2::{Digest, Sha256};
+
+use super::Layout;
+use crate::dsl::types::{DepthEncoding, Output, RgbEncoding, Sensors};
+use crate::error::{Error, code};
+use crate::exec::observe::SensorFrame;
+use crate::exec::observe::camera::{CameraImages, SKY_DEPTH_M, dvs};
+use crate::exec::observe::scene::tag;
+use crate::fsutil::write_atomically_unsynced;
+
+/// The camera streams, in the order they are written.
+pub const CAMERA_STREAMS: [&str; 5] = ["rgb", "depth", "semantic", "instance", "dvs"];
+
+/// One row of the sensor index.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IndexRow {
+    /// Frame (None for a per-clip file such as the DVS events).
+    pub frame: Option<u32>,
+    /// Simulated time of the frame, nanoseconds (None for a per-clip file).
+    pub timestamp_ns: Option<i64>,
+    /// Stream name.
+    pub stream: &'static str,
+    /// Path relative to the dataset root, `/`-separated.
+    pub path: String,
+    /// File size.
+    pub bytes: u64,
+    /// SHA-256 of the file, hex.
+    pub sha256: String,
+}
+
+/// Writes one clip's sensor files as frames arrive.
+#[derive(Debug)]
+pub struct ClipSensorWriter<'a> {
+    layout: &'a Layout,
+    clip_id: &'a str,
+    sensors: &'a Sensors,
+    output: &'a Output,
+    rows: Vec<IndexRow>,
+    events: Vec<(u32, dvs::Event)>,
+    scratch: Vec<u8>,
+}
+
+/// PNG bytes of an image.
+pub fn png_bytes(width: usize, height: usize, colour: png::ColorType, depth: png::BitDepth, data: &[u8], palette: Option<&[u8]>) -> Result<Vec<u8>, Error> {
+    let mut out = Vec::with_capacity(data.len() / 2 + 1024);
+    let fail = |e: png::EncodingError| Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a PNG image: {e}"));
+    {
+        let mut enc = png::Encoder::new(&mut out, width as u32, height as u32);
+        enc.set_color(colour);
+        enc.set_depth(depth);
+        enc.set_compression(png::Compression::Fast);
+        if let Some(p) = palette {
+            enc.set_palette(p.to_vec());
+        }
+        let mut w = enc.write_header().map_err(fail)?;
+        w.write_image_data(data).map_err(fail)?;
+        w.finish().map_err(fail)?;
+    }
+    Ok(out)
+}
+
+/// The semantic palette (CARLA's colours) as PNG `PLTE` bytes for all 256 indices.
+pub fn semantic_palette() -> Vec<u8> {
+    let mut p = vec![0u8; 256 * 3];
+    for (i, c) in tag::PALETTE.iter().enumerate() {
+        p[i * 3..i * 3 + 3].copy_from_slice(c);
+    }
+    p
+}
+
+/// Depth in CARLA's 24-bit encoding: `(R, G, B)` with `R + 256 G + 65536 B = round(d / 1000 m × (2^24 − 1))`.
+pub fn carla_depth_rgb(depth_m: f32) -> [u8; 3] {
+    let v = ((f64::from(depth_m.clamp(0.0, SKY_DEPTH_M)) / 1000.0) * f64::from((1u32 << 24) - 1)).round() as u32;
+    [(v & 0xff) as u8, ((v >> 8) & 0xff) as u8, ((v >> 16) & 0xff) as u8]
+}
+
+/// Depth in millimetres, saturated at 65535.
+pub fn depth_mm(depth_m: f32) -> u16 {
+    (f64::from(depth_m) * 1000.0).round().clamp(0.0, 65535.0) as u16
+}
+
+impl<'a> ClipSensorWriter<'a> {
+    /// A writer for one clip.
+    pub fn new(layout: &'a Layout, clip_id: &'a str, sensors: &'a Sensors, output: &'a Output) -> Self {
+        ClipSensorWriter {
+            layout,
+            clip_id,
+            sensors,
+            output,
+            rows: Vec::new(),
+            events: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    fn put(&mut self, stream: &'static str, frame: Option<(u32, i64)>, ext: &str, bytes: &[u8]) -> Result<(), Error> {
+        let path = match frame {
+            Some((f, _)) => self.layout.sensor_frame(stream, self.clip_id, f, ext),
+            None => self.layout.sensor_clip(stream, self.clip_id, ext),
+        };
+        write_atomically_unsynced(&path, bytes).map_err(|e| Error::write(&path, e))?;
+        self.rows.push(IndexRow {
+            frame: frame.map(|f| f.0),
+            timestamp_ns: frame.map(|f| f.1),
+            stream,
+            path: self.layout.relative(&path),
+            bytes: bytes.len() as u64,
+            sha256: hex(&Sha256::digest(bytes)),
+        });
+        Ok(())
+    }
+
+    /// Encodes and writes the enabled streams of one frame.
+    pub fn frame(&mut self, f: SensorFrame) -> Result<(), Error> {
+        let img: &CameraImages = f.images;
+        let (w, h) = (img.width, img.height);
+        let at = Some((f.frame, f.timestamp_ns));
+        if self.sensors.rgb.enabled {
+            match self.output.rgb_encoding {
+                RgbEncoding::Png => {
+                    let bytes = png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &img.rgb, None)?;
+                    self.put("rgb", at, "png", &bytes)?;
+                }
+                RgbEncoding::Jpeg => {
+                    let mut out = Vec::new();
+                    jpeg_encoder::Encoder::new(&mut out, self.output.jpeg_quality.clamp(1, 100))
+                        .encode(&img.rgb, w as u16, h as u16, jpeg_encoder::ColorType::Rgb)
+                        .map_err(|e| Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}")))?;
+                    self.put("rgb", at, "jpg", &out)?;
+                }
+            }
+        }
+        if self.sensors.depth.enabled {
+            self.scratch.clear();
+            let bytes = match self.output.depth_encoding {
+                DepthEncoding::MillimetresU16 => {
+                    self.scratch.extend(img.depth_m.iter().flat_map(|d| depth_mm(*d).to_be_bytes()));
+                    png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &self.scratch, None)?
+                }
+                DepthEncoding::CarlaRgb24 => {
+                    self.scratch.extend(img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)));
+                    png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &self.scratch, None)?
+                }
+            };
+            self.put("depth", at, "png", &bytes)?;
+        }
+        if self.sensors.semantic.enabled {
+            let bytes = png_bytes(
+                w,
+                h,
+                png::ColorType::Indexed,
+                png::BitDepth::Eight,
+                &img.semantic,
+                Some(&semantic_palette()),
+            )?;
+            self.put("semantic", at, "png", &bytes)?;
+        }
+        if self.sensors.instance.enabled {
+            self.scratch.clear();
+            self.scratch.extend(img.instance.iter().flat_map(|i| i.to_be_bytes()));
+            let bytes = png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &self.scratch, None)?;
+            self.put("instance", at, "png", &bytes)?;
+        }
+        if self.sensors.dvs.enabled {
+            self.events.extend(f.events.iter().map(|e| (f.frame, *e)));
+        }
+        Ok(())
+    }
+
+    /// Writes the per-clip files (DVS events) and returns the index rows, sorted by (frame, stream).
+    pub fn finish(mut self, parquet: impl Fn(&RecordBatch, &str) -> Result<Vec<u8>, Error>) -> Result<Vec<IndexRow>, Error> {
+        if self.sensors.dvs.enabled {
+            let batch = dvs_batch(&self.events);
+            let bytes = parquet(&batch, "dvs")?;
+            self.put("dvs", None, "parquet", &bytes)?;
+        }
+        let order = |s: &str| CAMERA_STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
+        self.rows.sort_by(|a, b| (a.frame, order(a.stream)).cmp(&(b.frame, order(b.stream))));
+        Ok(self.rows)
+    }
+}
+
+fn hex(bytes: &[u8]) -> String {
+    use std::fmt::Write;
+    bytes.iter().fold(String::with_capacity(bytes.len() * 2), |mut s, b| {
+        let _ = write!(s, "{b:02x}");
+        s
+    })
+}
+
+/// The DVS events of a clip: `frame` (the frame whose interval (previous, this] holds the event), `t_ns`,
+/// `x`, `y`, `polarity` (true: brighter).
+pub fn dvs_batch(events: &[(u32, dvs::Event)]) -> RecordBatch {
+    let schema = Schema::new(vec![
+        Field::new("frame", DataType::UInt32, false),
+        Field::new("t_ns", DataType::Int64, false),
+        Field::new("x", DataType::UInt16, false),
+        Field::new("y", DataType::UInt16, false),
+        Field::new("polarity", DataType::Boolean, false),
+    ]);
+    let columns: Vec<ArrayRef> = vec![
+        Arc::new(UInt32Array::from_iter_values(events.iter().map(|e| e.0))),
+        Arc::new(Int64Array::from_iter_values(events.iter().map(|e| e.1.t_ns))),
+        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.1.x))),
+        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.1.y))),
+        Arc::new(BooleanArray::from_iter(events.iter().map(|e| Some(e.1.positive)))),
+    ];
+    RecordBatch::try_new(Arc::new(schema), columns).expect("columns match their schema")
+}
+
+/// The `sensors` index table of a clip.
+pub fn index_batch(clip_id: &str, rows: &[IndexRow]) -> RecordBatch {
+    let schema = Schema::new(vec![
+        Field::new("clip_id", DataType::Utf8, false),
+        Field::new("frame", DataType::UInt32, true),
+        Field::new("timestamp_ns", DataType::Int64, true),
+        Field::new("stream", DataType::Utf8, false),
+        Field::new("path", DataType::Utf8, false),
+        Field::new("bytes", DataType::UInt64, false),
+        Field::new("sha256", DataType::Utf8, false),
+    ]);
+    let columns: Vec<ArrayRef> = vec![
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|_| clip_id))),
+        Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.frame))),
+        Arc::new(Int64Array::from_iter(rows.iter().map(|r| r.timestamp_ns))),
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.stream))),
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.path.as_str()))),
+        Arc::new(UInt64Array::from_iter_values(rows.iter().map(|r| r.bytes))),
+        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.sha256.as_str()))),
+    ];
+    RecordBatch::try_new(Arc::new(schema), columns).expect("columns match their schema")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depth_encodings_round_trip() {
+        assert_eq!(depth_mm(12.3456), 12346);
+        assert_eq!(depth_mm(100.0), 65535, "saturates");
+        let [r, g, b] = carla_depth_rgb(37.5);
+        let back = 1000.0 * (f64::from(r) + 256.0 * f64::from(g) + 65536.0 * f64::from(b)) / f64::from((1u32 << 24) - 1);
+        assert!((back - 37.5).abs() < 1e-4, "{back}");
+    }
+
+    #[test]
+    fn sha256_is_the_standard_one() {
+        assert_eq!(
+            hex(&Sha256::digest(b"abc")),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+    }
+}
