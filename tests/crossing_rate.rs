@@ -16,7 +16,11 @@ fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
     let out = std::env::temp_dir().join(format!("pedsynth-crossing-rate-{}-{target}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let options = LoadOptions {
-        overrides: vec![format!("crossing.target_ratio={target}")],
+        overrides: common::NO_CAMERAS
+            .iter()
+            .map(|s| s.to_string())
+            .chain([format!("crossing.target_ratio={target}")])
+            .collect(),
         allow_large: false,
     };
     let args = GenerateArgs {

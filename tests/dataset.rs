@@ -5,6 +5,8 @@
 //! files are byte-identical across job counts, interruption and resumption, and spec vs plan file; and that
 //! `generate` refuses directories it must not write into.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fs::File;
 use std::path::{Path, PathBuf};
@@ -58,9 +60,14 @@ fn spec(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("specs").join(name)
 }
 
+/// Load options with `overrides`, cameras off (tests/camera.rs tests the sensor files).
 fn options(overrides: &[&str]) -> LoadOptions {
     LoadOptions {
-        overrides: overrides.iter().map(|s| s.to_string()).collect(),
+        overrides: common::NO_CAMERAS
+            .iter()
+            .chain(overrides)
+            .map(|s| s.to_string())
+            .collect(),
         allow_large: false,
     }
 }
@@ -152,7 +159,7 @@ fn read_table(dir: &Path, table: &str, spec_hash: &str) -> Vec<RecordBatch> {
         assert_eq!(kv["pedsynth.table"], table, "{}", path.display());
         assert_eq!(kv["pedsynth.clip_id"], clip_id, "{}", path.display());
         assert_eq!(kv["pedsynth.spec_hash"], spec_hash, "{}", path.display());
-        assert_eq!(kv["pedsynth.schema_version"], "2", "{}", path.display());
+        assert_eq!(kv["pedsynth.schema_version"], "3", "{}", path.display());
         assert_eq!(kv["pedsynth.version"], env!("CARGO_PKG_VERSION"), "{}", path.display());
         for batch in builder.build().expect("reader") {
             let batch = batch.expect("batch");
@@ -931,6 +938,9 @@ fn generate_refuses_directories_it_must_not_write_into() {
     let qs = spec("quickstart.yaml");
     let gen_args = |out: &Path, extra: &[&str]| -> Vec<std::ffi::OsString> {
         let mut v: Vec<std::ffi::OsString> = vec!["generate".into(), qs.clone().into(), "--out".into(), out.into()];
+        for set in common::NO_CAMERAS {
+            v.extend(["--set".into(), set.into()]);
+        }
         v.extend(extra.iter().map(|s| s.into()));
         v
     };

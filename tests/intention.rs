@@ -32,7 +32,15 @@ fn generate(spec: &str, name: &str) -> PathBuf {
     };
     let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
     let code = commands::finish(
-        commands::generate(Path::new(spec), &LoadOptions::default(), &args, &mut stdout),
+        commands::generate(
+            Path::new(spec),
+            &LoadOptions {
+                overrides: common::NO_CAMERAS.iter().map(|s| s.to_string()).collect(),
+                allow_large: false,
+            },
+            &args,
+            &mut stdout,
+        ),
         &mut stderr,
     );
     assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));

@@ -215,3 +215,13 @@ pub fn assert_queries(net: &RoadNetwork) {
     assert_route(net, 500.0);
     assert_crossings(net, 0.5);
 }
+
+/// `--set` overrides that turn every camera stream off: for tests of the tables and the simulation, which
+/// would otherwise render thousands of images (the camera tests render their own, small ones).
+pub const NO_CAMERAS: [&str; 5] = [
+    "sensors.rgb.enabled=false",
+    "sensors.depth.enabled=false",
+    "sensors.semantic.enabled=false",
+    "sensors.instance.enabled=false",
+    "sensors.dvs.enabled=false",
+];

@@ -89,7 +89,13 @@ pub fn render_cameras<E>(
         frame_scene.build(&stat, script, trace, t);
         let (pos, yaw) = scene::ego_at(trace, t);
         let pose = rig.camera.at(pos, yaw);
-        renderer.render(&stat, &frame_scene, &pose, camera::streak_seed(script.seed, t.frame, k), images);
+        renderer.render(
+            &stat,
+            &frame_scene,
+            &pose,
+            camera::streak_seed(script.seed, t.frame, k),
+            images,
+        );
     };
     for frame in 0..frames {
         events.clear();
@@ -103,13 +109,23 @@ pub fn render_cameras<E>(
                 };
                 render(t, k, &mut images);
                 let now = frame_time_ns(frame - 1, script.fps, k, substeps);
-                esim.step(&images.rgb, now, camera::streak_seed(script.seed ^ 0xd75, frame - 1, k), &mut events);
+                esim.step(
+                    &images.rgb,
+                    now,
+                    camera::streak_seed(script.seed ^ 0xd75, frame - 1, k),
+                    &mut events,
+                );
             }
         }
         render(scene::SceneTime::at(frame), 0, &mut images);
         let now = frame_time_ns(frame, script.fps, 0, 1);
         if let Some(esim) = esim.as_mut() {
-            esim.step(&images.rgb, now, camera::streak_seed(script.seed ^ 0xd75, frame, 0), &mut events);
+            esim.step(
+                &images.rgb,
+                now,
+                camera::streak_seed(script.seed ^ 0xd75, frame, 0),
+                &mut events,
+            );
         }
         sink(SensorFrame {
             frame,
@@ -119,4 +135,30 @@ pub fn render_cameras<E>(
         })?;
     }
     Ok(())
+}
+
+/// Renders one frame of a clip (no DVS): for previews, tests and benchmarks.
+pub fn render_frame(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    rig: &Rig,
+    town: &RoadNetwork,
+    frame: u32,
+) -> camera::CameraImages {
+    let stat = scene::StaticScene::build(script, trace, town);
+    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut frame_scene = scene::FrameScene::default();
+    let mut images = camera::CameraImages::default();
+    let t = scene::SceneTime::at(frame);
+    frame_scene.build(&stat, script, trace, t);
+    let (pos, yaw) = scene::ego_at(trace, t);
+    renderer.render(
+        &stat,
+        &frame_scene,
+        &rig.camera.at(pos, yaw),
+        camera::streak_seed(script.seed, frame, 0),
+        &mut images,
+    );
+    images
 }

@@ -289,7 +289,11 @@ pub fn mix64(mut x: u64) -> u64 {
 pub fn linear(c: [u8; 3]) -> Vec3 {
     let f = |v: u8| {
         let x = f32::from(v) / 255.0;
-        if x <= 0.04045 { x / 12.92 } else { ((x + 0.055) / 1.055).powf(2.4) }
+        if x <= 0.04045 {
+            x / 12.92
+        } else {
+            ((x + 0.055) / 1.055).powf(2.4)
+        }
     };
     Vec3::new(f(c[0]), f(c[1]), f(c[2]))
 }
@@ -441,11 +445,7 @@ impl StaticScene {
         let (lo, hi) = crate::world::bounding_box(ego.iter().copied()).unwrap_or((DVec2::ZERO, DVec2::ZERO));
         let (lo, hi) = (lo - DVec2::splat(SCENE_MARGIN_M), hi + DVec2::splat(SCENE_MARGIN_M));
         let z0 = trace.ego.first().map_or(0.0, |e| e.pos.z);
-        let origin = DVec3::new(
-            ((lo.x + hi.x) * 0.5).round(),
-            ((lo.y + hi.y) * 0.5).round(),
-            z0.round(),
-        );
+        let origin = DVec3::new(((lo.x + hi.x) * 0.5).round(), ((lo.y + hi.y) * 0.5).round(), z0.round());
         let near = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
         let seed = script.seed;
         let mut b = Builder {
@@ -489,13 +489,7 @@ impl StaticScene {
             .filter(|p| near(p.centre()[0]))
             .map(|p| f64::from(p.z_m))
             .fold(z0, f64::min);
-        let terrain = b.prim(flat(
-            Material::Terrain,
-            tag::TERRAIN,
-            linear([86, 104, 58]),
-            Vec3::Z,
-            0,
-        ));
+        let terrain = b.prim(flat(Material::Terrain, tag::TERRAIN, linear([86, 104, 58]), Vec3::Z, 0));
         let tz = (min_z - 0.03 - origin.z) as f32;
         let e = 1500.0f32;
         b.quad(
@@ -519,10 +513,10 @@ impl StaticScene {
         let cw_boxes: Vec<(Vec2, Vec2)> = crosswalks
             .iter()
             .map(|poly| {
-                poly.iter()
-                    .fold((Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)), |(a, b), p| {
-                        (a.min(*p), b.max(*p))
-                    })
+                poly.iter().fold(
+                    (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+                    |(a, b), p| (a.min(*p), b.max(*p)),
+                )
             })
             .collect();
         let mut pieces = Vec::new();
@@ -546,11 +540,10 @@ impl StaticScene {
                 };
                 let aux = if material == Material::Road {
                     let qb = q.map(|v| v.truncate());
-                    let (pmin, pmax) = qb
-                        .iter()
-                        .fold((Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)), |(a, b), p| {
-                            (a.min(*p), b.max(*p))
-                        });
+                    let (pmin, pmax) = qb.iter().fold(
+                        (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+                        |(a, b), p| (a.min(*p), b.max(*p)),
+                    );
                     let crosswalk = cw_boxes
                         .iter()
                         .position(|(a, b2)| a.x <= pmax.x && a.y <= pmax.y && b2.x >= pmin.x && b2.y >= pmin.y)
@@ -620,7 +613,10 @@ impl StaticScene {
                 continue;
             }
             let c = (o.centre - origin.truncate()).as_vec2();
-            let z = [(o.base_z_m - origin.z) as f32, (o.base_z_m + o.height_m - origin.z) as f32];
+            let z = [
+                (o.base_z_m - origin.z) as f32,
+                (o.base_z_m + o.height_m - origin.z) as f32,
+            ];
             let h = mix64(seed ^ mix64(i as u64 + 1));
             match o.kind {
                 ObstacleKind::Building => {
@@ -926,7 +922,11 @@ fn capsule_tris(tris: &mut Vec<Tri>, c: &SceneCapsule, prim: u32) {
     // Vertices sit slightly outside the surface so the polygon's silhouette matches the capsule's on average.
     let r = c.radius_m * 1.04;
     let d = c.b - c.a;
-    let axis = if d.length_squared() > 1e-10 { d.normalize() } else { Vec3::Z };
+    let axis = if d.length_squared() > 1e-10 {
+        d.normalize()
+    } else {
+        Vec3::Z
+    };
     let u = axis.any_orthonormal_vector();
     let v = axis.cross(u);
     let ring = |centre: Vec3, radius: f32| -> [Vec3; N] {
@@ -1014,7 +1014,12 @@ impl FrameScene {
             let b = frames.get(f0 + 1).unwrap_or(a);
             let (pos, yaw) = lerp_vehicle(a, b, t.alpha);
             let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
-            self.push_vehicle(stat.rel(pos), yaw as f32, paint_of(id), VEHICLE_INSTANCE_BASE.saturating_add(id as u16));
+            self.push_vehicle(
+                stat.rel(pos),
+                yaw as f32,
+                paint_of(id),
+                VEHICLE_INSTANCE_BASE.saturating_add(id as u16),
+            );
         }
         for (pi, frames) in trace.pedestrians.iter().enumerate() {
             let Some(a) = frames.get(f0) else { continue };

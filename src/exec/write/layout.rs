@@ -68,7 +68,10 @@ impl Layout {
 
     /// A clip's single file of a sensor stream: `sensors/<stream>/<clip_id>.<ext>`.
     pub fn sensor_clip(&self, stream: &str, clip_id: &str, ext: &str) -> PathBuf {
-        self.root.join(SENSORS_DIR).join(stream).join(format!("{clip_id}.{ext}"))
+        self.root
+            .join(SENSORS_DIR)
+            .join(stream)
+            .join(format!("{clip_id}.{ext}"))
     }
 
     /// The path of a dataset file relative to the root, with `/` separators (as the manifest records it).

@@ -180,7 +180,12 @@ impl DatasetWriter {
         for stream in sensors::CAMERA_STREAMS {
             let stream_dir = self.layout.root().join(layout::SENSORS_DIR).join(stream);
             dirs.push(stream_dir);
-            dirs.extend(self.manifest.clips.iter().map(|c| self.layout.sensor_dir(stream, &c.clip_id)));
+            dirs.extend(
+                self.manifest
+                    .clips
+                    .iter()
+                    .map(|c| self.layout.sensor_dir(stream, &c.clip_id)),
+            );
         }
         for dir in dirs {
             let Ok(entries) = std::fs::read_dir(&dir) else { continue };

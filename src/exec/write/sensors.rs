@@ -15,7 +15,9 @@
 
 use std::sync::Arc;
 
-use arrow_array::{ArrayRef, BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array};
+use arrow_array::{
+    ArrayRef, BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array,
+};
 use arrow_schema::{DataType, Field, Schema};
 use sha2::{Digest, Sha256};
 
@@ -60,7 +62,14 @@ pub struct ClipSensorWriter<'a> {
 }
 
 /// PNG bytes of an image.
-pub fn png_bytes(width: usize, height: usize, colour: png::ColorType, depth: png::BitDepth, data: &[u8], palette: Option<&[u8]>) -> Result<Vec<u8>, Error> {
+pub fn png_bytes(
+    width: usize,
+    height: usize,
+    colour: png::ColorType,
+    depth: png::BitDepth,
+    data: &[u8],
+    palette: Option<&[u8]>,
+) -> Result<Vec<u8>, Error> {
     let mut out = Vec::with_capacity(data.len() / 2 + 1024);
     let fail = |e: png::EncodingError| Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a PNG image: {e}"));
     {
@@ -144,7 +153,9 @@ impl<'a> ClipSensorWriter<'a> {
                     let mut out = Vec::new();
                     jpeg_encoder::Encoder::new(&mut out, self.output.jpeg_quality.clamp(1, 100))
                         .encode(&img.rgb, w as u16, h as u16, jpeg_encoder::ColorType::Rgb)
-                        .map_err(|e| Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}")))?;
+                        .map_err(|e| {
+                            Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}"))
+                        })?;
                     self.put("rgb", at, "jpg", &out)?;
                 }
             }
@@ -153,11 +164,20 @@ impl<'a> ClipSensorWriter<'a> {
             self.scratch.clear();
             let bytes = match self.output.depth_encoding {
                 DepthEncoding::MillimetresU16 => {
-                    self.scratch.extend(img.depth_m.iter().flat_map(|d| depth_mm(*d).to_be_bytes()));
-                    png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &self.scratch, None)?
+                    self.scratch
+                        .extend(img.depth_m.iter().flat_map(|d| depth_mm(*d).to_be_bytes()));
+                    png_bytes(
+                        w,
+                        h,
+                        png::ColorType::Grayscale,
+                        png::BitDepth::Sixteen,
+                        &self.scratch,
+                        None,
+                    )?
                 }
                 DepthEncoding::CarlaRgb24 => {
-                    self.scratch.extend(img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)));
+                    self.scratch
+                        .extend(img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)));
                     png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &self.scratch, None)?
                 }
             };
@@ -177,7 +197,14 @@ impl<'a> ClipSensorWriter<'a> {
         if self.sensors.instance.enabled {
             self.scratch.clear();
             self.scratch.extend(img.instance.iter().flat_map(|i| i.to_be_bytes()));
-            let bytes = png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &self.scratch, None)?;
+            let bytes = png_bytes(
+                w,
+                h,
+                png::ColorType::Grayscale,
+                png::BitDepth::Sixteen,
+                &self.scratch,
+                None,
+            )?;
             self.put("instance", at, "png", &bytes)?;
         }
         if self.sensors.dvs.enabled {
@@ -187,14 +214,18 @@ impl<'a> ClipSensorWriter<'a> {
     }
 
     /// Writes the per-clip files (DVS events) and returns the index rows, sorted by (frame, stream).
-    pub fn finish(mut self, parquet: impl Fn(&RecordBatch, &str) -> Result<Vec<u8>, Error>) -> Result<Vec<IndexRow>, Error> {
+    pub fn finish(
+        mut self,
+        parquet: impl Fn(&RecordBatch, &str) -> Result<Vec<u8>, Error>,
+    ) -> Result<Vec<IndexRow>, Error> {
         if self.sensors.dvs.enabled {
             let batch = dvs_batch(&self.events);
             let bytes = parquet(&batch, "dvs")?;
             self.put("dvs", None, "parquet", &bytes)?;
         }
         let order = |s: &str| CAMERA_STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
-        self.rows.sort_by(|a, b| (a.frame, order(a.stream)).cmp(&(b.frame, order(b.stream))));
+        self.rows
+            .sort_by(|a, b| (a.frame, order(a.stream)).cmp(&(b.frame, order(b.stream))));
         Ok(self.rows)
     }
 }
@@ -259,7 +290,8 @@ mod tests {
         assert_eq!(depth_mm(12.3456), 12346);
         assert_eq!(depth_mm(100.0), 65535, "saturates");
         let [r, g, b] = carla_depth_rgb(37.5);
-        let back = 1000.0 * (f64::from(r) + 256.0 * f64::from(g) + 65536.0 * f64::from(b)) / f64::from((1u32 << 24) - 1);
+        let back =
+            1000.0 * (f64::from(r) + 256.0 * f64::from(g) + 65536.0 * f64::from(b)) / f64::from((1u32 << 24) - 1);
         assert!((back - 37.5).abs() < 1e-4, "{back}");
     }
 

@@ -225,7 +225,11 @@ pub(crate) fn build_with(
                 let first_piece = pieces.len() as u32;
                 let mut length = 0.0;
                 // Sidewalks are raised by a curb (CARLA's are; OpenDRIVE's lane <height> is not read).
-                let curb = if rl.lane_type == LaneType::Sidewalk { crate::world::CURB_HEIGHT_M } else { 0.0 };
+                let curb = if rl.lane_type == LaneType::Sidewalk {
+                    crate::world::CURB_HEIGHT_M
+                } else {
+                    0.0
+                };
                 for k in 0..per_station.len() - 1 {
                     let (p0, n0, z0, cw0, ref b0) = per_station[k];
                     let (p1, n1, z1, cw1, ref b1) = per_station[k + 1];

@@ -184,7 +184,11 @@ mod tests {
         esim.step_log(&[0.5], 2_000_000, 1, &mut ev);
         assert_eq!(ev.len(), 1);
         assert!(!ev[0].positive);
-        assert!((ev[0].t_ns - 1_800_000).abs() <= 1, "(0.6 − 1.0)·1ms/(0.5 − 1.0) = 0.8 ms: {}", ev[0].t_ns);
+        assert!(
+            (ev[0].t_ns - 1_800_000).abs() <= 1,
+            "(0.6 − 1.0)·1ms/(0.5 − 1.0) = 0.8 ms: {}",
+            ev[0].t_ns
+        );
     }
 
     #[test]

@@ -39,9 +39,9 @@ pub struct Lighting {
 }
 
 /// Luminous intensity of a street lamp (linear units × m²).
-pub const LAMP_INTENSITY: f32 = 28.0;
+pub const LAMP_INTENSITY: f32 = 16.0;
 /// Luminous intensity of a headlamp along its axis (linear units × m²).
-pub const HEADLAMP_INTENSITY: f32 = 90.0;
+pub const HEADLAMP_INTENSITY: f32 = 110.0;
 
 fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
     let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
@@ -67,15 +67,17 @@ impl Lighting {
         let sun_colour = Vec3::new(1.0, 0.95, 0.88).lerp(Vec3::new(1.0, 0.55, 0.28), low);
         let direct = 2.4 * smoothstep(-1.0, 12.0, alt_deg) * (1.0 - 0.9 * cloud) * (1.0 - 0.6 * fog);
         let overcast = Vec3::new(0.62, 0.64, 0.68);
-        let blue = Vec3::new(0.30, 0.45, 0.80);
+        let blue = Vec3::new(0.16, 0.32, 0.78);
         let sky_day = blue.lerp(overcast, cloud).lerp(Vec3::new(0.9, 0.55, 0.38), 0.55 * low);
         let ambient_day = 0.55 + 0.35 * cloud;
         let moon = Vec3::new(0.010, 0.013, 0.022);
         let sky_ambient = (sky_day * ambient_day * day + moon * (1.0 - day)) * (1.0 - 0.35 * rain);
         let zenith = (sky_day * 0.95 * day + Vec3::new(0.004, 0.006, 0.014) * (1.0 - day)) * (1.0 - 0.4 * rain);
-        let horizon_day = Vec3::new(0.75, 0.82, 0.92).lerp(overcast * 1.1, cloud).lerp(Vec3::new(1.0, 0.6, 0.35), low);
-        let horizon = horizon_day * day + Vec3::new(0.012, 0.014, 0.022) * (1.0 - day);
-        let fog_colour = (Vec3::new(0.62, 0.64, 0.66) * day.max(0.02)).lerp(horizon, 0.3);
+        let horizon_day = Vec3::new(0.48, 0.62, 0.88)
+            .lerp(overcast * 1.1, cloud)
+            .lerp(Vec3::new(1.0, 0.6, 0.35), low);
+        let horizon = horizon_day * day + Vec3::new(0.005, 0.006, 0.011) * (1.0 - day);
+        let fog_colour = (Vec3::new(0.62, 0.64, 0.66) * day.max(0.006)).lerp(horizon, 0.3);
         Lighting {
             sun_dir,
             sun: sun_colour * direct,

@@ -282,8 +282,12 @@ impl Renderer {
         self.lights.lamps.extend(lamps.iter().take(16).map(|l| l.1));
         // The ego's own headlights (under the camera), then the nearest traffic's.
         let fwd = pose.forward.as_vec3();
-        let axis = Vec3::new(fwd.x, fwd.y, -0.06).normalize();
-        self.lights.heads.push((cam + Vec3::new(fwd.x, fwd.y, 0.0) * 1.5 - Vec3::Z * 0.7, axis));
+        let axis = Vec3::new(fwd.x, fwd.y, 0.0).normalize_or_zero();
+        let left = Vec3::new(-axis.y, axis.x, 0.0);
+        for side in [0.7f32, -0.7] {
+            let lamp = cam + axis * 1.5 + left * (side - 0.3) - Vec3::Z * 0.7;
+            self.lights.heads.push((lamp, axis));
+        }
         let mut heads: Vec<(f32, (Vec3, Vec3))> = frame
             .head_lamps
             .iter()
@@ -388,7 +392,7 @@ impl Renderer {
             let x0: f32 = rng.random_range(-50.0..w + 50.0);
             let y0: f32 = rng.random_range(-50.0..h);
             let len: f32 = rng.random_range(0.02..0.07) * h;
-            let alpha: f32 = rng.random_range(0.08..0.22);
+            let alpha: f32 = rng.random_range(0.12..0.3);
             let steps = len as usize;
             for k in 0..steps {
                 let t = k as f32;

@@ -177,7 +177,13 @@ mod tests {
     fn the_nearer_triangle_wins_and_depth_is_interpolated() {
         let mut r = Raster::new(8, 8);
         r.clear(0.0);
-        let t = |k: f64| [DVec3::new(0.0, 0.0, k), DVec3::new(8.0, 0.0, k), DVec3::new(0.0, 8.0, k)];
+        let t = |k: f64| {
+            [
+                DVec3::new(0.0, 0.0, k),
+                DVec3::new(8.0, 0.0, k),
+                DVec3::new(0.0, 8.0, k),
+            ]
+        };
         r.draw(t(0.5), 1);
         r.draw(t(0.25), 2); // farther (smaller key)
         assert_eq!(r.prim[0], 1);
@@ -186,7 +192,11 @@ mod tests {
         let mut r = Raster::new(8, 1);
         r.clear(-1.0);
         r.draw(
-            [DVec3::new(0.0, 0.0, 0.0), DVec3::new(8.0, 0.0, 8.0), DVec3::new(0.0, 8.0, 0.0)],
+            [
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(8.0, 0.0, 8.0),
+                DVec3::new(0.0, 8.0, 0.0),
+            ],
             3,
         );
         assert!((r.key[3] - 3.5).abs() < 1e-5, "{}", r.key[3]);
@@ -196,7 +206,11 @@ mod tests {
     fn near_clipping_keeps_the_front_part() {
         let mut out = [Vec3::ZERO; 4];
         let n = clip_near(
-            [Vec3::new(0.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)],
+            [
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(1.0, 0.0, 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
             0.1,
             &mut out,
         );

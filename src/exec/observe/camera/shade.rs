@@ -119,11 +119,11 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
             let z = p.z / 3.2;
             let (fa, fz) = (a - a.floor(), z - z.floor());
             if fa > 0.22 && fa < 0.78 && fz > 0.3 && fz < 0.82 && p.z > 1.2 {
-                let lit = nz.cell(a.floor() as i32, z.floor() as i32, prim.aux) < 0.3;
+                let lit = nz.cell(a.floor() as i32, z.floor() as i32, prim.aux) < 0.22;
                 albedo = Vec3::new(0.03, 0.035, 0.045);
                 gloss = 0.35;
                 if lit {
-                    emissive = Vec3::new(0.9, 0.7, 0.42) * (0.6 * l.night);
+                    emissive = Vec3::new(0.9, 0.7, 0.42) * (0.35 * l.night);
                 }
             } else if fz < 0.04 {
                 albedo *= 0.7;
@@ -150,8 +150,10 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         }
     }
     if ground && l.wet > 0.0 {
-        albedo *= 1.0 - 0.45 * l.wet;
-        gloss = gloss.max(l.wet * (0.55 + 0.25 * nz.sample(xy * 0.7)));
+        // Darker when wet, and puddles (a low-frequency noise mask) that mirror the sky and the lights.
+        let puddle = ((nz.sample(xy * 0.35) - 0.15) * 4.0).clamp(0.0, 1.0) * l.wet;
+        albedo *= 1.0 - 0.4 * l.wet - 0.2 * puddle;
+        gloss = gloss.max(l.wet * 0.25 + 0.6 * puddle);
     }
 
     // Light received.
@@ -168,7 +170,8 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
             let inv = d2.sqrt().recip();
             let dir = d * inv;
             let fall = LAMP_INTENSITY * l.night / (d2 + 1.0);
-            light += Vec3::new(1.0, 0.78, 0.5) * (fall * normal.dot(dir).max(0.0) * dir.z.max(0.0).sqrt());
+            // The lamp shines downwards: light falls off away from below it.
+            light += Vec3::new(1.0, 0.78, 0.5) * (fall * normal.dot(dir).max(0.0) * dir.z.max(0.0));
             if gloss > 0.0 {
                 let h = (dir + view).normalize_or_zero();
                 let s = normal.dot(h).max(0.0);
@@ -183,11 +186,17 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
             if d2 > 3600.0 || d2 < 1e-4 {
                 continue;
             }
-            let inv = d2.sqrt().recip();
-            let dir = d * inv;
-            let cone = ((dir.dot(axis) - 0.88) / 0.12).clamp(0.0, 1.0);
-            if cone > 0.0 {
-                let fall = HEADLAMP_INTENSITY * l.night * cone * cone / (d2 + 1.0);
+            // A low beam: wide sideways, cut off just above the lamp's horizontal.
+            let ahead = d.truncate().dot(axis.truncate());
+            if ahead <= 0.1 {
+                continue;
+            }
+            let side = (d.truncate().perp_dot(axis.truncate()) / ahead / 0.7).abs();
+            let up = d.z / ahead;
+            let beam = (1.0 - side * side).max(0.0) * ((0.02 - up) / 0.04).clamp(0.0, 1.0);
+            if beam > 0.0 {
+                let dir = d * d2.sqrt().recip();
+                let fall = HEADLAMP_INTENSITY * l.night * beam / (d2 + 30.0);
                 light += Vec3::new(1.0, 0.97, 0.9) * (fall * normal.dot(-dir).max(0.0));
             }
         }
@@ -198,7 +207,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         let r = Vec3::new(r.x, r.y, r.z.abs());
         let cos = normal.dot(view).max(0.0);
         let fresnel = 0.04 + 0.96 * (1.0 - cos).powi(5);
-        colour += l.sky(r) * (gloss * (0.25 + 0.75 * fresnel));
+        colour += l.sky(r) * (gloss * (0.08 + 0.92 * fresnel));
     }
     colour
 }
