@@ -310,6 +310,16 @@ pub fn stats(
     emit(out, &text)
 }
 
+/// `pedsynth preview DIR`: a contact sheet or GIF of one clip's camera stream with its labels.
+pub fn preview(
+    dir: &Path,
+    options: &crate::exec::read::preview::PreviewOptions,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    let text = crate::exec::read::preview::preview(dir, options)?;
+    emit(out, &text)
+}
+
 /// Loads a spec file, its towns and its full plan: the programmatic path to a plan (tests, benchmarks, tools).
 pub fn plan_spec_file(
     path: &Path,

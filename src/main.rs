@@ -98,6 +98,21 @@ enum Command {
         #[arg(long, value_name = "FRAMES", requires = "protocol")]
         min_track: Option<usize>,
     },
+    /// Draw a clip's camera stream with its labels (boxes, ids, states, skeletons): a contact sheet of nine
+    /// frames (--out FILE.png) or an animation (--out FILE.gif).
+    Preview {
+        /// Dataset directory.
+        dir: PathBuf,
+        /// Clip id (manifest.json lists them).
+        #[arg(long, value_name = "CLIP_ID")]
+        clip: String,
+        /// Stream to show.
+        #[arg(long, value_enum, default_value = "rgb")]
+        stream: PreviewStream,
+        /// Output file: .png (contact sheet) or .gif (animation); default `<clip>.<stream>.png`.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
     /// Inspect towns.
@@ -105,6 +120,16 @@ enum Command {
         #[command(subcommand)]
         command: TownCommand,
     },
+}
+
+/// Streams `preview` can show.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum PreviewStream {
+    Rgb,
+    Semantic,
+    Instance,
+    Depth,
+    Dvs,
 }
 
 /// Benchmark protocols of `stats --protocol`.
@@ -212,6 +237,31 @@ fn main() -> ExitCode {
                 min_track: min_track.unwrap_or(obs_length + tte.1),
             });
             commands::stats(&dir, json, options.as_ref(), &mut out)
+        }
+        Command::Preview {
+            dir,
+            clip,
+            stream,
+            out: file,
+        } => {
+            use pedsynth::exec::read::preview::{PreviewOptions, Stream};
+            let (stream, name) = match stream {
+                PreviewStream::Rgb => (Stream::Rgb, "rgb"),
+                PreviewStream::Semantic => (Stream::Semantic, "semantic"),
+                PreviewStream::Instance => (Stream::Instance, "instance"),
+                PreviewStream::Depth => (Stream::Depth, "depth"),
+                PreviewStream::Dvs => (Stream::Dvs, "dvs"),
+            };
+            let file = file.unwrap_or_else(|| PathBuf::from(format!("{clip}.{name}.png")));
+            commands::preview(
+                &dir,
+                &PreviewOptions {
+                    clip,
+                    stream,
+                    out: file,
+                },
+                &mut out,
+            )
         }
         Command::Schema => commands::schema(&mut out),
         Command::Town {

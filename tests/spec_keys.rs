@@ -13,6 +13,7 @@ use pedsynth::dsl::not_yet::NOT_YET;
 use pedsynth::dsl::{self, LoadOptions, Spec};
 use pedsynth::exec::observe::{self, rig::Rig};
 use pedsynth::exec::simulate;
+use pedsynth::exec::write::sensors::ClipSensorWriter;
 use pedsynth::exec::write::tables::{self, FileMeta};
 use pedsynth::planner::{self, TownContext};
 use serde_json::{Value as Json, json};
@@ -23,7 +24,8 @@ struct Outcome {
     /// The plan's clip scripts, dataset name and target (not its copy of the spec or the simulation
     /// parameters, which hold every key verbatim: those must prove themselves in the tables).
     plan: String,
-    /// blake3 of every table file of every clip (with fixed file metadata, so the spec hash does not count).
+    /// blake3 of every table file of every clip (with fixed file metadata, so the spec hash does not count),
+    /// and, for the keys of `sensors` and `output`, of the sensor files of the first frames of the first clip.
     tables: Option<String>,
 }
 
@@ -31,6 +33,10 @@ struct Walker {
     base: Json,
     /// The base spec's tables (computed once).
     base_tables: std::cell::OnceCell<Option<String>>,
+    /// The base spec's tables and sensor files (computed once).
+    base_sensors: std::cell::OnceCell<Option<String>>,
+    /// Whether the key being judged may show in the sensor files only.
+    sensors: std::cell::Cell<bool>,
     towns: BTreeMap<String, TownContext>,
     base_dir: std::path::PathBuf,
 }
@@ -84,6 +90,25 @@ impl Walker {
                         tables::parquet_bytes(batch, &plan.spec.output, &meta, "t", &script.clip_id).expect("parquet");
                     hasher.update(&bytes);
                 }
+                if self.sensors.get() && script.clip_id == plan.clips[0].clip_id {
+                    // The sensor files of the first frames, written to a scratch directory and hashed through
+                    // the sensor index (path, size, SHA-256).
+                    let dir = std::env::temp_dir().join(format!("pedsynth-keys-{}", std::process::id()));
+                    let layout = pedsynth::exec::write::Layout::new(&dir);
+                    let sensors = &plan.spec.sensors;
+                    let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output);
+                    let _ = observe::render_cameras(script, &trace, sensors, &rig, net, |f| {
+                        files.frame(f).expect("sensor files");
+                        if f.frame >= 4 { Err(()) } else { Ok(()) }
+                    });
+                    let rows = files
+                        .finish(|b, t| tables::parquet_bytes(b, &plan.spec.output, &meta, t, &script.clip_id))
+                        .expect("sensor files");
+                    for r in rows {
+                        hasher.update(format!("{}|{}|{}", r.path, r.bytes, r.sha256).as_bytes());
+                    }
+                    std::fs::remove_dir_all(&dir).ok();
+                }
             }
             hasher.finalize().to_hex().to_string()
         });
@@ -100,6 +125,13 @@ impl Walker {
                 *pointer(&mut spec, p) = v.clone();
             }
             spec
+        };
+        self.sensors
+            .set(path.starts_with("sensors.") || path.starts_with("output."));
+        let cache = if self.sensors.get() {
+            &self.base_sensors
+        } else {
+            &self.base_tables
         };
         let base_spec = with_context(self.base.clone());
         let base_loaded = self
@@ -120,9 +152,7 @@ impl Walker {
                     }
                     let base_tables = base_tables.get_or_insert_with(|| {
                         if context.is_empty() {
-                            self.base_tables
-                                .get_or_init(|| self.outcome(&base_loaded, true).tables)
-                                .clone()
+                            cache.get_or_init(|| self.outcome(&base_loaded, true).tables).clone()
                         } else {
                             self.outcome(&base_loaded, true).tables
                         }
@@ -348,6 +378,8 @@ fn every_key_changes_the_plan_or_the_tables_or_is_reported_as_not_implemented() 
     let walker = Walker {
         base: serde_json::to_value(&loaded.spec).expect("json"),
         base_tables: std::cell::OnceCell::new(),
+        base_sensors: std::cell::OnceCell::new(),
+        sensors: std::cell::Cell::new(false),
         towns,
         base_dir,
     };

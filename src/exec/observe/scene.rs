@@ -1052,7 +1052,7 @@ impl FrameScene {
             aux: 0,
         };
         let body = car(Material::CarPaint, paint);
-        let glass = car(Material::CarGlass, linear([30, 36, 44]));
+        let glass = car(Material::CarGlass, linear([14, 16, 20]));
         let tyre = car(Material::Tyre, linear([20, 20, 20]));
         // Lower body, cabin (glass sides, painted roof), four wheels.
         push_box(

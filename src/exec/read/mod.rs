@@ -3,6 +3,8 @@
 //! - [`tables`] — reading tables: files, columns, typed access that reports bad input as errors.
 //! - [`stats`] — `pedsynth stats`: statistics computed from the written tables.
 //! - [`protocol`] — `pedsynth stats --protocol pab`: PedestrianActionBenchmark's sampling of the tables.
+//! - [`preview`] — `pedsynth preview`: a contact sheet or GIF of a clip's camera stream with its labels.
+pub mod preview;
 pub mod protocol;
 pub mod stats;
 pub mod tables;

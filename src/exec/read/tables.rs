@@ -6,7 +6,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, Int32Type, UInt32Type, UInt64Type};
+use arrow_array::types::{Float32Type, Float64Type, Int32Type, UInt16Type, UInt32Type, UInt64Type};
 use arrow_array::{Array, ArrowPrimitiveType, PrimitiveArray, RecordBatch};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 
@@ -86,6 +86,26 @@ impl Batch {
         let c = self.column(name)?;
         c.as_primitive_opt::<T>()
             .ok_or_else(|| self.invalid(&format!("column `{name}` is {}, not {}", c.data_type(), T::DATA_TYPE)))
+    }
+
+    /// A `uint16` column.
+    pub fn u16s(&self, name: &str) -> Result<&PrimitiveArray<UInt16Type>, Error> {
+        self.primitive(name)
+    }
+
+    /// A fixed-size list of `float32` column: all values, row after row, and the list width.
+    pub fn f32_lists(&self, name: &str) -> Result<(&[f32], usize), Error> {
+        let c = self.column(name)?;
+        let list = c
+            .as_fixed_size_list_opt()
+            .ok_or_else(|| self.invalid(&format!("column `{name}` is {}, not a fixed-size list", c.data_type())))?;
+        let values = list
+            .values()
+            .as_primitive_opt::<Float32Type>()
+            .ok_or_else(|| self.invalid(&format!("column `{name}` does not hold float32 values")))?;
+        let width = list.value_length() as usize;
+        let start = list.offset() * width;
+        Ok((&values.values()[start..start + list.len() * width], width))
     }
 
     /// A `uint32` column.

@@ -136,7 +136,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         Material::Trunk => albedo *= 1.0 + 0.2 * nz.sample(Vec2::new(xy.x * 9.0, p.z * 3.0)),
         Material::Foliage => albedo *= 0.8 + 0.45 * nz.sample(Vec2::new(xy.x * 2.2 + p.z, xy.y * 2.2 - p.z)),
         Material::CarPaint => gloss = 0.18,
-        Material::CarGlass => gloss = 0.3,
+        Material::CarGlass => gloss = 0.12,
         Material::HeadLamp => emissive = Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night),
         Material::TailLamp => emissive = Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night),
         Material::Body | Material::Head => {
