@@ -81,7 +81,14 @@ fn generate(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> (i32, 
         quiet: true,
     };
     let (mut o, mut e) = (Vec::new(), Vec::new());
-    let code = commands::finish(commands::generate(input, &options(overrides), &args, &mut o), &mut e);
+    // A plan file takes no overrides: it was planned with the cameras off already.
+    let is_plan = input.extension().is_some_and(|x| x == "json");
+    let opts = if is_plan {
+        LoadOptions::default()
+    } else {
+        options(overrides)
+    };
+    let code = commands::finish(commands::generate(input, &opts, &args, &mut o), &mut e);
     (
         code,
         String::from_utf8_lossy(&o).into_owned(),

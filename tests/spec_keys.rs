@@ -98,8 +98,9 @@ impl Walker {
                     let sensors = &plan.spec.sensors;
                     let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output);
                     let _ = observe::render_cameras(script, &trace, sensors, &rig, net, |f| {
+                        let last = f.frame >= 4;
                         files.frame(f).expect("sensor files");
-                        if f.frame >= 4 { Err(()) } else { Ok(()) }
+                        if last { Err(()) } else { Ok(()) }
                     });
                     let rows = files
                         .finish(|b, t| tables::parquet_bytes(b, &plan.spec.output, &meta, t, &script.clip_id))
@@ -197,6 +198,9 @@ impl Walker {
     }
 }
 
+/// Keys of enums with a single variant in this version (no other value to try).
+const SINGLE_VALUED: &[&str] = &["output.dvs_encoding"];
+
 /// Keys whose only effect is on validation: the sanity limits, a gate stage that cannot be turned off, and the
 /// cap on allocated crossers (every valid spec allocates at most the cap, so it bounds the reachable target).
 const VALIDATION_KEYS: &[&str] = &[
@@ -234,6 +238,8 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
             ("pedestrians.per_clip", json!([30, 30])),
         ],
         // Beyond 50 m the default 8 px width already rejects everyone: the height shows with a lower width.
+        // The JPEG quality shows in JPEG files only.
+        "output.jpeg_quality" => vec![("output.rgb_encoding", json!("jpeg"))],
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }
@@ -264,6 +270,10 @@ fn leaves(v: &Json, path: String, out: &mut Vec<(String, Json)>) {
 
 /// Values to try for a leaf, in order (the first that validates is used).
 fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
+    // A refractory period shows only when a pixel fires twice within it: longer than a frame interval.
+    if path == "sensors.dvs.refractory_period_ns" {
+        return vec![json!(20_000_000)];
+    }
     let key = path.rsplit('.').next().unwrap_or(path);
     let parent_key = path.rsplit('.').nth(1).unwrap_or("");
     // Shares of a mix (a mapping of numbers only): swap with a sibling of another value (the sum stays 1).
@@ -293,7 +303,8 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
                 "body" => &["adult", "child", "adult_with_child"],
                 "pose_format" => &["coco17", "openpose18"],
                 "compression" => &["zstd", "snappy", "none"],
-                "rgb_encoding" => &["png"],
+                "rgb_encoding" => &["png", "jpeg"],
+                "depth_encoding" => &["mm_u16", "carla_rgb24"],
                 "lidar_encoding" => &["parquet", "bin_f32"],
                 "dvs_encoding" => &["parquet"],
                 "name" => &["walk", "walk_renamed"],
@@ -392,6 +403,9 @@ fn every_key_changes_the_plan_or_the_tables_or_is_reported_as_not_implemented() 
     for (path, value) in &all {
         if path == "version" {
             continue; // the format marker: validation accepts 1 only
+        }
+        if SINGLE_VALUED.contains(&path.as_str()) {
+            continue; // nothing to perturb: the only value there is
         }
         let parent_path = path.rsplit_once('.').map_or("", |p| p.0);
         let parent = parent_path
