@@ -224,8 +224,7 @@ impl<'a> ClipSensorWriter<'a> {
             self.put("dvs", None, "parquet", &bytes)?;
         }
         let order = |s: &str| CAMERA_STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
-        self.rows
-            .sort_by(|a, b| (a.frame, order(a.stream)).cmp(&(b.frame, order(b.stream))));
+        self.rows.sort_by_key(|r| (r.frame, order(r.stream)));
         Ok(self.rows)
     }
 }

@@ -183,7 +183,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         for &(pos, axis) in &ctx.lights.heads {
             let d = p - pos;
             let d2 = d.length_squared();
-            if d2 > 3600.0 || d2 < 1e-4 {
+            if !(1e-4..=3600.0).contains(&d2) {
                 continue;
             }
             // A low beam: wide sideways, cut off just above the lamp's horizontal.
