@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::observe::{self, rig::Rig};
 use pedsynth::exec::simulate;
-use pedsynth::exec::write::sensors::{png_bytes, semantic_palette};
+use pedsynth::exec::write::sensors::{rgb_png, semantic_png};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -57,24 +57,7 @@ fn main() {
         let start = std::time::Instant::now();
         let img = observe::render_frame(clip, &trace, &rig, net, frame);
         let took = start.elapsed();
-        let rgb = png_bytes(
-            img.width,
-            img.height,
-            png::ColorType::Rgb,
-            png::BitDepth::Eight,
-            &img.rgb,
-            None,
-        )
-        .expect("png");
-        let sem = png_bytes(
-            img.width,
-            img.height,
-            png::ColorType::Indexed,
-            png::BitDepth::Eight,
-            &img.semantic,
-            Some(&semantic_palette()),
-        )
-        .expect("png");
+        let (rgb, sem) = (rgb_png(&img).expect("png"), semantic_png(&img).expect("png"));
         let name = format!("{}-{frame:06}", clip.clip_id);
         std::fs::write(out.join(format!("{name}.rgb.png")), rgb).expect("write");
         std::fs::write(out.join(format!("{name}.semantic.png")), sem).expect("write");

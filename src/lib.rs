@@ -7,5 +7,6 @@ pub mod dsl;
 pub mod error;
 pub mod exec;
 pub mod fsutil;
+pub mod mix;
 pub mod planner;
 pub mod world;

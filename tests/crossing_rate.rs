@@ -8,31 +8,20 @@ mod common;
 
 use std::path::PathBuf;
 
-use pedsynth::commands::{self, GenerateArgs};
-use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::read::stats;
 
 fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
     let out = std::env::temp_dir().join(format!("pedsynth-crossing-rate-{}-{target}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let options = LoadOptions {
-        overrides: common::NO_CAMERAS
-            .iter()
-            .map(|s| s.to_string())
-            .chain([format!("crossing.target_ratio={target}")])
-            .collect(),
-        allow_large: false,
-    };
-    let args = GenerateArgs {
-        out: out.clone(),
-        jobs: None,
-        only: None,
-        quiet: true,
-    };
-    let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
+    let target_set = format!("crossing.target_ratio={target}");
+    let overrides: Vec<&str> = common::NO_CAMERAS
+        .iter()
+        .copied()
+        .chain([target_set.as_str()])
+        .collect();
     let spec = std::path::Path::new("tests/data/specs/heldout_crossing.yaml");
-    let code = commands::finish(commands::generate(spec, &options, &args, &mut stdout), &mut stderr);
-    assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
+    let (code, _, stderr) = common::generate(spec, &overrides, &out, None);
+    assert_eq!(code, 0, "{stderr}");
     let stats = stats::compute(&out).expect("the tables read back");
     (out, stats)
 }

@@ -18,7 +18,7 @@ use arrow_array::{Array, RecordBatch};
 use glam::{DVec2, DVec3};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 
-use pedsynth::commands::{self, GenerateArgs, PlanArgs};
+use pedsynth::commands::{self, PlanArgs};
 use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::observe::{body, rig::Camera};
 use pedsynth::exec::simulate;
@@ -72,28 +72,15 @@ fn options(overrides: &[&str]) -> LoadOptions {
     }
 }
 
-/// Runs `pedsynth generate` through the library; returns the exit code, stdout and stderr.
+/// Runs `pedsynth generate` with the cameras off (a plan file takes no overrides: plan it with them off).
 fn generate(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> (i32, String, String) {
-    let args = GenerateArgs {
-        out: out.to_path_buf(),
-        jobs: Some(jobs),
-        only: None,
-        quiet: true,
-    };
-    let (mut o, mut e) = (Vec::new(), Vec::new());
-    // A plan file takes no overrides: it was planned with the cameras off already.
     let is_plan = input.extension().is_some_and(|x| x == "json");
-    let opts = if is_plan {
-        LoadOptions::default()
+    let all: Vec<&str> = if is_plan {
+        Vec::new()
     } else {
-        options(overrides)
+        common::NO_CAMERAS.iter().chain(overrides).copied().collect()
     };
-    let code = commands::finish(commands::generate(input, &opts, &args, &mut o), &mut e);
-    (
-        code,
-        String::from_utf8_lossy(&o).into_owned(),
-        String::from_utf8_lossy(&e).into_owned(),
-    )
+    common::generate(input, &all, out, Some(jobs))
 }
 
 fn generate_ok(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> String {
@@ -102,27 +89,7 @@ fn generate_ok(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> Str
     stdout
 }
 
-/// Every file under `dir`, by path relative to it.
-fn all_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for entry in std::fs::read_dir(dir).expect("read dir") {
-            let path = entry.expect("dir entry").path();
-            if path.is_dir() {
-                walk(root, &path, out);
-            } else {
-                let rel = path
-                    .strip_prefix(root)
-                    .expect("under root")
-                    .to_string_lossy()
-                    .into_owned();
-                out.insert(rel, std::fs::read(&path).expect("read file"));
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(dir, dir, &mut out);
-    out
-}
+use common::all_files;
 
 fn assert_same_files(a: &Path, b: &Path, what: &str) {
     let (fa, fb) = (all_files(a), all_files(b));

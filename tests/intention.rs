@@ -15,8 +15,6 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use pedsynth::commands::{self, GenerateArgs};
-use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::read::protocol::{self, PabOptions};
 use pedsynth::exec::read::tables;
 use pedsynth::exec::write::Layout;
@@ -24,26 +22,8 @@ use pedsynth::exec::write::Layout;
 fn generate(spec: &str, name: &str) -> PathBuf {
     let out = std::env::temp_dir().join(format!("pedsynth-intention-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let args = GenerateArgs {
-        out: out.clone(),
-        jobs: None,
-        only: None,
-        quiet: true,
-    };
-    let (mut stdout, mut stderr) = (Vec::new(), Vec::new());
-    let code = commands::finish(
-        commands::generate(
-            Path::new(spec),
-            &LoadOptions {
-                overrides: common::NO_CAMERAS.iter().map(|s| s.to_string()).collect(),
-                allow_large: false,
-            },
-            &args,
-            &mut stdout,
-        ),
-        &mut stderr,
-    );
-    assert_eq!(code, 0, "{}", String::from_utf8_lossy(&stderr));
+    let (code, _, stderr) = common::generate(Path::new(spec), &common::NO_CAMERAS, &out, None);
+    assert_eq!(code, 0, "{stderr}");
     out
 }
 

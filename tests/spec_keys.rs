@@ -96,15 +96,14 @@ impl Walker {
                     let dir = std::env::temp_dir().join(format!("pedsynth-keys-{}", std::process::id()));
                     let layout = pedsynth::exec::write::Layout::new(&dir);
                     let sensors = &plan.spec.sensors;
-                    let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output);
+                    let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output, &meta)
+                        .expect("sensor writer");
                     let _ = observe::render_cameras(script, &trace, sensors, &rig, net, |f| {
                         let last = f.frame >= 4;
                         files.frame(f).expect("sensor files");
                         if last { Err(()) } else { Ok(()) }
                     });
-                    let rows = files
-                        .finish(|b, t| tables::parquet_bytes(b, &plan.spec.output, &meta, t, &script.clip_id))
-                        .expect("sensor files");
+                    let rows = files.finish().expect("sensor files");
                     for r in rows {
                         hasher.update(format!("{}|{}|{}", r.path, r.bytes, r.sha256).as_bytes());
                     }

@@ -47,13 +47,13 @@ pub fn run_clip(
     let observations = observe::observe(script, &trace, &plan.spec, rig, &town.network);
     let sensors = &plan.spec.sensors;
     let mut images = 0u64;
-    let sensor_rows = if observe::cameras_enabled(sensors) {
-        let mut files = out.clip_sensors(plan, script);
+    let sensor_rows = if sensors.cameras_enabled() {
+        let mut files = out.clip_sensors(plan, script)?;
         observe::render_cameras(script, &trace, sensors, rig, &town.network, |frame| {
             images += 1;
             files.frame(frame)
         })?;
-        files.finish(|batch, stream| out.sensor_parquet(plan, batch, stream, &script.clip_id))?
+        files.finish()?
     } else {
         Vec::new()
     };

@@ -24,14 +24,24 @@ pub const CLIP_FILE_BYTES: f64 = 8_500.0;
 pub const PEDESTRIAN_ROW_BYTES: f64 = 924.0;
 /// Bytes of the `events` table per pedestrian (measured: 570).
 pub const EVENT_BYTES_PER_PEDESTRIAN: f64 = 570.0;
-/// Bytes per pixel of a fast-compressed PNG frame of a rendered street scene (an estimate).
-pub const PNG_BYTES_PER_PIXEL: f64 = 1.0;
+/// Bytes per pixel of each camera stream's file, measured on `specs/quickstart.yaml` at 1280 × 720
+/// (BENCHMARKS.md, "Cameras": 355, 36, 20 and 12 kB per frame): RGB PNG (fast compression), depth (u16 PNG),
+/// semantic (indexed PNG), instance (u16 PNG).
+pub const RGB_PNG_BYTES_PER_PIXEL: f64 = 0.385;
+/// See [`RGB_PNG_BYTES_PER_PIXEL`].
+pub const DEPTH_PNG_BYTES_PER_PIXEL: f64 = 0.039;
+/// See [`RGB_PNG_BYTES_PER_PIXEL`].
+pub const SEMANTIC_PNG_BYTES_PER_PIXEL: f64 = 0.022;
+/// See [`RGB_PNG_BYTES_PER_PIXEL`].
+pub const INSTANCE_PNG_BYTES_PER_PIXEL: f64 = 0.013;
+/// CPU time to render, encode and write all camera streams of one frame, per pixel, release build: 293 CPU-s
+/// for 1,070 frames of 1280 × 720 (BENCHMARKS.md, "Cameras").
+pub const CAMERA_CPU_S_PER_PIXEL: f64 = 2.97e-7;
 /// Bytes per LiDAR point (x, y, z, intensity as f32).
 pub const LIDAR_POINT_BYTES: f64 = 16.0;
-/// Share of pixels that fire a DVS event per frame in a moving-ego street scene (an estimate).
-pub const DVS_EVENTS_PER_PIXEL: f64 = 0.02;
-/// Bytes per DVS event (x u16, y u16, t i64, polarity), before compression.
-pub const DVS_EVENT_BYTES: f64 = 13.0;
+/// Bytes of DVS events (Parquet, zstd) per pixel and frame, measured on `specs/quickstart.yaml` (BENCHMARKS.md,
+/// "Cameras": 98 MB for 1,070 frames of 1280 × 720).
+pub const DVS_BYTES_PER_PIXEL: f64 = 0.1;
 
 /// Pedestrian-frames simulated, annotated and written per CPU-second by `pedsynth generate` (annotation tables
 /// only), release build: 1,701,362 pedestrian-frames of `specs/pedsynth_pp.yaml` in 13.1 CPU-seconds
@@ -134,7 +144,7 @@ pub struct PlanStats {
     pub estimated_annotated_samples: u64,
     /// Estimated output size.
     pub estimated_bytes: SizeEstimate,
-    /// Estimated generation time on one core, seconds (annotation tables; sensors are not rendered yet).
+    /// Estimated generation time on one core, seconds (simulation, annotation tables and camera streams).
     pub estimated_generation_cpu_s: f64,
     /// Counts per split.
     pub splits: BTreeMap<String, SplitStats>,
@@ -285,8 +295,15 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
     }
     stats.estimated_annotated_samples = (stats.pedestrian_frames as f64 * EXPECTED_VISIBLE_SHARE).round() as u64;
     stats.estimated_bytes = estimate_bytes(&stats, spec, vehicle_frames);
+    let s = &spec.sensors;
+    let camera_pixels = if s.cameras_enabled() {
+        f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px)
+    } else {
+        0.0
+    };
     stats.estimated_generation_cpu_s = round(
-        stats.pedestrian_frames as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S,
+        stats.pedestrian_frames as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
+            + stats.frames as f64 * camera_pixels * CAMERA_CPU_S_PER_PIXEL,
         1,
     );
     stats
@@ -314,21 +331,23 @@ fn estimate_bytes(stats: &PlanStats, spec: &Spec, vehicle_frames: u64) -> SizeEs
     );
     let s = &spec.sensors;
     let pixels = f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px);
-    if s.rgb.enabled {
-        e.sensors
-            .insert("rgb".into(), (frames * pixels * PNG_BYTES_PER_PIXEL) as u64);
+    for (stream, on, bytes_per_pixel) in [
+        ("rgb", s.rgb.enabled, RGB_PNG_BYTES_PER_PIXEL),
+        ("depth", s.depth.enabled, DEPTH_PNG_BYTES_PER_PIXEL),
+        ("semantic", s.semantic.enabled, SEMANTIC_PNG_BYTES_PER_PIXEL),
+        ("instance", s.instance.enabled, INSTANCE_PNG_BYTES_PER_PIXEL),
+        ("dvs", s.dvs.enabled, DVS_BYTES_PER_PIXEL),
+    ] {
+        if on {
+            e.sensors
+                .insert(stream.into(), (frames * pixels * bytes_per_pixel) as u64);
+        }
     }
     if s.lidar.enabled {
         let per_frame = f64::from(s.lidar.points_per_second) / f64::from(spec.dataset.fps.max(1))
             * (1.0 - s.lidar.dropoff_general_rate);
         e.sensors
             .insert("lidar".into(), (frames * per_frame * LIDAR_POINT_BYTES) as u64);
-    }
-    if s.dvs.enabled {
-        e.sensors.insert(
-            "dvs".into(),
-            (frames * pixels * DVS_EVENTS_PER_PIXEL * DVS_EVENT_BYTES) as u64,
-        );
     }
     e.total = e.tables.values().sum::<u64>() + e.sensors.values().sum::<u64>();
     e
@@ -463,7 +482,7 @@ impl std::fmt::Display for PlanStats {
         }
         writeln!(
             out,
-            "\nestimated generation time {:.1} s on one core, {:.1} s on two (annotation tables; sensors are not rendered yet)",
+            "\nestimated generation time {:.1} s on one core, {:.1} s on two (LiDAR is not rendered yet)",
             stats.estimated_generation_cpu_s,
             stats.estimated_generation_cpu_s / 2.0
         )?;

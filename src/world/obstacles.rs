@@ -92,13 +92,6 @@ impl ObstacleIndex {
     }
 }
 
-fn splitmix(mut x: u64) -> u64 {
-    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^ (x >> 31)
-}
-
 /// Building blocks beside the sidewalks of a network that has none: for each ~22 m chunk of each sidewalk
 /// outside junctions, a box 1.5 m behind the sidewalk's outer border, 12 m deep, kept only if no part of it
 /// lies on any lane and it does not overlap a previous box. Deterministic.
@@ -139,7 +132,7 @@ pub(crate) fn synthesize_buildings(net: &RoadNetwork) -> Vec<Obstacle> {
                 continue;
             }
             let depth = 12.0;
-            let h = splitmix((li as u64) << 20 | start as u64);
+            let h = crate::mix::splitmix64((li as u64) << 20 | start as u64);
             let height = 8.0 + (h % 23) as f64;
             let o = Obstacle {
                 kind: ObstacleKind::Building,

@@ -7,6 +7,9 @@
 //!   `PEDSYNTH_REQUIRE_CARLA_MAPS=1` (set by `.ci/run`) a missing map fails the test instead, so CI cannot pass
 //!   by skipping.
 //! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
+//!
+//! Also: `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
+//! cameras off (`NO_CAMERAS`).
 #![allow(dead_code)]
 
 use glam::DVec2;
@@ -225,3 +228,52 @@ pub const NO_CAMERAS: [&str; 5] = [
     "sensors.instance.enabled=false",
     "sensors.dvs.enabled=false",
 ];
+
+/// Runs `pedsynth generate` through the library with `--set` overrides (none for a plan file); returns the
+/// exit code, stdout and stderr.
+pub fn generate(
+    input: &std::path::Path,
+    overrides: &[&str],
+    out: &std::path::Path,
+    jobs: Option<usize>,
+) -> (i32, String, String) {
+    let args = pedsynth::commands::GenerateArgs {
+        out: out.to_path_buf(),
+        jobs,
+        only: None,
+        quiet: true,
+    };
+    let options = pedsynth::dsl::LoadOptions {
+        overrides: overrides.iter().map(|s| s.to_string()).collect(),
+        allow_large: false,
+    };
+    let (mut o, mut e) = (Vec::new(), Vec::new());
+    let code = pedsynth::commands::finish(pedsynth::commands::generate(input, &options, &args, &mut o), &mut e);
+    (
+        code,
+        String::from_utf8_lossy(&o).into_owned(),
+        String::from_utf8_lossy(&e).into_owned(),
+    )
+}
+
+/// Every file under `dir`, by `/`-separated path relative to it.
+pub fn all_files(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    fn walk(root: &std::path::Path, dir: &std::path::Path, out: &mut std::collections::BTreeMap<String, Vec<u8>>) {
+        for entry in std::fs::read_dir(dir).expect("read dir") {
+            let path = entry.expect("dir entry").path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                let rel = path
+                    .strip_prefix(root)
+                    .expect("under root")
+                    .to_string_lossy()
+                    .replace('\\', "/");
+                out.insert(rel, std::fs::read(&path).expect("read file"));
+            }
+        }
+    }
+    let mut out = std::collections::BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}

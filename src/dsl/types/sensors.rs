@@ -22,6 +22,13 @@ pub struct Sensors {
     pub instance: LabelStream,
 }
 
+impl Sensors {
+    /// Whether any camera stream (RGB, depth, semantic, instance, DVS) is enabled: the frames are rendered.
+    pub fn cameras_enabled(&self) -> bool {
+        self.rgb.enabled || self.dvs.enabled || self.depth.enabled || self.semantic.enabled || self.instance.enabled
+    }
+}
+
 /// A label stream rendered from the RGB camera's view (same intrinsics and mount, pixel-aligned with it).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]

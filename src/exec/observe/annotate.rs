@@ -19,7 +19,7 @@ use crate::planner::ClipScript;
 use crate::world::{LaneType, RoadNetwork};
 
 /// Radius of the cylinder standing in for another pedestrian when testing occlusion, as a share of height.
-const PED_OCCLUDER_RADIUS_PER_M: f64 = 0.14;
+pub(crate) const PED_OCCLUDER_RADIUS_PER_M: f64 = 0.14;
 
 /// Why a pedestrian-frame is not annotated (the first gate it fails).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

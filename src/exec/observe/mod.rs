@@ -50,15 +50,6 @@ pub struct SensorFrame<'a> {
     pub events: &'a [camera::dvs::Event],
 }
 
-/// Whether any camera stream of the spec is enabled.
-pub fn cameras_enabled(sensors: &Sensors) -> bool {
-    sensors.rgb.enabled
-        || sensors.dvs.enabled
-        || sensors.depth.enabled
-        || sensors.semantic.enabled
-        || sensors.instance.enabled
-}
-
 /// The simulated time of frame `frame` plus `k / substeps` of a frame, nanoseconds.
 pub fn frame_time_ns(frame: u32, fps: u32, k: u32, substeps: u32) -> i64 {
     let ns = i128::from(frame) * 1_000_000_000 * i128::from(substeps) + i128::from(k) * 1_000_000_000;

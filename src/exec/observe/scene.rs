@@ -22,6 +22,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 use super::body::{self, CAPSULES, CHILD_OFFSET_M};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::{ClipTrace, PedFrame, VehicleFrame};
+use crate::mix::splitmix64;
 use crate::planner::{ClipScript, Identity};
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
 
@@ -264,7 +265,8 @@ pub struct StaticScene {
     pub tris: Vec<Tri>,
     /// Clusters for culling.
     pub clusters: Vec<Cluster>,
-    /// Primitive table of the static triangles (dynamic primitives follow it in [`FrameScene::prims`]).
+    /// Primitive table of the static triangles (a frame's agents number theirs after these: see
+    /// [`FrameScene::prim`]).
     pub prims: Vec<Prim>,
     /// Road paint of each road primitive (indexed by [`Prim::aux`]).
     pub pieces: Vec<PieceSurface>,
@@ -274,15 +276,48 @@ pub struct StaticScene {
     pub lamps: Vec<Lamp>,
     /// The clip's seed (textures, colours).
     pub seed: u64,
+    /// What each pedestrian (and the child beside it) wears, by pedestrian index: worked out once per clip.
+    pub outfits: Vec<(Outfit, Option<Outfit>)>,
+    /// Each traffic vehicle's paint (linear RGB), by vehicle index.
+    pub car_paint: Vec<Vec3>,
 }
 
-/// A 64-bit mix (SplitMix64's finaliser): seeded colours and textures that are pure functions of their inputs.
-pub fn mix64(mut x: u64) -> u64 {
-    x ^= x >> 30;
-    x = x.wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    x ^= x >> 27;
-    x = x.wrapping_mul(0x94d0_49bb_1331_11eb);
-    x ^ (x >> 31)
+/// What a body wears: the material and colour of each capsule (see [`body::pose`]'s order), and its hair.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outfit {
+    /// Per capsule: shading model and linear colour.
+    pub parts: [(Material, Vec3); CAPSULES],
+    /// Hair colour, linear RGB.
+    pub hair: Vec3,
+}
+
+impl Outfit {
+    /// The outfit of an identity; `key` seeds sleeve and leg length.
+    pub fn of(identity: &Identity, seed: u64, key: u64) -> Outfit {
+        let h = splitmix64(seed ^ 0xb0d1 ^ splitmix64(key));
+        let short_sleeves = h & 3 == 0;
+        let shorts = (h >> 2) & 7 == 0;
+        let (skin, top, bottom) = (
+            linear(identity.skin_rgb),
+            linear(identity.top_rgb),
+            linear(identity.bottom_rgb),
+        );
+        let shoes = linear(identity.shoes_rgb);
+        Outfit {
+            parts: WEAR.map(|w| match w {
+                Wear::Top => (Material::Body, top),
+                Wear::Bottom => (Material::Body, bottom),
+                Wear::Skin => (Material::Body, skin),
+                Wear::Shoes => (Material::Body, shoes),
+                Wear::Head => (Material::Head, skin),
+                Wear::Sleeve if short_sleeves => (Material::Body, skin),
+                Wear::Sleeve => (Material::Body, top),
+                Wear::Leg if shorts => (Material::Body, skin),
+                Wear::Leg => (Material::Body, bottom),
+            }),
+            hair: linear(identity.hair_rgb),
+        }
+    }
 }
 
 /// An sRGB colour (0–255) in linear RGB.
@@ -298,23 +333,34 @@ pub fn linear(c: [u8; 3]) -> Vec3 {
     Vec3::new(f(c[0]), f(c[1]), f(c[2]))
 }
 
-struct Builder {
-    origin: DVec3,
-    tris: Vec<Tri>,
-    prims: Vec<Prim>,
+/// Triangles and their primitives under construction. Primitive ids start at `base`: a frame's agents
+/// ([`FrameScene`]) number theirs after the static scene's, which are not copied per frame.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Triangles.
+    pub tris: Vec<Tri>,
+    /// Primitives; `prims[i]` has id `base + i`.
+    pub prims: Vec<Prim>,
+    /// Id of the first primitive.
+    pub base: u32,
 }
 
-impl Builder {
-    fn rel(&self, p: DVec3) -> Vec3 {
-        (p - self.origin).as_vec3()
+impl Mesh {
+    /// Empties the mesh; new primitives are numbered from `base`.
+    pub fn clear(&mut self, base: u32) {
+        self.tris.clear();
+        self.prims.clear();
+        self.base = base;
     }
 
-    fn prim(&mut self, prim: Prim) -> u32 {
+    /// Adds a primitive; returns its id.
+    pub fn prim(&mut self, prim: Prim) -> u32 {
         self.prims.push(prim);
-        (self.prims.len() - 1) as u32
+        self.base + (self.prims.len() - 1) as u32
     }
 
-    fn quad(&mut self, q: [Vec3; 4], prim: u32) {
+    /// Adds a quad (corners in order) as two triangles.
+    pub fn quad(&mut self, q: [Vec3; 4], prim: u32) {
         self.tris.push(Tri {
             v: [q[0], q[1], q[2]],
             prim,
@@ -323,6 +369,89 @@ impl Builder {
             v: [q[0], q[2], q[3]],
             prim,
         });
+    }
+
+    /// Adds an upright box (footprint centre, heading, half extents along and across, z range): four sides of
+    /// `side` and a top of `top`, each face its own primitive with its flat normal.
+    pub fn upright_box(&mut self, centre: Vec2, heading_rad: f32, half: Vec2, z: [f32; 2], side: Prim, top: Prim) {
+        let (s, c) = heading_rad.sin_cos();
+        let ax = Vec2::new(c, s) * half.x;
+        let ay = Vec2::new(-s, c) * half.y;
+        let corners = [centre - ax - ay, centre + ax - ay, centre + ax + ay, centre - ax + ay];
+        for k in 0..4 {
+            let (a, b) = (corners[k], corners[(k + 1) % 4]);
+            let n = -(b - a).perp().normalize_or_zero();
+            let id = self.prim(Prim {
+                normal: Vec3::new(n.x, n.y, 0.0),
+                ..side
+            });
+            self.quad(
+                [
+                    Vec3::new(a.x, a.y, z[0]),
+                    Vec3::new(b.x, b.y, z[0]),
+                    Vec3::new(b.x, b.y, z[1]),
+                    Vec3::new(a.x, a.y, z[1]),
+                ],
+                id,
+            );
+        }
+        let id = self.prim(Prim { normal: Vec3::Z, ..top });
+        self.quad(corners.map(|c| Vec3::new(c.x, c.y, z[1])), id);
+    }
+
+    /// Adds a capsule as a closed polyhedron (8 sides, two rings per cap) of one primitive.
+    pub fn capsule(&mut self, c: &SceneCapsule, prim: u32) {
+        const N: usize = 8;
+        // Vertices sit slightly outside the surface so the polygon's silhouette matches the capsule's on average.
+        let r = c.radius_m * 1.04;
+        let d = c.b - c.a;
+        let axis = if d.length_squared() > 1e-10 {
+            d.normalize()
+        } else {
+            Vec3::Z
+        };
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        let ring = |centre: Vec3, radius: f32| -> [Vec3; N] {
+            std::array::from_fn(|k| {
+                let (s, co) = (k as f32 * std::f32::consts::TAU / N as f32).sin_cos();
+                centre + (u * co + v * s) * radius
+            })
+        };
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        let rings = [
+            ring(c.a - axis * r * h, r * h),
+            ring(c.a, r),
+            ring(c.b, r),
+            ring(c.b + axis * r * h, r * h),
+        ];
+        let poles = [c.a - axis * r, c.b + axis * r];
+        for k in 0..N {
+            let k1 = (k + 1) % N;
+            self.tris.push(Tri {
+                v: [poles[0], rings[0][k1], rings[0][k]],
+                prim,
+            });
+            self.tris.push(Tri {
+                v: [poles[1], rings[3][k], rings[3][k1]],
+                prim,
+            });
+            for r2 in 0..3 {
+                let (p, q) = (&rings[r2], &rings[r2 + 1]);
+                self.quad([p[k], p[k1], q[k1], q[k]], prim);
+            }
+        }
+    }
+}
+
+struct Builder {
+    origin: DVec3,
+    mesh: Mesh,
+}
+
+impl Builder {
+    fn rel(&self, p: DVec3) -> Vec3 {
+        (p - self.origin).as_vec3()
     }
 }
 
@@ -336,65 +465,6 @@ fn flat(material: Material, tag: u8, albedo: Vec3, normal: Vec3, aux: u32) -> Pr
         normal,
         aux,
     }
-}
-
-/// Appends an upright box (footprint centre, heading, half extents along/across, z range) as faces with
-/// their own primitives (flat normals); `top` is the material of the top face.
-#[allow(clippy::too_many_arguments)]
-fn push_box(
-    tris: &mut Vec<Tri>,
-    prims: &mut Vec<Prim>,
-    centre: Vec2,
-    heading_rad: f32,
-    half: Vec2,
-    z: [f32; 2],
-    side: Prim,
-    top: Prim,
-) {
-    let (s, c) = heading_rad.sin_cos();
-    let ax = Vec2::new(c, s);
-    let ay = Vec2::new(-s, c);
-    let corners = [
-        centre - ax * half.x - ay * half.y,
-        centre + ax * half.x - ay * half.y,
-        centre + ax * half.x + ay * half.y,
-        centre - ax * half.x + ay * half.y,
-    ];
-    for k in 0..4 {
-        let (a, b) = (corners[k], corners[(k + 1) % 4]);
-        let n = (b - a).perp().normalize_or_zero() * -1.0;
-        let mut p = side;
-        p.normal = Vec3::new(n.x, n.y, 0.0);
-        prims.push(p);
-        let id = (prims.len() - 1) as u32;
-        let q = [
-            Vec3::new(a.x, a.y, z[0]),
-            Vec3::new(b.x, b.y, z[0]),
-            Vec3::new(b.x, b.y, z[1]),
-            Vec3::new(a.x, a.y, z[1]),
-        ];
-        tris.push(Tri {
-            v: [q[0], q[1], q[2]],
-            prim: id,
-        });
-        tris.push(Tri {
-            v: [q[0], q[2], q[3]],
-            prim: id,
-        });
-    }
-    let mut p = top;
-    p.normal = Vec3::Z;
-    prims.push(p);
-    let id = (prims.len() - 1) as u32;
-    let q = corners.map(|c| Vec3::new(c.x, c.y, z[1]));
-    tris.push(Tri {
-        v: [q[0], q[1], q[2]],
-        prim: id,
-    });
-    tris.push(Tri {
-        v: [q[0], q[2], q[3]],
-        prim: id,
-    });
 }
 
 /// The markings of each lane's inner and outer border.
@@ -450,17 +520,16 @@ impl StaticScene {
         let seed = script.seed;
         let mut b = Builder {
             origin,
-            tris: Vec::new(),
-            prims: Vec::new(),
+            mesh: Mesh::default(),
         };
         let mut clusters = Vec::new();
         let mut cluster_start = 0u32;
         let close_cluster = |b: &Builder, clusters: &mut Vec<Cluster>, start: &mut u32| {
-            let end = b.tris.len() as u32;
+            let end = b.mesh.tris.len() as u32;
             if end == *start {
                 return;
             }
-            let tris = &b.tris[*start as usize..end as usize];
+            let tris = &b.mesh.tris[*start as usize..end as usize];
             let (mut mn, mut mx) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
             for t in tris {
                 for v in t.v {
@@ -489,10 +558,12 @@ impl StaticScene {
             .filter(|p| near(p.centre()[0]))
             .map(|p| f64::from(p.z_m))
             .fold(z0, f64::min);
-        let terrain = b.prim(flat(Material::Terrain, tag::TERRAIN, linear([86, 104, 58]), Vec3::Z, 0));
+        let terrain = b
+            .mesh
+            .prim(flat(Material::Terrain, tag::TERRAIN, linear([86, 104, 58]), Vec3::Z, 0));
         let tz = (min_z - 0.03 - origin.z) as f32;
         let e = 1500.0f32;
-        b.quad(
+        b.mesh.quad(
             [
                 Vec3::new(-e, -e, tz),
                 Vec3::new(e, -e, tz),
@@ -563,21 +634,21 @@ impl StaticScene {
                 } else {
                     0
                 };
-                let id = b.prim(flat(material, tag, albedo, Vec3::Z, aux));
-                b.quad(q, id);
+                let id = b.mesh.prim(flat(material, tag, albedo, Vec3::Z, aux));
+                b.mesh.quad(q, id);
                 // Curb faces: a sidewalk's borders drop to the road (or the terrain) below.
                 if lane.lane_type == LaneType::Sidewalk {
                     let low = (z - CURB_HEIGHT_M - origin.z) as f32;
                     for (a, c) in [(q[0], q[1]), (q[2], q[3])] {
                         let n2 = (c - a).truncate().perp().normalize_or_zero();
-                        let curb = b.prim(flat(
+                        let curb = b.mesh.prim(flat(
                             Material::Curb,
                             tag::SIDEWALK,
                             linear([170, 168, 160]),
                             Vec3::new(n2.x, n2.y, 0.0),
                             0,
                         ));
-                        b.quad(
+                        b.mesh.quad(
                             [
                                 Vec3::new(a.x, a.y, low),
                                 Vec3::new(c.x, c.y, low),
@@ -617,53 +688,27 @@ impl StaticScene {
                 (o.base_z_m - origin.z) as f32,
                 (o.base_z_m + o.height_m - origin.z) as f32,
             ];
-            let h = mix64(seed ^ mix64(i as u64 + 1));
+            let h = splitmix64(seed ^ splitmix64(i as u64 + 1));
             match o.kind {
                 ObstacleKind::Building => {
                     let colour = linear(FACADES[(h % FACADES.len() as u64) as usize]);
                     let wall = flat(Material::Wall, tag::BUILDING, colour, Vec3::Z, i as u32);
                     let roof = flat(Material::Roof, tag::BUILDING, linear([84, 80, 78]), Vec3::Z, i as u32);
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
-                        c,
-                        o.heading_rad as f32,
-                        o.half_extents_m.as_vec2(),
-                        z,
-                        wall,
-                        roof,
-                    );
+                    b.mesh
+                        .upright_box(c, o.heading_rad as f32, o.half_extents_m.as_vec2(), z, wall, roof);
                 }
                 ObstacleKind::Pole => {
                     let metal = flat(Material::Metal, tag::POLE, linear([90, 92, 96]), Vec3::Z, 0);
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
-                        c,
-                        o.heading_rad as f32,
-                        o.half_extents_m.as_vec2(),
-                        z,
-                        metal,
-                        metal,
-                    );
+                    b.mesh
+                        .upright_box(c, o.heading_rad as f32, o.half_extents_m.as_vec2(), z, metal, metal);
                 }
                 ObstacleKind::Tree => {
                     let bark = flat(Material::Trunk, tag::VEGETATION, linear([92, 70, 50]), Vec3::Z, 0);
                     let leaves = flat(Material::Foliage, tag::VEGETATION, linear([60, 100, 44]), Vec3::Z, 0);
                     let trunk_top = z[0] + 0.45 * (z[1] - z[0]);
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
-                        c,
-                        0.0,
-                        Vec2::splat(0.15),
-                        [z[0], trunk_top],
-                        bark,
-                        bark,
-                    );
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
+                    b.mesh
+                        .upright_box(c, 0.0, Vec2::splat(0.15), [z[0], trunk_top], bark, bark);
+                    b.mesh.upright_box(
                         c,
                         o.heading_rad as f32,
                         o.half_extents_m.as_vec2(),
@@ -704,20 +749,10 @@ impl StaticScene {
                     let f = (foot - origin.truncate()).as_vec2();
                     let dir = to_road.as_vec2();
                     let top = base + LAMP_HEIGHT_M;
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
-                        f,
-                        0.0,
-                        Vec2::splat(0.07),
-                        [base, top + 0.2],
-                        metal,
-                        metal,
-                    );
+                    b.mesh
+                        .upright_box(f, 0.0, Vec2::splat(0.07), [base, top + 0.2], metal, metal);
                     let arm_end = f + dir * 1.4;
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
+                    b.mesh.upright_box(
                         (f + arm_end) * 0.5,
                         dir.y.atan2(dir.x),
                         Vec2::new(0.7, 0.05),
@@ -725,9 +760,7 @@ impl StaticScene {
                         metal,
                         metal,
                     );
-                    push_box(
-                        &mut b.tris,
-                        &mut b.prims,
+                    b.mesh.upright_box(
                         arm_end,
                         dir.y.atan2(dir.x),
                         Vec2::new(0.3, 0.15),
@@ -747,13 +780,30 @@ impl StaticScene {
 
         StaticScene {
             origin,
-            tris: b.tris,
+            tris: b.mesh.tris,
             clusters,
-            prims: b.prims,
+            prims: b.mesh.prims,
             pieces,
             crosswalks,
             lamps,
             seed,
+            outfits: script
+                .pedestrians
+                .iter()
+                .map(|p| {
+                    (
+                        Outfit::of(&p.identity, seed, u64::from(p.id)),
+                        p.child.as_ref().map(|c| Outfit::of(c, seed, u64::from(p.id) | 1 << 40)),
+                    )
+                })
+                .collect(),
+            car_paint: (0..trace.vehicles.len())
+                .map(|vi| {
+                    let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
+                    let h = splitmix64(seed ^ 0x5eed_ca75 ^ splitmix64(u64::from(id)));
+                    linear(CAR_COLOURS[(h % CAR_COLOURS.len() as u64) as usize])
+                })
+                .collect(),
         }
     }
 
@@ -847,13 +897,12 @@ impl SceneCapsule {
     }
 }
 
-/// The dynamic part of a frame's scene (traffic and pedestrians), appended to a static scene's primitives.
+/// The dynamic part of a frame's scene (traffic and pedestrians); its primitive ids follow the static
+/// scene's.
 #[derive(Clone, Debug, Default)]
 pub struct FrameScene {
-    /// Triangles of the frame's agents.
-    pub tris: Vec<Tri>,
-    /// The full primitive table: the static scene's, then the frame's.
-    pub prims: Vec<Prim>,
+    /// Triangles and primitives of the frame's agents.
+    pub mesh: Mesh,
     /// Body capsules (for [`Material::Body`] normals).
     pub capsules: Vec<SceneCapsule>,
     /// Vehicle head lamps (position, forward axis), for lighting.
@@ -917,56 +966,6 @@ const CAR_COLOURS: [[u8; 3]; 10] = [
     [190, 120, 30],
 ];
 
-fn capsule_tris(tris: &mut Vec<Tri>, c: &SceneCapsule, prim: u32) {
-    const N: usize = 8;
-    // Vertices sit slightly outside the surface so the polygon's silhouette matches the capsule's on average.
-    let r = c.radius_m * 1.04;
-    let d = c.b - c.a;
-    let axis = if d.length_squared() > 1e-10 {
-        d.normalize()
-    } else {
-        Vec3::Z
-    };
-    let u = axis.any_orthonormal_vector();
-    let v = axis.cross(u);
-    let ring = |centre: Vec3, radius: f32| -> [Vec3; N] {
-        std::array::from_fn(|k| {
-            let (s, co) = (k as f32 * std::f32::consts::TAU / N as f32).sin_cos();
-            centre + (u * co + v * s) * radius
-        })
-    };
-    let h = std::f32::consts::FRAC_1_SQRT_2;
-    let rings = [
-        ring(c.a - axis * r * h, r * h),
-        ring(c.a, r),
-        ring(c.b, r),
-        ring(c.b + axis * r * h, r * h),
-    ];
-    let poles = [c.a - axis * r, c.b + axis * r];
-    for k in 0..N {
-        let k1 = (k + 1) % N;
-        tris.push(Tri {
-            v: [poles[0], rings[0][k1], rings[0][k]],
-            prim,
-        });
-        tris.push(Tri {
-            v: [poles[1], rings[3][k], rings[3][k1]],
-            prim,
-        });
-        for r2 in 0..3 {
-            let (p, q) = (&rings[r2], &rings[r2 + 1]);
-            tris.push(Tri {
-                v: [p[k], p[k1], q[k1]],
-                prim,
-            });
-            tris.push(Tri {
-                v: [p[k], q[k1], q[k]],
-                prim,
-            });
-        }
-    }
-}
-
 /// Which colour of an identity each body capsule wears (see [`body::pose`]'s capsule order).
 #[derive(Clone, Copy)]
 enum Wear {
@@ -997,27 +996,30 @@ const WEAR: [Wear; CAPSULES] = [
 ];
 
 impl FrameScene {
-    /// Builds the dynamic scene at time `t` (the static scene's primitives first).
+    /// The primitive of an id: the static scene's, or one of this frame's.
+    #[inline]
+    pub fn prim<'a>(&'a self, stat: &'a StaticScene, id: u32) -> &'a Prim {
+        stat.prims
+            .get(id as usize)
+            .unwrap_or_else(|| &self.mesh.prims[id as usize - stat.prims.len()])
+    }
+
+    /// Builds the dynamic scene at time `t`.
     pub fn build(&mut self, stat: &StaticScene, script: &ClipScript, trace: &ClipTrace, t: SceneTime) {
-        self.tris.clear();
-        self.prims.clear();
-        self.prims.extend_from_slice(&stat.prims);
+        self.mesh.clear(stat.prims.len() as u32);
         self.capsules.clear();
         self.head_lamps.clear();
         let f0 = t.frame as usize;
-        let paint_of = |id: u32| {
-            let h = mix64(stat.seed ^ 0x5eed_ca75 ^ mix64(u64::from(id)));
-            linear(CAR_COLOURS[(h % CAR_COLOURS.len() as u64) as usize])
-        };
         for (vi, frames) in trace.vehicles.iter().enumerate() {
             let Some(a) = frames.get(f0) else { continue };
             let b = frames.get(f0 + 1).unwrap_or(a);
             let (pos, yaw) = lerp_vehicle(a, b, t.alpha);
             let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
+            let paint = stat.car_paint.get(vi).copied().unwrap_or(Vec3::splat(0.5));
             self.push_vehicle(
                 stat.rel(pos),
                 yaw as f32,
-                paint_of(id),
+                paint,
                 VEHICLE_INSTANCE_BASE.saturating_add(id as u16),
             );
         }
@@ -1026,12 +1028,15 @@ impl FrameScene {
             let b = frames.get(f0 + 1).unwrap_or(a);
             let frame = if t.alpha > 0.0 { lerp_ped(a, b, t.alpha) } else { *a };
             let Some(ps) = script.pedestrians.get(pi) else { continue };
+            let Some((outfit, child_outfit)) = stat.outfits.get(pi) else {
+                continue;
+            };
             let pose = body::pose(&frame, ps.identity.height_m, DVec3::ZERO);
-            self.push_body(stat, &pose, &ps.identity, pedestrian_instance(ps.id), ps.id);
-            if let Some(child) = &ps.child {
+            self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id));
+            if let (Some(child), Some(child_outfit)) = (&ps.child, child_outfit) {
                 let pose = body::pose(&frame, child.height_m, CHILD_OFFSET_M);
                 let inst = CHILD_INSTANCE_BASE.saturating_add(ps.id.min(16_383) as u16);
-                self.push_body(stat, &pose, child, inst, ps.id ^ 0x8000_0000);
+                self.push_body(stat, &pose, child_outfit, inst);
             }
         }
     }
@@ -1055,9 +1060,7 @@ impl FrameScene {
         let glass = car(Material::CarGlass, linear([14, 16, 20]));
         let tyre = car(Material::Tyre, linear([20, 20, 20]));
         // Lower body, cabin (glass sides, painted roof), four wheels.
-        push_box(
-            &mut self.tris,
-            &mut self.prims,
+        self.mesh.upright_box(
             centre,
             yaw,
             Vec2::new(l * 0.5, w * 0.5),
@@ -1065,9 +1068,7 @@ impl FrameScene {
             body,
             body,
         );
-        push_box(
-            &mut self.tris,
-            &mut self.prims,
+        self.mesh.upright_box(
             centre - fwd * (0.08 * l),
             yaw,
             Vec2::new(l * 0.26, w * 0.45),
@@ -1077,16 +1078,8 @@ impl FrameScene {
         );
         for (fx, sy) in [(0.32f32, 1.0f32), (0.32, -1.0), (-0.32, 1.0), (-0.32, -1.0)] {
             let wc = centre + fwd * (fx * l) + fwd.perp() * (sy * (w * 0.5 - 0.14));
-            push_box(
-                &mut self.tris,
-                &mut self.prims,
-                wc,
-                yaw,
-                Vec2::new(0.33, 0.13),
-                [base, base + 0.64],
-                tyre,
-                tyre,
-            );
+            self.mesh
+                .upright_box(wc, yaw, Vec2::new(0.33, 0.13), [base, base + 0.64], tyre, tyre);
         }
         // Lamps: small boxes standing just out of the front and rear faces.
         for (fx, mat, albedo) in [
@@ -1095,9 +1088,7 @@ impl FrameScene {
         ] {
             for sy in [1.0f32, -1.0] {
                 let lc = centre + fwd * (fx * l + fx.signum() * 0.01) + fwd.perp() * (sy * w * 0.33);
-                push_box(
-                    &mut self.tris,
-                    &mut self.prims,
+                self.mesh.upright_box(
                     lc,
                     yaw,
                     Vec2::new(0.03, 0.16),
@@ -1113,44 +1104,28 @@ impl FrameScene {
         ));
     }
 
-    fn push_body(&mut self, stat: &StaticScene, pose: &body::BodyPose, identity: &Identity, instance: u16, key: u32) {
-        let h = mix64(stat.seed ^ 0xb0d1 ^ mix64(u64::from(key)));
-        let short_sleeves = h & 3 == 0;
-        let shorts = (h >> 2) & 7 == 0;
-        let (skin, hair) = (linear(identity.skin_rgb), linear(identity.hair_rgb));
+    fn push_body(&mut self, stat: &StaticScene, pose: &body::BodyPose, outfit: &Outfit, instance: u16) {
         let forward = {
             let (s, c) = (pose.yaw_rad as f32).sin_cos();
             Vec3::new(c, s, 0.0)
         };
-        for (k, cap) in pose.capsules.iter().enumerate() {
+        for (cap, &(material, albedo)) in pose.capsules.iter().zip(&outfit.parts) {
             let sc = SceneCapsule {
                 a: stat.rel(cap.a),
                 b: stat.rel(cap.b),
                 radius_m: cap.radius_m as f32,
             };
-            let (material, albedo) = match WEAR[k] {
-                Wear::Top => (Material::Body, linear(identity.top_rgb)),
-                Wear::Bottom => (Material::Body, linear(identity.bottom_rgb)),
-                Wear::Skin => (Material::Body, skin),
-                Wear::Shoes => (Material::Body, linear(identity.shoes_rgb)),
-                Wear::Head => (Material::Head, skin),
-                Wear::Sleeve if short_sleeves => (Material::Body, skin),
-                Wear::Sleeve => (Material::Body, linear(identity.top_rgb)),
-                Wear::Leg if shorts => (Material::Body, skin),
-                Wear::Leg => (Material::Body, linear(identity.bottom_rgb)),
-            };
             self.capsules.push(sc);
-            self.prims.push(Prim {
+            let prim = self.mesh.prim(Prim {
                 material,
                 tag: tag::PEDESTRIAN,
                 instance,
                 albedo,
-                albedo2: hair,
+                albedo2: outfit.hair,
                 normal: forward,
                 aux: (self.capsules.len() - 1) as u32,
             });
-            let prim = (self.prims.len() - 1) as u32;
-            capsule_tris(&mut self.tris, &sc, prim);
+            self.mesh.capsule(&sc, prim);
         }
     }
 }

@@ -12,10 +12,11 @@ use font8x8::UnicodeFonts;
 
 use super::tables;
 use crate::error::{Error, code};
-use crate::exec::observe::scene::{mix64, tag};
+use crate::exec::observe::scene::tag;
 use crate::exec::write::Layout;
 use crate::exec::write::sensors::png_bytes;
 use crate::fsutil::write_atomically;
+use crate::mix::splitmix64;
 
 /// The streams a preview can show.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -198,7 +199,7 @@ fn frame_canvas(
                     if v == 0 {
                         [0, 0, 0]
                     } else {
-                        let hsh = mix64(u64::from(v));
+                        let hsh = splitmix64(u64::from(v));
                         [(hsh >> 8) as u8 | 64, (hsh >> 24) as u8 | 64, (hsh >> 40) as u8 | 64]
                     }
                 }

@@ -10,7 +10,7 @@ use glam::DVec3;
 use super::vehicle::Vehicle;
 use super::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Visibility;
-use crate::exec::observe::annotate::gate_box_size_px;
+use crate::exec::observe::annotate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px};
 use crate::exec::observe::rig::{Camera, CameraPose};
 use crate::planner::SimParams;
 use crate::world::{RoadNetwork, segment_hits_box, segment_hits_cylinder};
@@ -22,23 +22,8 @@ const BODY_EXTENT_M: f64 = 1.1;
 const IMAGE_MARGIN_PX: f64 = 4.0;
 /// The estimated box must exceed the gate's minimum size by this factor.
 const SIZE_MARGIN: f64 = 1.1;
-/// Radius of another pedestrian as an occluder, as a share of its height (as the annotation's).
-const PERSON_RADIUS_PER_M: f64 = 0.14;
 /// Height of the line of sight's end on the body, as a share of the body height (the chest).
 const CHEST_SHARE: f64 = 0.72;
-
-/// What the estimate found.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Sight {
-    Seen,
-    TooFar,
-    Behind,
-    TooSmall,
-    OutsideImage,
-    HiddenByVehicle,
-    HiddenByPerson,
-    HiddenByBuilding,
-}
 
 /// The estimate of what the camera sees.
 #[derive(Clone, Debug)]
@@ -64,9 +49,9 @@ impl ViewProxy {
         )
     }
 
-    /// Whether a pedestrian standing at `ground` (height `height_m`, facing `yaw_rad`) passes the gate and can be seen past the
-    /// other vehicles (`vehicles[0]` is the ego itself), the other pedestrians (`people`: ground point and
-    /// height, this one's own entry `me` skipped) and the town's buildings.
+    /// Whether a pedestrian standing at `ground` (height `height_m`, facing `yaw_rad`) passes the gate and can be
+    /// seen past the other vehicles (`vehicles[0]` is the ego itself), the other pedestrians (`people`: ground
+    /// point and height, this one's own entry `me` skipped) and the town's buildings.
     #[allow(clippy::too_many_arguments)]
     pub fn sees(
         &self,
@@ -79,31 +64,15 @@ impl ViewProxy {
         me: usize,
         net: &RoadNetwork,
     ) -> bool {
-        self.check(cam, ground, yaw_rad, height_m, vehicles, people, me, net) == Sight::Seen
-    }
-
-    /// [`sees`](Self::sees), with the reason when not.
-    #[allow(clippy::too_many_arguments)]
-    pub fn check(
-        &self,
-        cam: &CameraPose,
-        ground: DVec3,
-        yaw_rad: f64,
-        height_m: f64,
-        vehicles: &[Vehicle],
-        people: &[(DVec3, f64)],
-        me: usize,
-        net: &RoadNetwork,
-    ) -> Sight {
         let gate = &self.gate;
         let distance_m = (ground - cam.centre).truncate().length();
         if distance_m > gate.max_distance_m {
-            return Sight::TooFar;
+            return false;
         }
         let foot = cam.project(ground);
         let head = cam.project(ground + DVec3::Z * height_m);
         if foot.depth_m < 0.5 || head.depth_m < 0.5 {
-            return Sight::Behind;
+            return false;
         }
         let c = &cam.camera;
         let min = if distance_m > gate.far_distance_m {
@@ -112,10 +81,10 @@ impl ViewProxy {
             gate.min_box_px
         };
         let Some((width_px, height_px)) = gate_box_size_px(cam, ground, yaw_rad, height_m) else {
-            return Sight::Behind;
+            return false;
         };
         if width_px < SIZE_MARGIN * min.width_px || height_px < SIZE_MARGIN * min.height_px {
-            return Sight::TooSmall;
+            return false;
         }
         let (w, h) = (f64::from(c.width_px), f64::from(c.height_px));
         let u = 0.5 * (foot.px.x + head.px.x);
@@ -125,26 +94,22 @@ impl ViewProxy {
             && head.px.y >= IMAGE_MARGIN_PX
             && foot.px.y <= h - IMAGE_MARGIN_PX;
         if !inside {
-            return Sight::OutsideImage;
+            return false;
         }
         let chest = ground + DVec3::Z * (CHEST_SHARE * height_m);
         let d = chest - cam.centre;
         let half = DVec3::new(VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, VEHICLE_HEIGHT_M) * 0.5;
-        let blocked_by_vehicle = vehicles.iter().skip(1).any(|v| {
-            let centre = DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m + half.z);
-            segment_hits_box(cam.centre, d, 1.0, centre, v.pose.heading_rad.sin_cos(), half)
-        });
-        let blocked_by_person = people.iter().enumerate().any(|(k, &(other, h))| {
-            k != me && segment_hits_cylinder(cam.centre, d, 1.0, other, PERSON_RADIUS_PER_M * h, h)
-        });
-        if blocked_by_vehicle {
-            Sight::HiddenByVehicle
-        } else if blocked_by_person {
-            Sight::HiddenByPerson
-        } else if net.first_obstacle_hit(cam.centre, chest).is_some() {
-            Sight::HiddenByBuilding
-        } else {
-            Sight::Seen
-        }
+        let blocked_by_vehicle = || {
+            vehicles.iter().skip(1).any(|v| {
+                let centre = DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m + half.z);
+                segment_hits_box(cam.centre, d, 1.0, centre, v.pose.heading_rad.sin_cos(), half)
+            })
+        };
+        let blocked_by_person = || {
+            people.iter().enumerate().any(|(k, &(other, h))| {
+                k != me && segment_hits_cylinder(cam.centre, d, 1.0, other, PED_OCCLUDER_RADIUS_PER_M * h, h)
+            })
+        };
+        !blocked_by_vehicle() && !blocked_by_person() && net.first_obstacle_hit(cam.centre, chest).is_none()
     }
 }

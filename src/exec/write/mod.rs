@@ -126,19 +126,18 @@ impl DatasetWriter {
     }
 
     /// A writer of one clip's sensor files.
-    pub fn clip_sensors<'a>(&'a self, plan: &'a Plan, script: &'a ClipScript) -> sensors::ClipSensorWriter<'a> {
-        sensors::ClipSensorWriter::new(&self.layout, &script.clip_id, &plan.spec.sensors, &plan.spec.output)
-    }
-
-    /// The Parquet bytes of a per-clip sensor file (same codec and metadata as the tables).
-    pub fn sensor_parquet(
-        &self,
-        plan: &Plan,
-        batch: &arrow_array::RecordBatch,
-        stream: &str,
-        clip_id: &str,
-    ) -> Result<Vec<u8>, Error> {
-        tables::parquet_bytes(batch, &plan.spec.output, &self.meta, stream, clip_id)
+    pub fn clip_sensors<'a>(
+        &'a self,
+        plan: &'a Plan,
+        script: &'a ClipScript,
+    ) -> Result<sensors::ClipSensorWriter<'a>, Error> {
+        sensors::ClipSensorWriter::new(
+            &self.layout,
+            &script.clip_id,
+            &plan.spec.sensors,
+            &plan.spec.output,
+            &self.meta,
+        )
     }
 
     /// Writes the final manifest: every finished clip `done` with its files' hashes, the others `pending`.

@@ -18,10 +18,12 @@ use std::sync::Arc;
 use arrow_array::{
     ArrayRef, BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array,
 };
-use arrow_schema::{DataType, Field, Schema};
+use arrow_schema::{DataType, Field, Schema, SchemaRef};
+use parquet::arrow::ArrowWriter;
 use sha2::{Digest, Sha256};
 
 use super::Layout;
+use super::tables::{self, FileMeta};
 use crate::dsl::types::{DepthEncoding, Output, RgbEncoding, Sensors};
 use crate::error::{Error, code};
 use crate::exec::observe::SensorFrame;
@@ -49,16 +51,25 @@ pub struct IndexRow {
     pub sha256: String,
 }
 
-/// Writes one clip's sensor files as frames arrive.
-#[derive(Debug)]
+/// Writes one clip's sensor files as frames arrive. DVS events go into the clip's Parquet writer frame by
+/// frame (encoded and compressed as they come), so a clip's events are never all held raw in memory.
 pub struct ClipSensorWriter<'a> {
     layout: &'a Layout,
     clip_id: &'a str,
     sensors: &'a Sensors,
     output: &'a Output,
     rows: Vec<IndexRow>,
-    events: Vec<(u32, dvs::Event)>,
+    dvs: Option<ArrowWriter<Vec<u8>>>,
     scratch: Vec<u8>,
+}
+
+impl std::fmt::Debug for ClipSensorWriter<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClipSensorWriter")
+            .field("clip_id", &self.clip_id)
+            .field("files", &self.rows.len())
+            .finish()
+    }
 }
 
 /// PNG bytes of an image.
@@ -88,12 +99,40 @@ pub fn png_bytes(
 }
 
 /// The semantic palette (CARLA's colours) as PNG `PLTE` bytes for all 256 indices.
-pub fn semantic_palette() -> Vec<u8> {
-    let mut p = vec![0u8; 256 * 3];
-    for (i, c) in tag::PALETTE.iter().enumerate() {
-        p[i * 3..i * 3 + 3].copy_from_slice(c);
+pub const SEMANTIC_PALETTE: [u8; 768] = {
+    let mut p = [0u8; 768];
+    let mut i = 0;
+    while i < tag::PALETTE.len() {
+        p[3 * i] = tag::PALETTE[i][0];
+        p[3 * i + 1] = tag::PALETTE[i][1];
+        p[3 * i + 2] = tag::PALETTE[i][2];
+        i += 1;
     }
     p
+};
+
+/// The `rgb` stream's PNG of a frame.
+pub fn rgb_png(img: &CameraImages) -> Result<Vec<u8>, Error> {
+    png_bytes(
+        img.width,
+        img.height,
+        png::ColorType::Rgb,
+        png::BitDepth::Eight,
+        &img.rgb,
+        None,
+    )
+}
+
+/// The `semantic` stream's PNG of a frame: tag ids as palette indices, CARLA's palette.
+pub fn semantic_png(img: &CameraImages) -> Result<Vec<u8>, Error> {
+    png_bytes(
+        img.width,
+        img.height,
+        png::ColorType::Indexed,
+        png::BitDepth::Eight,
+        &img.semantic,
+        Some(&SEMANTIC_PALETTE),
+    )
 }
 
 /// Depth in CARLA's 24-bit encoding: `(R, G, B)` with `R + 256 G + 65536 B = round(d / 1000 m × (2^24 − 1))`.
@@ -108,17 +147,32 @@ pub fn depth_mm(depth_m: f32) -> u16 {
 }
 
 impl<'a> ClipSensorWriter<'a> {
-    /// A writer for one clip.
-    pub fn new(layout: &'a Layout, clip_id: &'a str, sensors: &'a Sensors, output: &'a Output) -> Self {
-        ClipSensorWriter {
+    /// A writer for one clip; `meta` goes into its Parquet file's metadata.
+    pub fn new(
+        layout: &'a Layout,
+        clip_id: &'a str,
+        sensors: &'a Sensors,
+        output: &'a Output,
+        meta: &FileMeta,
+    ) -> Result<Self, Error> {
+        let dvs = if sensors.dvs.enabled {
+            let props = tables::writer_properties(output, meta, "dvs", clip_id);
+            Some(
+                ArrowWriter::try_new(Vec::new(), dvs_schema(), Some(props))
+                    .map_err(|e| tables::parquet_error("dvs", clip_id, &e))?,
+            )
+        } else {
+            None
+        };
+        Ok(ClipSensorWriter {
             layout,
             clip_id,
             sensors,
             output,
             rows: Vec::new(),
-            events: Vec::new(),
+            dvs,
             scratch: Vec::new(),
-        }
+        })
     }
 
     fn put(&mut self, stream: &'static str, frame: Option<(u32, i64)>, ext: &str, bytes: &[u8]) -> Result<(), Error> {
@@ -145,10 +199,7 @@ impl<'a> ClipSensorWriter<'a> {
         let at = Some((f.frame, f.timestamp_ns));
         if self.sensors.rgb.enabled {
             match self.output.rgb_encoding {
-                RgbEncoding::Png => {
-                    let bytes = png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &img.rgb, None)?;
-                    self.put("rgb", at, "png", &bytes)?;
-                }
+                RgbEncoding::Png => self.put("rgb", at, "png", &rgb_png(img)?)?,
                 RgbEncoding::Jpeg => {
                     let mut out = Vec::new();
                     jpeg_encoder::Encoder::new(&mut out, self.output.jpeg_quality.clamp(1, 100))
@@ -184,15 +235,7 @@ impl<'a> ClipSensorWriter<'a> {
             self.put("depth", at, "png", &bytes)?;
         }
         if self.sensors.semantic.enabled {
-            let bytes = png_bytes(
-                w,
-                h,
-                png::ColorType::Indexed,
-                png::BitDepth::Eight,
-                &img.semantic,
-                Some(&semantic_palette()),
-            )?;
-            self.put("semantic", at, "png", &bytes)?;
+            self.put("semantic", at, "png", &semantic_png(img)?)?;
         }
         if self.sensors.instance.enabled {
             self.scratch.clear();
@@ -207,20 +250,21 @@ impl<'a> ClipSensorWriter<'a> {
             )?;
             self.put("instance", at, "png", &bytes)?;
         }
-        if self.sensors.dvs.enabled {
-            self.events.extend(f.events.iter().map(|e| (f.frame, *e)));
+        if let Some(dvs) = self.dvs.as_mut()
+            && !f.events.is_empty()
+        {
+            dvs.write(&dvs_batch(f.frame, f.events))
+                .map_err(|e| tables::parquet_error("dvs", self.clip_id, &e))?;
         }
         Ok(())
     }
 
     /// Writes the per-clip files (DVS events) and returns the index rows, sorted by (frame, stream).
-    pub fn finish(
-        mut self,
-        parquet: impl Fn(&RecordBatch, &str) -> Result<Vec<u8>, Error>,
-    ) -> Result<Vec<IndexRow>, Error> {
-        if self.sensors.dvs.enabled {
-            let batch = dvs_batch(&self.events);
-            let bytes = parquet(&batch, "dvs")?;
+    pub fn finish(mut self) -> Result<Vec<IndexRow>, Error> {
+        if let Some(dvs) = self.dvs.take() {
+            let bytes = dvs
+                .into_inner()
+                .map_err(|e| tables::parquet_error("dvs", self.clip_id, &e))?;
             self.put("dvs", None, "parquet", &bytes)?;
         }
         let order = |s: &str| CAMERA_STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
@@ -237,24 +281,28 @@ fn hex(bytes: &[u8]) -> String {
     })
 }
 
-/// The DVS events of a clip: `frame` (the frame whose interval (previous, this] holds the event), `t_ns`,
-/// `x`, `y`, `polarity` (true: brighter).
-pub fn dvs_batch(events: &[(u32, dvs::Event)]) -> RecordBatch {
-    let schema = Schema::new(vec![
+/// The schema of a clip's DVS events: `frame` (the frame whose interval (previous, this] holds the event),
+/// `t_ns`, `x`, `y`, `polarity` (true: brighter).
+fn dvs_schema() -> SchemaRef {
+    Arc::new(Schema::new(vec![
         Field::new("frame", DataType::UInt32, false),
         Field::new("t_ns", DataType::Int64, false),
         Field::new("x", DataType::UInt16, false),
         Field::new("y", DataType::UInt16, false),
         Field::new("polarity", DataType::Boolean, false),
-    ]);
+    ]))
+}
+
+/// One frame's DVS events as a record batch of [`dvs_schema`].
+pub fn dvs_batch(frame: u32, events: &[dvs::Event]) -> RecordBatch {
     let columns: Vec<ArrayRef> = vec![
-        Arc::new(UInt32Array::from_iter_values(events.iter().map(|e| e.0))),
-        Arc::new(Int64Array::from_iter_values(events.iter().map(|e| e.1.t_ns))),
-        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.1.x))),
-        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.1.y))),
-        Arc::new(BooleanArray::from_iter(events.iter().map(|e| Some(e.1.positive)))),
+        Arc::new(UInt32Array::from_iter_values(events.iter().map(|_| frame))),
+        Arc::new(Int64Array::from_iter_values(events.iter().map(|e| e.t_ns))),
+        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.x))),
+        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.y))),
+        Arc::new(BooleanArray::from_iter(events.iter().map(|e| Some(e.positive)))),
     ];
-    RecordBatch::try_new(Arc::new(schema), columns).expect("columns match their schema")
+    RecordBatch::try_new(dvs_schema(), columns).expect("columns match their schema")
 }
 
 /// The `sensors` index table of a clip.

@@ -519,21 +519,16 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
     )
 }
 
-/// The Parquet bytes of a record batch: zstd (or the spec's codec), with the file's key-value metadata.
-pub fn parquet_bytes(
-    batch: &RecordBatch,
-    output: &Output,
-    meta: &FileMeta,
-    table: &str,
-    clip_id: &str,
-) -> Result<Vec<u8>, Error> {
+/// The Parquet writer settings of a dataset file: the spec's codec (zstd by default) and the file's key-value
+/// metadata.
+pub fn writer_properties(output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> WriterProperties {
     let compression = match output.compression {
         Compression::Zstd => ParquetCompression::ZSTD(ZstdLevel::try_new(output.zstd_level as i32).unwrap_or_default()),
         Compression::Snappy => ParquetCompression::SNAPPY,
         Compression::None => ParquetCompression::UNCOMPRESSED,
     };
     let kv = |k: &str, v: String| KeyValue::new(k.to_owned(), v);
-    let props = WriterProperties::builder()
+    WriterProperties::builder()
         .set_compression(compression)
         .set_created_by(format!("pedsynth {}", env!("CARGO_PKG_VERSION")))
         .set_key_value_metadata(Some(vec![
@@ -543,16 +538,30 @@ pub fn parquet_bytes(
             kv("pedsynth.table", table.to_owned()),
             kv("pedsynth.clip_id", clip_id.to_owned()),
         ]))
-        .build();
+        .build()
+}
+
+/// The error of a file that cannot be encoded as Parquet.
+pub fn parquet_error(table: &str, clip_id: &str, e: &parquet::errors::ParquetError) -> Error {
+    Error::new(
+        code::INTERNAL_SERIALIZE,
+        format!("cannot encode table `{table}` of clip {clip_id} as Parquet: {e}"),
+    )
+}
+
+/// The Parquet bytes of a record batch, with [`writer_properties`].
+pub fn parquet_bytes(
+    batch: &RecordBatch,
+    output: &Output,
+    meta: &FileMeta,
+    table: &str,
+    clip_id: &str,
+) -> Result<Vec<u8>, Error> {
+    let props = writer_properties(output, meta, table, clip_id);
     let encode = || -> Result<Vec<u8>, parquet::errors::ParquetError> {
         let mut writer = ArrowWriter::try_new(Vec::new(), batch.schema(), Some(props))?;
         writer.write(batch)?;
         writer.into_inner()
     };
-    encode().map_err(|e| {
-        Error::new(
-            code::INTERNAL_SERIALIZE,
-            format!("cannot encode table `{table}` of clip {clip_id} as Parquet: {e}"),
-        )
-    })
+    encode().map_err(|e| parquet_error(table, clip_id, &e))
 }

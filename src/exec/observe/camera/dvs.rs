@@ -50,7 +50,7 @@ pub struct Esim {
 /// The ESIM log-intensity (or intensity) of one 8-bit RGB pixel.
 #[inline]
 pub fn log_intensity(params: &Dvs, rgb: [u8; 3]) -> f32 {
-    let i = 0.2989 * f32::from(rgb[0]) + 0.587 * f32::from(rgb[1]) + 0.114 * f32::from(rgb[2]);
+    let i = super::luminance(&rgb);
     if params.use_log {
         (params.log_eps as f32 + i / 255.0).ln()
     } else {

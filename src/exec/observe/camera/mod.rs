@@ -22,7 +22,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::rig::{Camera, CameraPose};
-use super::scene::{FrameScene, Material, Prim, StaticScene, mix64, tag};
+use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
+use crate::mix::splitmix64;
 use light::Lighting;
 use raster::{EMPTY, Raster, clip_near};
 use shade::{ActiveLights, Noise, ShadeContext};
@@ -87,7 +88,23 @@ pub struct Renderer {
     shadow: Raster,
     sun: Option<SunView>,
     lights: ActiveLights,
+    /// Scratch of [`nearest`]: (squared distance, index), reused from frame to frame.
+    nearby: Vec<(f32, u32)>,
     lut: Vec<u8>,
+}
+
+/// The (up to) `n` items nearest to `from` within `radius_m`, nearest first (ties by index), into `out`.
+fn nearest<T>(items: &[T], pos: impl Fn(&T) -> Vec3, from: Vec3, radius_m: f32, n: usize, out: &mut Vec<(f32, u32)>) {
+    out.clear();
+    out.extend(
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (pos(t).distance_squared(from), i as u32))
+            .filter(|(d2, _)| *d2 < radius_m * radius_m),
+    );
+    out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    out.truncate(n);
 }
 
 /// Linear → sRGB lookup: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]` with a soft shoulder.
@@ -122,6 +139,7 @@ impl Renderer {
             shadow: Raster::new(SHADOW_PX, SHADOW_PX),
             sun: None,
             lights: ActiveLights::default(),
+            nearby: Vec::new(),
             lut: build_lut(),
         }
     }
@@ -203,7 +221,7 @@ impl Renderer {
                 }
             }
         }
-        for tri in &frame.tris {
+        for tri in &frame.mesh.tris {
             draw(tri);
         }
     }
@@ -241,7 +259,7 @@ impl Renderer {
                 }
             }
         }
-        for tri in &frame.tris {
+        for tri in &frame.mesh.tris {
             self.shadow.draw(tri.v.map(|q| sun.project(q)), tri.prim);
         }
         self.sun = Some(sun);
@@ -272,14 +290,10 @@ impl Renderer {
         if self.light.night <= 0.0 {
             return;
         }
-        let mut lamps: Vec<(f32, Vec3)> = scene
+        nearest(&scene.lamps, |l| l.pos, cam, 90.0, 16, &mut self.nearby);
+        self.lights
             .lamps
-            .iter()
-            .map(|l| (l.pos.distance_squared(cam), l.pos))
-            .filter(|(d2, _)| *d2 < 90.0 * 90.0)
-            .collect();
-        lamps.sort_by(|a, b| a.0.total_cmp(&b.0));
-        self.lights.lamps.extend(lamps.iter().take(16).map(|l| l.1));
+            .extend(self.nearby.iter().map(|&(_, i)| scene.lamps[i as usize].pos));
         // The ego's own headlights (under the camera), then the nearest traffic's.
         let fwd = pose.forward.as_vec3();
         let axis = Vec3::new(fwd.x, fwd.y, 0.0).normalize_or_zero();
@@ -288,14 +302,10 @@ impl Renderer {
             let lamp = cam + axis * 1.5 + left * (side - 0.3) - Vec3::Z * 0.7;
             self.lights.heads.push((lamp, axis));
         }
-        let mut heads: Vec<(f32, (Vec3, Vec3))> = frame
-            .head_lamps
-            .iter()
-            .map(|h| (h.0.distance_squared(cam), *h))
-            .filter(|(d2, _)| *d2 < 70.0 * 70.0)
-            .collect();
-        heads.sort_by(|a, b| a.0.total_cmp(&b.0));
-        self.lights.heads.extend(heads.iter().take(6).map(|h| h.1));
+        nearest(&frame.head_lamps, |h| h.0, cam, 70.0, 6, &mut self.nearby);
+        self.lights
+            .heads
+            .extend(self.nearby.iter().map(|&(_, i)| frame.head_lamps[i as usize]));
     }
 
     fn resolve(&self, scene: &StaticScene, frame: &FrameScene, pose: &CameraPose, cam: Vec3, out: &mut CameraImages) {
@@ -320,7 +330,7 @@ impl Renderer {
                 let dir = ray.normalize();
                 return shade::fog(&self.light, self.light.sky(dir), 1.0e4);
             }
-            let prim: &Prim = &frame.prims[prim_id as usize];
+            let prim: &Prim = frame.prim(scene, prim_id);
             let z = 1.0 / key;
             let p = cam + ray * z;
             let dist = ray.length() * z;
@@ -346,7 +356,7 @@ impl Renderer {
                     out.semantic[o] = tag::SKY;
                     out.instance[o] = 0;
                 } else {
-                    let prim = &frame.prims[prims[0] as usize];
+                    let prim = frame.prim(scene, prims[0]);
                     let z = 1.0 / keys[0];
                     out.depth_m[o] = z.min(SKY_DEPTH_M);
                     out.instance[o] = prim.instance;
@@ -384,7 +394,7 @@ impl Renderer {
     /// Rain: thin, slanted, semi-transparent streaks at seeded places, brighter against dark backgrounds.
     fn rain_streaks(&self, seed: u64, out: &mut CameraImages) {
         let (w, h) = (out.width as f32, out.height as f32);
-        let mut rng = ChaCha8Rng::seed_from_u64(mix64(seed ^ 0x7a1f));
+        let mut rng = ChaCha8Rng::seed_from_u64(splitmix64(seed ^ 0x7a1f));
         let count = (self.light.rain * 1500.0 * (w * h) / (1280.0 * 720.0)) as usize;
         let slant = 0.08 + 0.35 * self.light.wind;
         let bright = 150.0 + 60.0 * (1.0 - self.light.night);
@@ -421,5 +431,5 @@ pub fn luminance(rgb: &[u8]) -> f32 {
 
 /// A random generator for a (clip, frame, sub-step) stream.
 pub fn streak_seed(clip_seed: u64, frame: u32, substep: u32) -> u64 {
-    mix64(clip_seed ^ mix64((u64::from(frame) << 16) | u64::from(substep)))
+    splitmix64(clip_seed ^ splitmix64((u64::from(frame) << 16) | u64::from(substep)))
 }

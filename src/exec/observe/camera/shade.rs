@@ -6,7 +6,8 @@
 use glam::{Vec2, Vec3};
 
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
-use crate::exec::observe::scene::{FrameScene, Material, Prim, StaticScene, mix64, road_paint, tag};
+use crate::exec::observe::scene::{FrameScene, Material, Prim, StaticScene, road_paint, tag};
+use crate::mix::splitmix64;
 
 /// A seeded tileable value-noise table, sampled bilinearly (values in [−1, 1]).
 #[derive(Clone, Debug)]
@@ -20,7 +21,7 @@ impl Noise {
     /// The noise table of a seed.
     pub fn new(seed: u64) -> Noise {
         let values = (0..NOISE_SIZE * NOISE_SIZE)
-            .map(|i| (mix64(seed ^ mix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0)
+            .map(|i| (splitmix64(seed ^ splitmix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0)
             .collect();
         Noise { values }
     }
@@ -42,7 +43,7 @@ impl Noise {
     /// A cell hash in [0, 1).
     #[inline]
     pub fn cell(&self, x: i32, y: i32, salt: u32) -> f32 {
-        let h = mix64(((x as u32 as u64) << 32 | y as u32 as u64) ^ (u64::from(salt) << 17) ^ 0x9e37_79b9);
+        let h = splitmix64(((x as u32 as u64) << 32 | y as u32 as u64) ^ (u64::from(salt) << 17) ^ 0x9e37_79b9);
         (h >> 40) as f32 / (1u64 << 24) as f32
     }
 }
