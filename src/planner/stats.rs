@@ -25,28 +25,28 @@ pub const PEDESTRIAN_ROW_BYTES: f64 = 924.0;
 /// Bytes of the `events` table per pedestrian (measured: 570).
 pub const EVENT_BYTES_PER_PEDESTRIAN: f64 = 570.0;
 /// Bytes per pixel of each camera stream's file, measured on `specs/quickstart.yaml` at 1280 × 720
-/// (BENCHMARKS.md, "Cameras": 355, 36, 20 and 12 kB per frame): RGB PNG (fast compression), depth (u16 PNG),
+/// (BENCHMARKS.md, "Cameras": 364, 35, 18 and 12 kB per frame): RGB PNG (fast compression), depth (u16 PNG),
 /// semantic (indexed PNG), instance (u16 PNG).
-pub const RGB_PNG_BYTES_PER_PIXEL: f64 = 0.385;
+pub const RGB_PNG_BYTES_PER_PIXEL: f64 = 0.395;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
-pub const DEPTH_PNG_BYTES_PER_PIXEL: f64 = 0.039;
+pub const DEPTH_PNG_BYTES_PER_PIXEL: f64 = 0.038;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
-pub const SEMANTIC_PNG_BYTES_PER_PIXEL: f64 = 0.022;
+pub const SEMANTIC_PNG_BYTES_PER_PIXEL: f64 = 0.019;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
 pub const INSTANCE_PNG_BYTES_PER_PIXEL: f64 = 0.013;
-/// CPU time to render, encode and write all camera streams of one frame, per pixel, release build: 293 CPU-s
+/// CPU time to render, encode and write all camera streams of one frame, per pixel, release build: 237 CPU-s
 /// for 1,070 frames of 1280 × 720 (BENCHMARKS.md, "Cameras").
-pub const CAMERA_CPU_S_PER_PIXEL: f64 = 2.97e-7;
+pub const CAMERA_CPU_S_PER_PIXEL: f64 = 2.4e-7;
 /// Bytes per LiDAR point (x, y, z, intensity as f32).
 pub const LIDAR_POINT_BYTES: f64 = 16.0;
 /// Bytes of DVS events (Parquet, zstd) per pixel and frame, measured on `specs/quickstart.yaml` (BENCHMARKS.md,
-/// "Cameras": 98 MB for 1,070 frames of 1280 × 720).
-pub const DVS_BYTES_PER_PIXEL: f64 = 0.1;
+/// "Cameras": 101 kB per frame of 1280 × 720).
+pub const DVS_BYTES_PER_PIXEL: f64 = 0.11;
 
 /// Pedestrian-frames simulated, annotated and written per CPU-second by `pedsynth generate` (annotation tables
-/// only), release build: 1,701,362 pedestrian-frames of `specs/pedsynth_pp.yaml` in 13.1 CPU-seconds
-/// (BENCHMARKS.md, "Generation").
-pub const GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S: f64 = 130_000.0;
+/// only), release build: 2,939,923 pedestrian-frames of `specs/pedsynth_pp.yaml` in 32.6 CPU-seconds
+/// (BENCHMARKS.md, "Generation", with the pre-crossing timeline).
+pub const GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S: f64 = 90_000.0;
 
 /// Clips in one (town, weather) cell.
 #[derive(Clone, Debug, PartialEq, Serialize)]
