@@ -16,17 +16,90 @@ pub fn write_atomically_unsynced(path: &Path, bytes: &[u8]) -> std::io::Result<(
     write_atomically_with(path, bytes, false)
 }
 
+/// A file written in pieces that appears at its path complete or not at all: it is written under a temporary
+/// name in the same directory and renamed by [`AtomicFile::commit`]; dropped uncommitted, the temporary file
+/// is removed. Counts and hashes (SHA-256) what is written, so the caller can index the file without reading
+/// it back.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: std::path::PathBuf,
+    tmp: std::path::PathBuf,
+    file: Option<std::io::BufWriter<std::fs::File>>,
+    hasher: sha2::Sha256,
+    bytes: u64,
+}
+
+impl AtomicFile {
+    /// Starts writing the file at `path` (creating its directory).
+    pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
+        let tmp = temporary_path(path);
+        if let Some(dir) = tmp.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        let file = std::fs::File::create(&tmp)?;
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            tmp,
+            file: Some(std::io::BufWriter::with_capacity(1 << 20, file)),
+            hasher: sha2::Digest::new(),
+            bytes: 0,
+        })
+    }
+
+    /// Moves the complete file to its path (not fsynced: see [`write_atomically_unsynced`]); returns its size
+    /// and SHA-256.
+    pub fn commit(mut self) -> std::io::Result<(u64, [u8; 32])> {
+        if let Some(file) = self.file.take() {
+            file.into_inner().map_err(|e| e.into_error())?;
+        }
+        std::fs::rename(&self.tmp, &self.path)?;
+        let hasher = std::mem::take(&mut self.hasher);
+        Ok((self.bytes, sha2::Digest::finalize(hasher).into()))
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let file = self.file.as_mut().ok_or_else(|| std::io::Error::other("file already committed"))?;
+        let n = file.write(buf)?;
+        sha2::Digest::update(&mut self.hasher, &buf[..n]);
+        self.bytes += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.as_mut().map_or(Ok(()), Write::flush)
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.file.take().is_some() {
+            std::fs::remove_file(&self.tmp).ok();
+        }
+    }
+}
+
+/// The temporary name under which `path` is written: `.<name>.tmp-<pid>` in the same directory.
+fn temporary_path(path: &Path) -> std::path::PathBuf {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    dir.join(format!(".{name}.tmp-{}", std::process::id()))
+}
+
 fn write_atomically_with(path: &Path, bytes: &[u8], sync: bool) -> std::io::Result<()> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let tmp = temporary_path(path);
     let result = (|| {
         let mut file = std::fs::File::create(&tmp)?;
         file.write_all(bytes)?;

@@ -7,6 +7,9 @@ use serde_json::Value as Json;
 use super::diagnostic::{Problem, code, suggestion};
 use super::tree::{Node, PathSeg, Value};
 
+/// Keys an earlier version of the spec language had at another place: (old path, new path).
+pub const MOVED: &[(&str, &str)] = &[("output.lidar_encoding", "sensors.lidar.format")];
+
 /// A structural problem and the path of the offending node (`None` when nothing should be pruned).
 pub type Found = (Option<Vec<PathSeg>>, Problem);
 
@@ -108,11 +111,16 @@ impl<'s> Checker<'s> {
                         } else {
                             format!("in `{parent}`")
                         };
+                        let full = super::tree::DisplayPath(&path[..]).to_string();
+                        let help = match MOVED.iter().find(|(old, _)| *old == full) {
+                            Some((_, new)) => format!("this key moved: write `{new}` instead"),
+                            None => suggestion(&key.name, &known),
+                        };
                         problems.push((
                             Some(path.clone()),
                             Problem::new(code::UNKNOWN_KEY, format!("unknown key `{}` {place}", key.name))
                                 .at(key.span, "unknown key")
-                                .help(suggestion(&key.name, &known)),
+                                .help(help),
                         ));
                     }
                     Some(extra @ Json::Object(_)) => self.check(value, extra, path, problems),

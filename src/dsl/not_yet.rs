@@ -40,14 +40,6 @@ pub const NOT_YET: &[NotYet] = &[
         path: "traffic.profiles.cautious.ignore_lights_probability",
         why: "no town has traffic lights yet, so there are no lights to ignore",
     },
-    NotYet {
-        path: "sensors.lidar",
-        why: "LiDAR sweeps are not rendered yet",
-    },
-    NotYet {
-        path: "output.lidar_encoding",
-        why: "LiDAR sweeps are not rendered yet",
-    },
 ];
 
 /// Reports every not-yet key of `spec` whose value differs from the default; `tree` (the user's YAML)

@@ -47,17 +47,25 @@ pub fn run_clip(
     let observations = observe::observe(script, &trace, &plan.spec, rig, &town.network);
     let sensors = &plan.spec.sensors;
     let mut images = 0u64;
-    let sensor_rows = if sensors.cameras_enabled() {
-        let mut files = out.clip_sensors(plan, script)?;
-        observe::render_cameras(script, &trace, sensors, rig, &town.network, |frame| {
-            images += 1;
-            files.frame(frame)
-        })?;
-        files.finish()?
-    } else {
-        Vec::new()
-    };
-    out.write_clip(plan, script, &trace, &observations, &sensor_rows)?;
+    let mut sensor_rows = Vec::new();
+    if sensors.cameras_enabled() || sensors.lidar.enabled {
+        let stat = observe::scene::StaticScene::build(script, &trace, &town.network);
+        if sensors.cameras_enabled() {
+            let mut files = out.clip_sensors(plan, script)?;
+            observe::render_cameras(&stat, script, &trace, sensors, rig, |frame| {
+                images += 1;
+                files.frame(frame)
+            })?;
+            sensor_rows.extend(files.finish()?);
+        }
+        if sensors.lidar.enabled {
+            let mut files = out.clip_lidar(plan, script)?;
+            observe::scan_lidar(&stat, script, &trace, &sensors.lidar, rig, |tick| files.tick(tick))?;
+            sensor_rows.extend(files.finish()?);
+        }
+        write::sensors::sort_index(&mut sensor_rows);
+    }
+    out.write_clip(plan, script, &trace, &observations, rig, &sensor_rows)?;
     Ok(ClipCounts {
         frames: u64::from(script.frame_count),
         pedestrian_frames: u64::from(script.frame_count) * script.pedestrians.len() as u64,

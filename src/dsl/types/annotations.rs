@@ -130,8 +130,6 @@ pub struct Output {
     pub jpeg_quality: u8,
     /// Encoding of depth images.
     pub depth_encoding: DepthEncoding,
-    /// Encoding of LiDAR sweeps.
-    pub lidar_encoding: LidarEncoding,
     /// Encoding of DVS events.
     pub dvs_encoding: DvsEncoding,
 }
@@ -144,7 +142,6 @@ impl Default for Output {
             rgb_encoding: RgbEncoding::Png,
             jpeg_quality: 90,
             depth_encoding: DepthEncoding::MillimetresU16,
-            lidar_encoding: LidarEncoding::Parquet,
             dvs_encoding: DvsEncoding::Parquet,
         }
     }
@@ -182,16 +179,6 @@ pub enum DepthEncoding {
     /// CARLA's 24-bit encoding in an RGB PNG: `depth_m = 1000 (R + 256 G + 65536 B) / (2^24 − 1)`.
     #[serde(rename = "carla_rgb24")]
     CarlaRgb24,
-}
-
-/// LiDAR sweep encodings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum LidarEncoding {
-    /// A Parquet table per clip (frame, x, y, z, intensity).
-    Parquet,
-    /// One little-endian f32 `x y z intensity` file per sweep (the seed system's `.bin`).
-    BinF32,
 }
 
 /// DVS event encodings.

@@ -135,6 +135,18 @@ pub struct Lidar {
     pub noise_stddev_m: f64,
     /// Roof mount.
     pub mount: Mount,
+    /// File format of the points.
+    pub format: LidarFormat,
+}
+
+/// LiDAR file formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum LidarFormat {
+    /// One Parquet file per clip: frame, time, x, y, z, intensity, cos_incidence, tag, instance, actor_id.
+    Parquet,
+    /// The seed system's layout: one `NNNNNN.bin` per frame of little-endian f32 `x y z intensity`.
+    CarlaBin,
 }
 
 impl Default for Lidar {
@@ -161,6 +173,7 @@ impl Default for Lidar {
                 yaw_deg: 0.0,
                 roll_deg: 0.0,
             },
+            format: LidarFormat::Parquet,
         }
     }
 }

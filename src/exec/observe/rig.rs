@@ -1,4 +1,5 @@
-//! The ego's sensor rig: the pinhole camera (mount, intrinsics, projection) from the spec.
+//! The ego's sensor rig: the pinhole camera (mount, intrinsics, projection) and the LiDAR's mount, from the
+//! spec.
 //!
 //! Frames: *world* (right-handed, x east, y north, z up), *vehicle* (x forward, y left, z up; origin on the
 //! ground under the vehicle's centre), *sensor* (the vehicle frame moved and turned by the mount) and
@@ -14,6 +15,8 @@ use crate::dsl::types::{Mount, Rgb, Sensors};
 pub struct Rig {
     /// The RGB camera (the annotations' camera: boxes and keypoints are in its image).
     pub camera: Camera,
+    /// Pose of the LiDAR in the vehicle frame (x forward, y left, z up).
+    pub lidar_vehicle_from_sensor: DAffine3,
 }
 
 impl Rig {
@@ -21,7 +24,13 @@ impl Rig {
     pub fn from_spec(sensors: &Sensors) -> Rig {
         Rig {
             camera: Camera::from_spec(&sensors.rgb),
+            lidar_vehicle_from_sensor: vehicle_from_mount(&sensors.lidar.mount),
         }
+    }
+
+    /// The LiDAR's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
+    pub fn world_from_lidar(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.lidar_vehicle_from_sensor
     }
 }
 

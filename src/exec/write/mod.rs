@@ -4,6 +4,7 @@
 //! - [`manifest`] — `manifest.json`.
 //! - [`tables`] — the Parquet tables: schemas and record batches.
 //! - [`sensors`] — the camera streams' files, the DVS events and the sensor index table.
+//! - [`lidar`] — the LiDAR's points (a Parquet file per clip, or the seed's `.bin` per frame).
 //!
 //! A [`DatasetWriter`] opens `--out` for a plan (refusing a directory that holds anything else), writes each
 //! clip's files atomically (`fsutil::write_atomically`: a complete file or none), and derives the manifest from
@@ -12,6 +13,7 @@
 //! skips, so a clip interrupted while rendering is rendered again whole.
 
 pub mod layout;
+pub mod lidar;
 pub mod manifest;
 pub mod sensors;
 pub mod tables;
@@ -101,6 +103,7 @@ impl DatasetWriter {
         script: &ClipScript,
         trace: &ClipTrace,
         obs: &Observations,
+        rig: &crate::exec::observe::rig::Rig,
         sensor_rows: &[sensors::IndexRow],
     ) -> Result<(), Error> {
         let ann = &obs.annotations;
@@ -113,6 +116,7 @@ impl DatasetWriter {
             ),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
+            ("sensor_poses", tables::sensor_poses_batch(script, trace, rig, &plan.spec.sensors)),
             ("sensors", sensors::index_batch(&script.clip_id, sensor_rows)),
             ("clips", tables::clips_batch(script, trace, ann)),
         ];
@@ -135,6 +139,17 @@ impl DatasetWriter {
             &self.layout,
             &script.clip_id,
             &plan.spec.sensors,
+            &plan.spec.output,
+            &self.meta,
+        )
+    }
+
+    /// A writer of one clip's LiDAR files.
+    pub fn clip_lidar<'a>(&'a self, plan: &'a Plan, script: &'a ClipScript) -> Result<lidar::ClipLidarWriter<'a>, Error> {
+        lidar::ClipLidarWriter::new(
+            &self.layout,
+            &script.clip_id,
+            &plan.spec.sensors.lidar,
             &plan.spec.output,
             &self.meta,
         )
@@ -176,7 +191,7 @@ impl DatasetWriter {
         let mut dirs: Vec<std::path::PathBuf> = std::iter::once(self.layout.root().to_path_buf())
             .chain(TABLES.iter().map(|t| self.layout.table_dir(t)))
             .collect();
-        for stream in sensors::CAMERA_STREAMS {
+        for stream in sensors::STREAMS {
             let stream_dir = self.layout.root().join(layout::SENSORS_DIR).join(stream);
             dirs.push(stream_dir);
             dirs.extend(

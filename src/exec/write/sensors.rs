@@ -10,6 +10,11 @@
 //! tables/sensors/<clip_id>.parquet             clip_id, frame, timestamp_ns, stream, path, bytes, sha256
 //! ```
 //!
+//! (LiDAR files: [`super::lidar`]; the index covers them too.)
+//!
+//! ```text
+//! ```
+//!
 //! Every file is written atomically (a temporary name, then a rename). Blobs are not fsynced one by one
 //! (thousands per clip); the clip's tables, written after every blob, mark it complete.
 
@@ -33,6 +38,15 @@ use crate::fsutil::write_atomically_unsynced;
 
 /// The camera streams, in the order they are written.
 pub const CAMERA_STREAMS: [&str; 5] = ["rgb", "depth", "semantic", "instance", "dvs"];
+
+/// Every sensor stream, in the order of the sensor index within a frame.
+pub const STREAMS: [&str; 6] = ["rgb", "depth", "semantic", "instance", "dvs", super::lidar::STREAM];
+
+/// Sorts index rows by (frame, stream in [`STREAMS`] order); per-clip files (no frame) first.
+pub fn sort_index(rows: &mut [IndexRow]) {
+    let order = |s: &str| STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
+    rows.sort_by_key(|r| (r.frame, order(r.stream)));
+}
 
 /// One row of the sensor index.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -267,13 +281,13 @@ impl<'a> ClipSensorWriter<'a> {
                 .map_err(|e| tables::parquet_error("dvs", self.clip_id, &e))?;
             self.put("dvs", None, "parquet", &bytes)?;
         }
-        let order = |s: &str| CAMERA_STREAMS.iter().position(|x| *x == s).unwrap_or(usize::MAX);
-        self.rows.sort_by_key(|r| (r.frame, order(r.stream)));
+        sort_index(&mut self.rows);
         Ok(self.rows)
     }
 }
 
-fn hex(bytes: &[u8]) -> String {
+/// Lower-case hex of bytes.
+pub(crate) fn hex(bytes: &[u8]) -> String {
     use std::fmt::Write;
     bytes.iter().fold(String::with_capacity(bytes.len() * 2), |mut s, b| {
         let _ = write!(s, "{b:02x}");

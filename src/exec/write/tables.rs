@@ -26,15 +26,16 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 3;
+pub const SCHEMA_VERSION: u32 = 4;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 7] = [
+pub const TABLES: [&str; 8] = [
     "frames",
     "pedestrians",
     "annotations",
     "vehicles",
     "events",
+    "sensor_poses",
     "sensors",
     "clips",
 ];
@@ -183,6 +184,59 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             col(|f| f.yaw_rad),
             col(|f| f.speed_mps),
             col(|f| f.accel_mps2),
+        ],
+    )
+}
+
+/// The `sensor_poses` table: per frame, the world pose of the camera (whose image the annotations are in) and,
+/// when it is enabled, the LiDAR, as `world_from_sensor` with sensor axes x forward, y left, z up: position
+/// and a unit quaternion (w, x, y, z).
+pub fn sensor_poses_batch(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    rig: &crate::exec::observe::rig::Rig,
+    sensors: &crate::dsl::types::Sensors,
+) -> RecordBatch {
+    let frames = trace.frame_count.min(trace.ego.len() as u32);
+    let mut rows: Vec<(u32, &'static str, glam::DAffine3)> = Vec::new();
+    for f in 0..frames {
+        for (name, pose) in crate::exec::observe::sensor_poses(trace, rig, f) {
+            if name == "camera" || sensors.lidar.enabled {
+                rows.push((f, name, pose));
+            }
+        }
+    }
+    let n = rows.len();
+    let quats: Vec<glam::DQuat> = rows.iter().map(|r| glam::DQuat::from_mat3(&r.2.matrix3)).collect();
+    let f64c = |v: Vec<f64>| -> ArrayRef { Arc::new(Float64Array::from(v)) };
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("timestamp_ns", DataType::Int64, false),
+            field("sensor", DataType::Utf8, false),
+            field("x_m", DataType::Float64, false),
+            field("y_m", DataType::Float64, false),
+            field("z_m", DataType::Float64, false),
+            field("qw", DataType::Float64, false),
+            field("qx", DataType::Float64, false),
+            field("qy", DataType::Float64, false),
+            field("qz", DataType::Float64, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
+            Arc::new(Int64Array::from_iter_values(
+                rows.iter().map(|r| crate::exec::observe::frame_time_ns(r.0, trace.fps, 0, 1)),
+            )),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.1))),
+            f64c(rows.iter().map(|r| r.2.translation.x).collect()),
+            f64c(rows.iter().map(|r| r.2.translation.y).collect()),
+            f64c(rows.iter().map(|r| r.2.translation.z).collect()),
+            f64c(quats.iter().map(|q| q.w).collect()),
+            f64c(quats.iter().map(|q| q.x).collect()),
+            f64c(quats.iter().map(|q| q.y).collect()),
+            f64c(quats.iter().map(|q| q.z).collect()),
         ],
     )
 }
