@@ -204,7 +204,8 @@ fn instance_masks_match_the_annotated_boxes_and_keypoints_in_every_frame() {
     let net = &c.towns[&c.script.town].network;
     let mut report = MaskReport::default();
     let mut frames = 0;
-    observe::render_cameras(&c.script, &c.trace, &c.plan.spec.sensors, &c.rig, net, |f| {
+    let stat = StaticScene::build(&c.script, &c.trace, net);
+    observe::render_cameras(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
         check_masks(&c, f.frame, f.images, &mut report);
         frames += 1;
         Ok::<(), ()>(())
@@ -694,7 +695,8 @@ fn static_scenes_give_no_dvs_events_and_motion_gives_some() {
     let net = &c.towns[&c.script.town].network;
     let mut per_frame = Vec::new();
     let sensors = c.plan.spec.sensors.clone();
-    observe::render_cameras(&c.script, &c.trace, &sensors, &c.rig, net, |f| {
+    let stat = StaticScene::build(&c.script, &c.trace, net);
+    observe::render_cameras(&stat, &c.script, &c.trace, &sensors, &c.rig, |f| {
         per_frame.push((
             f.frame,
             f.events.len(),

@@ -14,7 +14,7 @@ fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
     let out = std::env::temp_dir().join(format!("pedsynth-crossing-rate-{}-{target}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let target_set = format!("crossing.target_ratio={target}");
-    let overrides: Vec<&str> = common::NO_CAMERAS
+    let overrides: Vec<&str> = common::NO_SENSORS
         .iter()
         .copied()
         .chain([target_set.as_str()])

@@ -63,7 +63,7 @@ fn spec(name: &str) -> PathBuf {
 /// Load options with `overrides`, cameras off (tests/camera.rs tests the sensor files).
 fn options(overrides: &[&str]) -> LoadOptions {
     LoadOptions {
-        overrides: common::NO_CAMERAS
+        overrides: common::NO_SENSORS
             .iter()
             .chain(overrides)
             .map(|s| s.to_string())
@@ -78,7 +78,7 @@ fn generate(input: &Path, overrides: &[&str], out: &Path, jobs: usize) -> (i32, 
     let all: Vec<&str> = if is_plan {
         Vec::new()
     } else {
-        common::NO_CAMERAS.iter().chain(overrides).copied().collect()
+        common::NO_SENSORS.iter().chain(overrides).copied().collect()
     };
     common::generate(input, &all, out, Some(jobs))
 }
@@ -912,7 +912,7 @@ fn generate_refuses_directories_it_must_not_write_into() {
     let qs = spec("quickstart.yaml");
     let gen_args = |out: &Path, extra: &[&str]| -> Vec<std::ffi::OsString> {
         let mut v: Vec<std::ffi::OsString> = vec!["generate".into(), qs.clone().into(), "--out".into(), out.into()];
-        for set in common::NO_CAMERAS {
+        for set in common::NO_SENSORS {
             v.extend(["--set".into(), set.into()]);
         }
         v.extend(extra.iter().map(|s| s.into()));

@@ -22,7 +22,7 @@ use pedsynth::exec::write::Layout;
 fn generate(spec: &str, name: &str) -> PathBuf {
     let out = std::env::temp_dir().join(format!("pedsynth-intention-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let (code, _, stderr) = common::generate(Path::new(spec), &common::NO_CAMERAS, &out, None);
+    let (code, _, stderr) = common::generate(Path::new(spec), &common::NO_SENSORS, &out, None);
     assert_eq!(code, 0, "{stderr}");
     out
 }

@@ -13,6 +13,8 @@ use pedsynth::dsl::not_yet::NOT_YET;
 use pedsynth::dsl::{self, LoadOptions, Spec};
 use pedsynth::exec::observe::{self, rig::Rig};
 use pedsynth::exec::simulate;
+use pedsynth::exec::observe::scene::StaticScene;
+use pedsynth::exec::write::lidar::ClipLidarWriter;
 use pedsynth::exec::write::sensors::ClipSensorWriter;
 use pedsynth::exec::write::tables::{self, FileMeta};
 use pedsynth::planner::{self, TownContext};
@@ -83,6 +85,7 @@ impl Walker {
                     tables::annotations_batch(script, ann, plan.spec.annotations.pose_format),
                     tables::vehicles_batch(script, &trace),
                     tables::events_batch(script, &trace),
+                    tables::sensor_poses_batch(script, &trace, &rig, &plan.spec.sensors),
                     tables::clips_batch(script, &trace, ann),
                 ];
                 for batch in &batches {
@@ -98,12 +101,24 @@ impl Walker {
                     let sensors = &plan.spec.sensors;
                     let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output, &meta)
                         .expect("sensor writer");
-                    let _ = observe::render_cameras(script, &trace, sensors, &rig, net, |f| {
+                    let stat = StaticScene::build(script, &trace, net);
+                    let _ = observe::render_cameras(&stat, script, &trace, sensors, &rig, |f| {
                         let last = f.frame >= 4;
                         files.frame(f).expect("sensor files");
                         if last { Err(()) } else { Ok(()) }
                     });
-                    let rows = files.finish().expect("sensor files");
+                    let mut rows = files.finish().expect("sensor files");
+                    if sensors.lidar.enabled {
+                        let mut lidar =
+                            ClipLidarWriter::new(&layout, &script.clip_id, &sensors.lidar, &plan.spec.output, &meta)
+                                .expect("lidar writer");
+                        let _ = observe::scan_lidar(&stat, script, &trace, &sensors.lidar, &rig, |t| {
+                            let last = t.frame >= 4;
+                            lidar.tick(t).expect("lidar files");
+                            if last { Err(()) } else { Ok(()) }
+                        });
+                        rows.extend(lidar.finish().expect("lidar files"));
+                    }
                     for r in rows {
                         hasher.update(format!("{}|{}|{}", r.path, r.bytes, r.sha256).as_bytes());
                     }
@@ -304,7 +319,7 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
                 "compression" => &["zstd", "snappy", "none"],
                 "rgb_encoding" => &["png", "jpeg"],
                 "depth_encoding" => &["mm_u16", "carla_rgb24"],
-                "lidar_encoding" => &["parquet", "bin_f32"],
+                "format" => &["parquet", "carla_bin"],
                 "dvs_encoding" => &["parquet"],
                 "name" => &["walk", "walk_renamed"],
                 _ if parent_key == "splits" => &["train", "val", "test"],

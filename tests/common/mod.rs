@@ -9,7 +9,7 @@
 //! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
 //!
 //! Also: `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
-//! cameras off (`NO_CAMERAS`).
+//! sensors off (`NO_SENSORS`).
 #![allow(dead_code)]
 
 use glam::DVec2;
@@ -221,8 +221,9 @@ pub fn assert_queries(net: &RoadNetwork) {
 
 /// `--set` overrides that turn every camera stream off: for tests of the tables and the simulation, which
 /// would otherwise render thousands of images (the camera tests render their own, small ones).
-pub const NO_CAMERAS: [&str; 5] = [
+pub const NO_SENSORS: [&str; 6] = [
     "sensors.rgb.enabled=false",
+    "sensors.lidar.enabled=false",
     "sensors.depth.enabled=false",
     "sensors.semantic.enabled=false",
     "sensors.instance.enabled=false",

@@ -6,7 +6,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float32Type, Float64Type, Int32Type, UInt16Type, UInt32Type, UInt64Type};
+use arrow_array::types::{Float32Type, Float64Type, Int32Type, UInt8Type, UInt16Type, UInt32Type, UInt64Type};
 use arrow_array::{Array, ArrowPrimitiveType, PrimitiveArray, RecordBatch};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 
@@ -86,6 +86,11 @@ impl Batch {
         let c = self.column(name)?;
         c.as_primitive_opt::<T>()
             .ok_or_else(|| self.invalid(&format!("column `{name}` is {}, not {}", c.data_type(), T::DATA_TYPE)))
+    }
+
+    /// A `uint8` column.
+    pub fn u8s(&self, name: &str) -> Result<&PrimitiveArray<UInt8Type>, Error> {
+        self.primitive(name)
     }
 
     /// A `uint16` column.

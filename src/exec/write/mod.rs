@@ -257,7 +257,16 @@ fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
         (
             "lidar",
             s.lidar.enabled,
-            "enabled in the spec; not rendered by this pedsynth version".to_owned(),
+            match s.lidar.format {
+                crate::dsl::types::LidarFormat::Parquet => format!(
+                    "rendered: sensors/lidar/<clip_id>.parquet ({} channels, {} points/s, {} Hz; sensor frame: x forward, y right, z up)",
+                    s.lidar.channels, s.lidar.points_per_second, s.lidar.rotation_hz
+                ),
+                crate::dsl::types::LidarFormat::CarlaBin => format!(
+                    "rendered: sensors/lidar/<clip_id>/<frame:06>.bin (f32 x y z intensity; {} channels, {} points/s, {} Hz)",
+                    s.lidar.channels, s.lidar.points_per_second, s.lidar.rotation_hz
+                ),
+            },
         ),
     ]
     .into_iter()
