@@ -60,7 +60,10 @@ impl AtomicFile {
 
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let file = self.file.as_mut().ok_or_else(|| std::io::Error::other("file already committed"))?;
+        let file = self
+            .file
+            .as_mut()
+            .ok_or_else(|| std::io::Error::other("file already committed"))?;
         let n = file.write(buf)?;
         sha2::Digest::update(&mut self.hasher, &buf[..n]);
         self.bytes += n as u64;

@@ -98,7 +98,7 @@ enum Command {
         #[arg(long, value_name = "FRAMES", requires = "protocol")]
         min_track: Option<usize>,
     },
-    /// Draw a clip's camera stream with its labels (boxes, ids, states, skeletons): a contact sheet of nine
+    /// Draw a clip's camera or LiDAR stream with its labels (boxes, ids, states, skeletons): a contact sheet of nine
     /// frames (--out FILE.png) or an animation (--out FILE.gif).
     Preview {
         /// Dataset directory.
@@ -130,6 +130,8 @@ enum PreviewStream {
     Instance,
     Depth,
     Dvs,
+    /// LiDAR points from above, coloured by tag, with the 3D boxes.
+    Lidar,
 }
 
 /// Benchmark protocols of `stats --protocol`.
@@ -251,6 +253,7 @@ fn main() -> ExitCode {
                 PreviewStream::Instance => (Stream::Instance, "instance"),
                 PreviewStream::Depth => (Stream::Depth, "depth"),
                 PreviewStream::Dvs => (Stream::Dvs, "dvs"),
+                PreviewStream::Lidar => (Stream::Lidar, "lidar"),
             };
             let file = file.unwrap_or_else(|| PathBuf::from(format!("{clip}.{name}.png")));
             commands::preview(

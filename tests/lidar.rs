@@ -144,7 +144,10 @@ fn a_wall_at_a_known_distance_is_returned_within_a_millimetre() {
     let mut spread = 0.0f64;
     for (a, b) in points.iter().zip(&moved) {
         let (da, db) = (Vec3::new(a.x_m, a.y_m, a.z_m), Vec3::new(b.x_m, b.y_m, b.z_m));
-        assert!(da.normalize().dot(db.normalize()) > 1.0 - 1e-6, "noise stays on the ray");
+        assert!(
+            da.normalize().dot(db.normalize()) > 1.0 - 1e-6,
+            "noise stays on the ray"
+        );
         spread += f64::from(db.length() - da.length()).powi(2);
     }
     let sd = (spread / points.len() as f64).sqrt();
@@ -217,7 +220,11 @@ fn ticks_follow_the_ray_pattern_the_drop_off_model_and_the_sweep() {
         previous_end = Some(p.start_deg + p.step_deg * f64::from(p.rays_per_channel));
         for q in t.points {
             let az = f64::from(q.y_m).atan2(f64::from(q.x_m)).to_degrees();
-            assert!(in_sweep(l, &p, az, -0.01), "tick {}: azimuth {az}° outside its sweep", t.frame);
+            assert!(
+                in_sweep(l, &p, az, -0.01),
+                "tick {}: azimuth {az}° outside its sweep",
+                t.frame
+            );
         }
         total += t.stats;
         ticks += 1;
@@ -351,7 +358,10 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
     generate(&LIDAR_ONLY, &one, 1);
     generate(&LIDAR_ONLY, &two, 2);
     let files = common::all_files(&one);
-    assert!(files == common::all_files(&two), "--jobs 1 and --jobs 2 wrote different files");
+    assert!(
+        files == common::all_files(&two),
+        "--jobs 1 and --jobs 2 wrote different files"
+    );
     let layout = Layout::new(&one);
     let manifest: serde_json::Value = serde_json::from_slice(&files["manifest.json"]).expect("manifest");
     assert!(
@@ -373,8 +383,8 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
             let (f, s) = (b.u32s("frame").unwrap(), b.strings("sensor").unwrap());
             let c = |n: &str| b.f64s(n).unwrap().clone();
             let (x, y, z, qw, qx, qy, qz) = (c("x_m"), c("y_m"), c("z_m"), c("qw"), c("qx"), c("qy"), c("qz"));
-            for i in 0..b.rows() {
-                if s[i] == "lidar" {
+            for (i, sensor) in s.iter().enumerate() {
+                if *sensor == "lidar" {
                     let q = DQuat::from_xyzw(qx.value(i), qy.value(i), qz.value(i), qw.value(i));
                     poses.insert(
                         f.value(i),
@@ -412,13 +422,21 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
                 let v = |a: &arrow_array::Float32Array| f64::from(a.value(i));
                 boxes.insert(
                     (f.value(i), p.value(i)),
-                    (DVec3::new(v(&x), v(&y), v(&z)), DVec3::new(v(&bl), v(&bw), v(&bh)), v(&yaw)),
+                    (
+                        DVec3::new(v(&x), v(&y), v(&z)),
+                        DVec3::new(v(&bl), v(&bw), v(&bh)),
+                        v(&yaw),
+                    ),
                 );
             }
         }
         let path = layout.sensor_clip("lidar", id, "parquet");
         for b in tables::read(&path, &["frame", "x", "y", "z", "tag", "instance", "actor_id"]).expect("points") {
-            let (f, tg, inst) = (b.u32s("frame").unwrap(), b.u8s("tag").unwrap(), b.u16s("instance").unwrap());
+            let (f, tg, inst) = (
+                b.u32s("frame").unwrap(),
+                b.u8s("tag").unwrap(),
+                b.u16s("instance").unwrap(),
+            );
             let (x, y, z) = (b.f32s("x").unwrap(), b.f32s("y").unwrap(), b.f32s("z").unwrap());
             let actor = b.u32s("actor_id").unwrap();
             for i in 0..b.rows() {
@@ -444,7 +462,10 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
         }
     }
     eprintln!("pedestrian points inside their boxes: {inside} ({unannotated} of unannotated pedestrians)");
-    assert!(inside >= 200, "{inside} pedestrian points checked ({unannotated} of unannotated pedestrians)");
+    assert!(
+        inside >= 200,
+        "{inside} pedestrian points checked ({unannotated} of unannotated pedestrians)"
+    );
 
     // Interrupted half-way: the clip's completion marker and its LiDAR file are gone and a temporary file is
     // left; the resumed run writes the clip again, byte-identical.
@@ -453,7 +474,10 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
     std::fs::remove_file(one.join(format!("sensors/lidar/{clip0}.parquet"))).expect("rm");
     std::fs::write(one.join(format!("sensors/lidar/.{clip0}.parquet.tmp-99999")), b"half").expect("tmp");
     generate(&LIDAR_ONLY, &one, 2);
-    assert!(common::all_files(&one) == files, "a resumed run differs from an uninterrupted one");
+    assert!(
+        common::all_files(&one) == files,
+        "a resumed run differs from an uninterrupted one"
+    );
 
     // The seed's layout: one .bin per frame with the same points' x y z intensity.
     let bin_dir = tmp.join("bin");
@@ -467,8 +491,11 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
         .expect("frame 10's .bin")
         .1;
     let mut expected = Vec::new();
-    for b in tables::read(&layout.sensor_clip("lidar", &clip0, "parquet"), &["frame", "x", "y", "z", "intensity"])
-        .expect("points")
+    for b in tables::read(
+        &layout.sensor_clip("lidar", &clip0, "parquet"),
+        &["frame", "x", "y", "z", "intensity"],
+    )
+    .expect("points")
     {
         let f = b.u32s("frame").unwrap();
         let cols = ["x", "y", "z", "intensity"].map(|n| b.f32s(n).unwrap().clone());

@@ -11,9 +11,9 @@ use std::path::Path;
 
 use pedsynth::dsl::not_yet::NOT_YET;
 use pedsynth::dsl::{self, LoadOptions, Spec};
+use pedsynth::exec::observe::scene::StaticScene;
 use pedsynth::exec::observe::{self, rig::Rig};
 use pedsynth::exec::simulate;
-use pedsynth::exec::observe::scene::StaticScene;
 use pedsynth::exec::write::lidar::ClipLidarWriter;
 use pedsynth::exec::write::sensors::ClipSensorWriter;
 use pedsynth::exec::write::tables::{self, FileMeta};

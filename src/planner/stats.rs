@@ -37,8 +37,15 @@ pub const INSTANCE_PNG_BYTES_PER_PIXEL: f64 = 0.013;
 /// CPU time to render, encode and write all camera streams of one frame, per pixel, release build: 237 CPU-s
 /// for 1,070 frames of 1280 × 720 (BENCHMARKS.md, "Cameras").
 pub const CAMERA_CPU_S_PER_PIXEL: f64 = 2.4e-7;
-/// Bytes per LiDAR point (x, y, z, intensity as f32).
-pub const LIDAR_POINT_BYTES: f64 = 16.0;
+/// Bytes of the LiDAR Parquet (zstd) per expected point (`pps / fps × (1 − general drop-off)` per frame: rays
+/// that hit nothing and the intensity drop-off are in the figure), measured on `specs/quickstart.yaml`:
+/// 157.2 MB for 1,070 frames (BENCHMARKS.md, "LiDAR").
+pub const LIDAR_POINT_BYTES: f64 = 8.0;
+/// CPU time of the LiDAR per ray of the pattern (trace, drop-off, encode, write), release build: 10.4 CPU-s
+/// for 1,070 frames of 33,344 rays (BENCHMARKS.md, "LiDAR").
+pub const LIDAR_CPU_S_PER_RAY: f64 = 2.9e-7;
+/// Bytes of the `sensor_poses` table per sensor and frame.
+pub const SENSOR_POSE_ROW_BYTES: f64 = 23.5;
 /// Bytes of DVS events (Parquet, zstd) per pixel and frame, measured on `specs/quickstart.yaml` (BENCHMARKS.md,
 /// "Cameras": 101 kB per frame of 1280 × 720).
 pub const DVS_BYTES_PER_PIXEL: f64 = 0.11;
@@ -301,9 +308,17 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
     } else {
         0.0
     };
+    let lidar_rays = if s.lidar.enabled {
+        (f64::from(s.lidar.points_per_second) / f64::from(spec.dataset.fps.max(1)) / f64::from(s.lidar.channels.max(1)))
+            .round()
+            * f64::from(s.lidar.channels)
+    } else {
+        0.0
+    };
     stats.estimated_generation_cpu_s = round(
         stats.pedestrian_frames as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
-            + stats.frames as f64 * camera_pixels * CAMERA_CPU_S_PER_PIXEL,
+            + stats.frames as f64 * camera_pixels * CAMERA_CPU_S_PER_PIXEL
+            + stats.frames as f64 * lidar_rays * LIDAR_CPU_S_PER_RAY,
         1,
     );
     stats
@@ -325,6 +340,11 @@ fn estimate_bytes(stats: &PlanStats, spec: &Spec, vehicle_frames: u64) -> SizeEs
     );
     e.tables
         .insert("clips".into(), (stats.clips as f64 * CLIP_FILE_BYTES) as u64);
+    let sensors_posed = if spec.sensors.lidar.enabled { 2.0 } else { 1.0 };
+    e.tables.insert(
+        "sensor_poses".into(),
+        (stats.frames as f64 * sensors_posed * SENSOR_POSE_ROW_BYTES) as u64,
+    );
     e.tables.insert(
         "events".into(),
         (stats.pedestrians as f64 * EVENT_BYTES_PER_PEDESTRIAN) as u64,

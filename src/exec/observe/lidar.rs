@@ -567,7 +567,10 @@ mod tests {
         let l = Lidar::default();
         let p = TickPattern::of(&l, 30, 0);
         assert_eq!(p.rays_per_channel, 521, "round(1e6 / 30 / 64)");
-        assert!((p.step_deg * 521.0 - 240.0).abs() < 1e-9, "20 Hz × 360° / 30 FPS = 240° per tick");
+        assert!(
+            (p.step_deg * 521.0 - 240.0).abs() < 1e-9,
+            "20 Hz × 360° / 30 FPS = 240° per tick"
+        );
         assert!((TickPattern::of(&l, 30, 1).start_deg - 240.0).abs() < 1e-9);
         assert!((TickPattern::of(&l, 30, 2).start_deg - 120.0).abs() < 1e-9);
         assert!((channel_elevation_deg(&l, 0) - 15.0).abs() < 1e-12);

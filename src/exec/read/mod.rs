@@ -4,6 +4,7 @@
 //! - [`stats`] — `pedsynth stats`: statistics computed from the written tables.
 //! - [`protocol`] — `pedsynth stats --protocol pab`: PedestrianActionBenchmark's sampling of the tables.
 //! - [`preview`] — `pedsynth preview`: a contact sheet or GIF of a clip's camera stream with its labels.
+pub mod lidar_view;
 pub mod preview;
 pub mod protocol;
 pub mod stats;

@@ -3,7 +3,7 @@
 //! crossing, green: not crossing), pedestrian ids and behaviour states, and the COCO-17 skeleton. Frames are
 //! shown at half resolution. Depth is shown near-bright/far-dark on a log scale, instance ids in hashed
 //! colours, semantic tags in CARLA's palette, and DVS events of a frame as red (brighter) and blue (darker)
-//! dots.
+//! dots. The LiDAR is shown from above with the 3D boxes ([`super::lidar_view`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -31,6 +31,8 @@ pub enum Stream {
     Depth,
     /// DVS events.
     Dvs,
+    /// LiDAR points from above (see [`super::lidar_view`]).
+    Lidar,
 }
 
 impl Stream {
@@ -40,6 +42,7 @@ impl Stream {
             Stream::Semantic => "semantic",
             Stream::Instance => "instance",
             Stream::Depth => "depth",
+            Stream::Lidar => "lidar",
         }
     }
 }
@@ -342,16 +345,48 @@ pub fn preview(dir: &Path, options: &PreviewOptions) -> Result<String, Error> {
         Vec::new()
     };
     let gif = options.out.extension().is_some_and(|e| e.eq_ignore_ascii_case("gif"));
+    // Every third frame (10 images per second of a 30 FPS clip), at most 120.
+    let gif_picks: Vec<u32> = (0..frames).step_by(3).take(120).collect();
+    // Nine frames spread over the clip, preferring frames with annotated pedestrians.
+    let mut sheet_picks: Vec<u32> = (0..9)
+        .map(|k| {
+            let lo = frames * k / 9;
+            let hi = (frames * (k + 1) / 9).max(lo + 1);
+            (lo..hi)
+                .max_by_key(|f| (labels.get(f).map_or(0, Vec::len), std::cmp::Reverse(*f)))
+                .unwrap_or(lo)
+        })
+        .collect();
+    sheet_picks.dedup();
+    let lidar = if options.stream == Stream::Lidar {
+        let wanted = if gif { &gif_picks } else { &sheet_picks };
+        Some(super::lidar_view::LidarFrames::read(
+            &layout,
+            &options.clip,
+            &wanted.iter().copied().collect(),
+        )?)
+    } else {
+        None
+    };
     let empty = Vec::new();
     let render = |f: u32| -> Result<Canvas, Error> {
-        let mut c = frame_canvas(&layout, options, f, &events)?;
-        draw_labels(&mut c, labels.get(&f).unwrap_or(&empty));
+        let mut c = if let Some(l) = &lidar {
+            let n = super::lidar_view::VIEW_PX;
+            Canvas {
+                w: n,
+                h: n,
+                px: l.view(f),
+            }
+        } else {
+            let mut c = frame_canvas(&layout, options, f, &events)?;
+            draw_labels(&mut c, labels.get(&f).unwrap_or(&empty));
+            c
+        };
         c.text(6, 6, &format!("{} frame {f}", options.clip), [255, 255, 255]);
         Ok(c)
     };
     let bytes = if gif {
-        // Every third frame (10 images per second of a 30 FPS clip), at most 120.
-        let picks: Vec<u32> = (0..frames).step_by(3).take(120).collect();
+        let picks = gif_picks;
         let mut out = Vec::new();
         {
             let first = render(picks.first().copied().unwrap_or(0))?;
@@ -368,17 +403,7 @@ pub fn preview(dir: &Path, options: &PreviewOptions) -> Result<String, Error> {
         }
         out
     } else {
-        // Nine frames spread over the clip, preferring frames with annotated pedestrians.
-        let mut picks: Vec<u32> = (0..9)
-            .map(|k| {
-                let lo = frames * k / 9;
-                let hi = (frames * (k + 1) / 9).max(lo + 1);
-                (lo..hi)
-                    .max_by_key(|f| (labels.get(f).map_or(0, Vec::len), std::cmp::Reverse(*f)))
-                    .unwrap_or(lo)
-            })
-            .collect();
-        picks.dedup();
+        let picks = sheet_picks;
         let tiles: Vec<Canvas> = picks.iter().map(|f| render(*f)).collect::<Result<_, _>>()?;
         let (tw, th) = (tiles[0].w, tiles[0].h);
         let cols = 3;

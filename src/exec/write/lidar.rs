@@ -59,7 +59,8 @@ pub fn lidar_schema() -> SchemaRef {
 
 /// One tick's points as a record batch of [`lidar_schema`].
 pub fn lidar_batch(clip_id: &str, frame: u32, timestamp_ns: i64, points: &[LidarPoint]) -> RecordBatch {
-    let f = |get: fn(&LidarPoint) -> f32| -> ArrayRef { Arc::new(Float32Array::from_iter_values(points.iter().map(get))) };
+    let f =
+        |get: fn(&LidarPoint) -> f32| -> ArrayRef { Arc::new(Float32Array::from_iter_values(points.iter().map(get))) };
     let columns: Vec<ArrayRef> = vec![
         Arc::new(StringArray::from_iter_values(points.iter().map(|_| clip_id))),
         Arc::new(UInt32Array::from_iter_values(points.iter().map(|_| frame))),

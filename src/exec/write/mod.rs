@@ -116,7 +116,10 @@ impl DatasetWriter {
             ),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
-            ("sensor_poses", tables::sensor_poses_batch(script, trace, rig, &plan.spec.sensors)),
+            (
+                "sensor_poses",
+                tables::sensor_poses_batch(script, trace, rig, &plan.spec.sensors),
+            ),
             ("sensors", sensors::index_batch(&script.clip_id, sensor_rows)),
             ("clips", tables::clips_batch(script, trace, ann)),
         ];
@@ -145,7 +148,11 @@ impl DatasetWriter {
     }
 
     /// A writer of one clip's LiDAR files.
-    pub fn clip_lidar<'a>(&'a self, plan: &'a Plan, script: &'a ClipScript) -> Result<lidar::ClipLidarWriter<'a>, Error> {
+    pub fn clip_lidar<'a>(
+        &'a self,
+        plan: &'a Plan,
+        script: &'a ClipScript,
+    ) -> Result<lidar::ClipLidarWriter<'a>, Error> {
         lidar::ClipLidarWriter::new(
             &self.layout,
             &script.clip_id,

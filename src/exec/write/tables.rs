@@ -227,7 +227,8 @@ pub fn sensor_poses_batch(
             utf8(n, &script.clip_id),
             Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
             Arc::new(Int64Array::from_iter_values(
-                rows.iter().map(|r| crate::exec::observe::frame_time_ns(r.0, trace.fps, 0, 1)),
+                rows.iter()
+                    .map(|r| crate::exec::observe::frame_time_ns(r.0, trace.fps, 0, 1)),
             )),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.1))),
             f64c(rows.iter().map(|r| r.2.translation.x).collect()),
