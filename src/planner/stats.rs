@@ -502,7 +502,7 @@ impl std::fmt::Display for PlanStats {
         }
         writeln!(
             out,
-            "\nestimated generation time {:.1} s on one core, {:.1} s on two (LiDAR is not rendered yet)",
+            "\nestimated generation time {:.1} s on one core, {:.1} s on two",
             stats.estimated_generation_cpu_s,
             stats.estimated_generation_cpu_s / 2.0
         )?;
