@@ -4,58 +4,22 @@
 //! issue's target is ≥ 60 rendered frames per second on one core.
 //! Run: `cargo bench --bench camera`.
 
-use std::path::Path;
-
-use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::observe::camera::light::Lighting;
 use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
-use pedsynth::exec::observe::rig::Rig;
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, StaticScene, ego_at};
+use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
 use pedsynth::exec::observe::{self};
-use pedsynth::exec::simulate;
-use pedsynth::exec::trace::ClipTrace;
 use pedsynth::exec::write::sensors::{rgb_png, semantic_png};
-use pedsynth::planner::ClipScript;
+
+mod common;
 
 fn main() {
     divan::main();
 }
 
-struct Setup {
-    script: ClipScript,
-    trace: ClipTrace,
-    rig: Rig,
-    scene: StaticScene,
-    frame: u32,
-}
+type Setup = common::BusyClip;
 
 fn setup(weather: &str) -> Setup {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-    let options = LoadOptions {
-        overrides: vec![format!("dataset.weathers=[{weather}]")],
-        allow_large: false,
-    };
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).expect("quickstart plans");
-    let script = plan.clips[0].clone();
-    let net = &towns[&script.town].network;
-    let trace = simulate::simulate(&script, &plan.sim, net);
-    let rig = Rig::from_spec(&plan.spec.sensors);
-    let ann = observe::observe(&script, &trace, &plan.spec, &rig, net).annotations;
-    let mut counts = vec![0u32; trace.frame_count as usize];
-    for r in &ann.rows {
-        counts[r.frame as usize] += 1;
-    }
-    let frame = (0..counts.len())
-        .max_by_key(|&f| (counts[f], std::cmp::Reverse(f)))
-        .unwrap_or(0) as u32;
-    let scene = StaticScene::build(&script, &trace, net);
-    Setup {
-        script,
-        trace,
-        rig,
-        scene,
-        frame,
-    }
+    common::busy_quickstart_clip(&[format!("dataset.weathers=[{weather}]")])
 }
 
 #[divan::bench(args = ["clear_noon", "night_rainy"])]
@@ -90,18 +54,13 @@ fn build_frame_scene(bencher: divan::Bencher) {
 #[divan::bench]
 fn encode_rgb_png(bencher: divan::Bencher) {
     let s = setup("clear_noon");
-    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &towns_net(&s), s.frame);
+    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
     bencher.bench_local(|| rgb_png(&img).expect("png").len());
 }
 
 #[divan::bench]
 fn encode_semantic_png(bencher: divan::Bencher) {
     let s = setup("clear_noon");
-    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &towns_net(&s), s.frame);
+    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
     bencher.bench_local(|| semantic_png(&img).expect("png").len());
-}
-
-/// The clip's town, built again (the setup keeps only its scene).
-fn towns_net(s: &Setup) -> pedsynth::world::RoadNetwork {
-    pedsynth::world::RoadNetwork::builtin(&s.script.town).expect("built-in town")
 }

@@ -11,19 +11,14 @@
 //!
 //! Run: `cargo bench --bench lidar`.
 
-use std::path::Path;
-
 use divan::counter::ItemsCount;
 use glam::Affine3A;
-use pedsynth::dsl::LoadOptions;
 use pedsynth::dsl::types::Lidar;
 use pedsynth::exec::observe::lidar::{self, ScanScratch, Tracer};
-use pedsynth::exec::observe::rig::Rig;
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, StaticScene, ego_at};
+use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
 use pedsynth::exec::observe::{self};
-use pedsynth::exec::simulate;
-use pedsynth::exec::trace::ClipTrace;
-use pedsynth::planner::ClipScript;
+
+mod common;
 
 fn main() {
     divan::main();
@@ -32,8 +27,7 @@ fn main() {
 const TOWNS: [&str; 3] = ["town01_like", "town03_like", "town05_like"];
 
 struct Setup {
-    script: ClipScript,
-    scene: StaticScene,
+    clip: common::BusyClip,
     frame_scene: FrameScene,
     tracer: Tracer,
     pose: Affine3A,
@@ -41,38 +35,20 @@ struct Setup {
 }
 
 fn setup(town: &str) -> Setup {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-    let options = LoadOptions {
-        overrides: vec![format!("dataset.towns=[{town}]")],
-        allow_large: false,
-    };
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).expect("quickstart plans");
-    let script = plan.clips[0].clone();
-    let net = &towns[&script.town].network;
-    let trace: ClipTrace = simulate::simulate(&script, &plan.sim, net);
-    let rig = Rig::from_spec(&plan.spec.sensors);
-    let ann = observe::observe(&script, &trace, &plan.spec, &rig, net).annotations;
-    let mut counts = vec![0u32; trace.frame_count as usize];
-    for r in &ann.rows {
-        counts[r.frame as usize] += 1;
-    }
-    let frame = (0..counts.len())
-        .max_by_key(|&f| (counts[f], std::cmp::Reverse(f)))
-        .unwrap_or(0) as u32;
-    let scene = StaticScene::build(&script, &trace, net);
+    let clip = common::busy_quickstart_clip(&[format!("dataset.towns=[{town}]")]);
     let mut frame_scene = FrameScene::default();
-    frame_scene.build(&scene, &script, &trace, SceneTime::at(frame));
-    let (pos, yaw) = ego_at(&trace, SceneTime::at(frame));
-    let pose = observe::scene_from(&scene, &rig.world_from_lidar(pos, yaw));
-    let mut tracer = Tracer::new(&scene);
+    let t = SceneTime::at(clip.frame);
+    frame_scene.build(&clip.scene, &clip.script, &clip.trace, t);
+    let (pos, yaw) = ego_at(&clip.trace, t);
+    let pose = observe::scene_from(&clip.scene, &clip.rig.world_from_lidar(pos, yaw));
+    let mut tracer = Tracer::new(&clip.scene);
     tracer.set_agents(&frame_scene, &pose);
     Setup {
-        script,
-        scene,
+        lidar: clip.sensors.lidar.clone(),
+        clip,
         frame_scene,
         tracer,
         pose,
-        lidar: plan.spec.sensors.lidar.clone(),
     }
 }
 
@@ -91,10 +67,10 @@ fn tick(bencher: divan::Bencher, mut s: Setup, general_dropoff: f64) {
             &s.lidar,
             30,
             0,
-            s.script.seed,
+            s.clip.script.seed,
             &s.pose,
             &s.tracer,
-            |id| s.frame_scene.prim(&s.scene, id),
+            |id| s.frame_scene.prim(&s.clip.scene, id),
             &mut scratch,
             &mut points,
         )
@@ -128,5 +104,5 @@ fn rebuild_agents(bencher: divan::Bencher, town: &str) {
 #[divan::bench(args = TOWNS)]
 fn build_static(bencher: divan::Bencher, town: &str) {
     let s = setup(town);
-    bencher.bench_local(|| Tracer::new(&s.scene));
+    bencher.bench_local(|| Tracer::new(&s.clip.scene));
 }

@@ -49,10 +49,15 @@ impl AtomicFile {
     /// Moves the complete file to its path (not fsynced: see [`write_atomically_unsynced`]); returns its size
     /// and SHA-256.
     pub fn commit(mut self) -> std::io::Result<(u64, [u8; 32])> {
-        if let Some(file) = self.file.take() {
-            file.into_inner().map_err(|e| e.into_error())?;
+        if let Some(file) = self.file.as_mut() {
+            file.flush()?;
         }
-        std::fs::rename(&self.tmp, &self.path)?;
+        // Closed before the rename; on failure the temporary file goes too.
+        self.file = None;
+        if let Err(e) = std::fs::rename(&self.tmp, &self.path) {
+            std::fs::remove_file(&self.tmp).ok();
+            return Err(e);
+        }
         let hasher = std::mem::take(&mut self.hasher);
         Ok((self.bytes, sha2::Digest::finalize(hasher).into()))
     }

@@ -23,7 +23,7 @@ use pedsynth::exec::observe::rig::Rig;
 use pedsynth::exec::observe::scene::{
     self, FrameScene, Material, Prim, SceneTime, StaticScene, Tri, ego_at, pedestrian_instance, tag,
 };
-use pedsynth::exec::observe::{self};
+use pedsynth::exec::observe::{self, body};
 use pedsynth::exec::read::tables;
 use pedsynth::exec::simulate;
 use pedsynth::exec::write::Layout;
@@ -91,18 +91,23 @@ fn a_wall_at_a_known_distance_is_returned_within_a_millimetre() {
     let pose = Affine3A::from_rotation_translation(glam::Quat::from_rotation_z(yaw), Vec3::new(0.0, 0.0, 1.5));
     let mut tracer = Tracer::new(&stat);
     tracer.set_agents(&FrameScene::default(), &pose);
-    let mut points = Vec::new();
-    let stats = lidar::scan(
-        &l,
-        30,
-        0,
-        7,
-        &pose,
-        &tracer,
-        |id| &stat.prims[id as usize],
-        &mut ScanScratch::default(),
-        &mut points,
-    );
+    let scan = |l: &Lidar| {
+        let mut points = Vec::new();
+        let prim = |id: u32| &stat.prims[id as usize];
+        let stats = lidar::scan(
+            l,
+            30,
+            0,
+            7,
+            &pose,
+            &tracer,
+            prim,
+            &mut ScanScratch::default(),
+            &mut points,
+        );
+        (stats, points)
+    };
+    let (stats, points) = scan(&l);
     assert_eq!(stats.rays, 5 * 360);
     assert!(points.len() > 300, "{} points", points.len());
     for p in &points {
@@ -128,18 +133,7 @@ fn a_wall_at_a_known_distance_is_returned_within_a_millimetre() {
         noise_stddev_m: 0.05,
         ..l.clone()
     };
-    let mut moved = Vec::new();
-    lidar::scan(
-        &noisy,
-        30,
-        0,
-        7,
-        &pose,
-        &tracer,
-        |id| &stat.prims[id as usize],
-        &mut ScanScratch::default(),
-        &mut moved,
-    );
+    let (_, moved) = scan(&noisy);
     assert_eq!(moved.len(), points.len());
     let mut spread = 0.0f64;
     for (a, b) in points.iter().zip(&moved) {
@@ -264,18 +258,49 @@ fn ticks_follow_the_ray_pattern_the_drop_off_model_and_the_sweep() {
 }
 
 #[test]
-fn pedestrians_in_clear_view_get_points() {
+fn pedestrians_in_clear_view_get_points_and_every_pedestrian_point_is_in_its_box() {
     let mut c = quickstart_clip();
     // Without the general drop-off (random by design), and within 30 m the intensity drop-off keeps every
     // return, so a pedestrian in clear view inside the sweep must get points.
     c.lidar.dropoff_general_rate = 0.0;
     assert!((-c.lidar.atmosphere_attenuation_per_m * 30.0).exp() > c.lidar.dropoff_intensity_limit);
     let l = &c.lidar;
+    // Each body of the clip by instance id: (pedestrian index, child?).
+    let mut bodies: BTreeMap<u16, (usize, bool)> = BTreeMap::new();
+    for (i, p) in c.script.pedestrians.iter().enumerate() {
+        bodies.insert(pedestrian_instance(p.id), (i, false));
+        if p.child.is_some() {
+            bodies.insert(scene::CHILD_INSTANCE_BASE + p.id as u16, (i, true));
+        }
+    }
+    let mut inside = 0u64;
     let mut by_frame: BTreeMap<u32, Vec<(u32, u32)>> = BTreeMap::new(); // frame → (actor, points)
     observe::scan_lidar(&c.stat, &c.script, &c.trace, l, &c.rig, |t| {
         let mut counts: BTreeMap<u32, u32> = BTreeMap::new();
+        let (pos, yaw) = ego_at(&c.trace, SceneTime::at(t.frame));
+        let world_from_lidar = c.rig.world_from_lidar(pos, yaw);
         for p in t.points.iter().filter(|p| p.tag == tag::PEDESTRIAN) {
             *counts.entry(u32::from(p.instance)).or_default() += 1;
+            // Every pedestrian point, annotated or not, adult or child, lies in its own body's 3D box + 5 cm.
+            let (pi, child) = bodies[&p.instance];
+            let ps = &c.script.pedestrians[pi];
+            let frame = &c.trace.pedestrians[pi][t.frame as usize];
+            let pose = match (&ps.child, child) {
+                (Some(k), true) => body::pose(frame, k.height_m, body::CHILD_OFFSET_M),
+                _ => body::pose(frame, ps.identity.height_m, DVec3::ZERO),
+            };
+            let (centre, size) = pose.box3d();
+            let world =
+                world_from_lidar.transform_point3(DVec3::new(f64::from(p.x_m), -f64::from(p.y_m), f64::from(p.z_m)));
+            let local = glam::DMat3::from_rotation_z(-pose.yaw_rad) * (world - centre);
+            let half = size * 0.5 + DVec3::splat(0.05);
+            assert!(
+                local.abs().cmple(half).all(),
+                "frame {}: a point of body {} is {local:?} from its box centre (half {half:?})",
+                t.frame,
+                p.instance
+            );
+            inside += 1;
         }
         by_frame.insert(t.frame, counts.into_iter().collect());
         Ok::<(), ()>(())
@@ -330,7 +355,11 @@ fn pedestrians_in_clear_view_get_points() {
             in_sensor.length()
         );
     }
-    eprintln!("pedestrian-frames in clear view within 30 m checked: {checked} ({blocked} blocked)");
+    eprintln!(
+        "pedestrian-frames in clear view within 30 m checked: {checked} ({blocked} blocked); {inside} pedestrian \
+         points inside their bodies' boxes"
+    );
+    assert!(inside >= 1000, "{inside} pedestrian points");
     assert!(checked >= 20, "{checked} pedestrian-frames checked ({blocked} blocked)");
     let _ = &c.net;
 }
@@ -340,28 +369,17 @@ fn generate(overrides: &[&str], out: &Path, jobs: usize) {
     assert_eq!(code, 0, "{stderr}");
 }
 
-/// Overrides for a LiDAR-only dataset of short clips.
-const LIDAR_ONLY: [&str; 6] = [
-    "sensors.rgb.enabled=false",
-    "sensors.depth.enabled=false",
-    "sensors.semantic.enabled=false",
-    "sensors.instance.enabled=false",
-    "sensors.dvs.enabled=false",
-    "dataset.clip_duration_s=[4, 5]",
-];
-
 #[test]
 fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
     let tmp = std::env::temp_dir().join(format!("pedsynth-lidar-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&tmp);
-    let (one, two) = (tmp.join("one"), tmp.join("two"));
-    generate(&LIDAR_ONLY, &one, 1);
-    generate(&LIDAR_ONLY, &two, 2);
-    let files = common::all_files(&one);
-    assert!(
-        files == common::all_files(&two),
-        "--jobs 1 and --jobs 2 wrote different files"
-    );
+    // A LiDAR-only dataset of short clips.
+    let lidar_only: Vec<&str> = common::NO_CAMERAS
+        .into_iter()
+        .chain(["dataset.clip_duration_s=[4, 5]"])
+        .collect();
+    let one = tmp.join("one");
+    let files = common::generate_with_jobs_1_and_2(&spec("quickstart.yaml"), &lidar_only, &tmp);
     let layout = Layout::new(&one);
     let manifest: serde_json::Value = serde_json::from_slice(&files["manifest.json"]).expect("manifest");
     assert!(
@@ -473,7 +491,7 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
     std::fs::remove_file(one.join(format!("tables/clips/{clip0}.parquet"))).expect("rm");
     std::fs::remove_file(one.join(format!("sensors/lidar/{clip0}.parquet"))).expect("rm");
     std::fs::write(one.join(format!("sensors/lidar/.{clip0}.parquet.tmp-99999")), b"half").expect("tmp");
-    generate(&LIDAR_ONLY, &one, 2);
+    generate(&lidar_only, &one, 2);
     assert!(
         common::all_files(&one) == files,
         "a resumed run differs from an uninterrupted one"
@@ -481,7 +499,7 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
 
     // The seed's layout: one .bin per frame with the same points' x y z intensity.
     let bin_dir = tmp.join("bin");
-    let mut overrides = LIDAR_ONLY.to_vec();
+    let mut overrides = lidar_only.clone();
     overrides.push("sensors.lidar.format=carla_bin");
     generate(&overrides, &bin_dir, 2);
     let bins = common::all_files(&bin_dir);

@@ -9,7 +9,7 @@
 //! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
 //!
 //! Also: `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
-//! sensors off (`NO_SENSORS`).
+//! sensors off (`NO_SENSORS`, `NO_CAMERAS`), and the --jobs 1 / --jobs 2 comparison.
 #![allow(dead_code)]
 
 use glam::DVec2;
@@ -219,16 +219,42 @@ pub fn assert_queries(net: &RoadNetwork) {
     assert_crossings(net, 0.5);
 }
 
-/// `--set` overrides that turn every camera stream off: for tests of the tables and the simulation, which
-/// would otherwise render thousands of images (the camera tests render their own, small ones).
-pub const NO_SENSORS: [&str; 6] = [
+/// `--set` overrides that turn every camera stream off.
+pub const NO_CAMERAS: [&str; 5] = [
     "sensors.rgb.enabled=false",
-    "sensors.lidar.enabled=false",
     "sensors.depth.enabled=false",
     "sensors.semantic.enabled=false",
     "sensors.instance.enabled=false",
     "sensors.dvs.enabled=false",
 ];
+
+/// `--set` overrides that turn every sensor off: for tests of the tables and the simulation, which would
+/// otherwise render thousands of images and sweeps (the sensor tests render their own, small ones).
+pub const NO_SENSORS: [&str; 6] = [
+    NO_CAMERAS[0],
+    NO_CAMERAS[1],
+    NO_CAMERAS[2],
+    NO_CAMERAS[3],
+    NO_CAMERAS[4],
+    "sensors.lidar.enabled=false",
+];
+
+/// Generates `input` with `overrides` into `dir/one` with `--jobs 1` and `dir/two` with `--jobs 2`, asserts
+/// that both wrote the same files, and returns them.
+pub fn generate_with_jobs_1_and_2(
+    input: &std::path::Path,
+    overrides: &[&str],
+    dir: &std::path::Path,
+) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let (one, two) = (dir.join("one"), dir.join("two"));
+    for (out, jobs) in [(&one, 1), (&two, 2)] {
+        let (code, _, stderr) = generate(input, overrides, out, Some(jobs));
+        assert_eq!(code, 0, "{stderr}");
+    }
+    let files = all_files(&one);
+    assert!(files == all_files(&two), "--jobs 1 and --jobs 2 wrote different files");
+    files
+}
 
 /// Runs `pedsynth generate` through the library with `--set` overrides (none for a plan file); returns the
 /// exit code, stdout and stderr.

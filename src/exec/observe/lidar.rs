@@ -183,10 +183,10 @@ impl Tracer {
                         | super::scene::tag::ROAD_LINE
                 )
         };
-        let all: Vec<PreTri> = stat.tris.iter().map(PreTri::of).collect();
-        let mut stat_tris: Vec<PreTri> = all.iter().copied().filter(|t| is_ground(t)).collect();
+        let (mut stat_tris, structures): (Vec<PreTri>, Vec<PreTri>) =
+            stat.tris.iter().map(PreTri::of).partition(is_ground);
         let ground_count = stat_tris.len();
-        stat_tris.extend(all.iter().copied().filter(|t| !is_ground(t)));
+        stat_tris.extend(structures);
         let bvh = |tris: &[PreTri]| {
             let leaves: Vec<Aabb> = tris.iter().map(tri_aabb).collect();
             (!leaves.is_empty()).then(|| Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves))
@@ -211,9 +211,7 @@ impl Tracer {
         self.groups.clear();
         self.scratch.clear();
         for (gi, g) in self.agent_tris.chunks(GROUP).enumerate() {
-            let Some(aabb) = g.iter().map(tri_aabb).reduce(|a, b| a.merged(&b)) else {
-                continue;
-            };
+            let aabb = g[1..].iter().fold(tri_aabb(&g[0]), |a, t| a.merged(&tri_aabb(t)));
             // Bounding sphere in the sensor frame, azimuth measured CARLA's way (y right).
             let c = sensor_from_scene.transform_point3(aabb.center());
             let r = aabb.half_extents().length();
@@ -252,13 +250,10 @@ impl Tracer {
         for b in 0..AZIMUTH_BINS {
             self.bin_start[b + 1] += self.bin_start[b];
         }
+        // The (bin, group) pairs in order (an in-place sort: no allocation per tick).
+        self.scratch.sort_unstable();
         self.bin_groups.clear();
-        self.bin_groups.resize(self.scratch.len(), 0);
-        let mut fill = self.bin_start.clone();
-        for &(b, g) in &self.scratch {
-            self.bin_groups[fill[b as usize] as usize] = g;
-            fill[b as usize] += 1;
-        }
+        self.bin_groups.extend(self.scratch.iter().map(|&(_, g)| g));
     }
 
     fn hit_of(tri: &PreTri, t: f32) -> Hit {

@@ -200,10 +200,7 @@ pub fn scan_lidar<E>(
 pub fn sensor_poses(trace: &ClipTrace, rig: &Rig, frame: u32) -> [(&'static str, DAffine3); 2] {
     let (pos, yaw): (DVec3, f64) = scene::ego_at(trace, scene::SceneTime::at(frame));
     [
-        (
-            "camera",
-            rig::world_from_vehicle(pos, yaw) * rig.camera.vehicle_from_sensor,
-        ),
+        ("camera", rig.camera.world_from_sensor(pos, yaw)),
         ("lidar", rig.world_from_lidar(pos, yaw)),
     ]
 }

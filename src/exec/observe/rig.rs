@@ -109,9 +109,14 @@ impl Camera {
         }
     }
 
+    /// The camera's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
+    pub fn world_from_sensor(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.vehicle_from_sensor
+    }
+
     /// The camera on a vehicle at `pos` heading `yaw_rad`.
     pub fn at(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> CameraPose {
-        let world_from_sensor = world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.vehicle_from_sensor;
+        let world_from_sensor = self.world_from_sensor(vehicle_pos, vehicle_yaw_rad);
         let sensor_from_world = world_from_sensor.inverse();
         let optical_from_world = DAffine3::from_mat3(OPTICAL_FROM_SENSOR) * sensor_from_world;
         let rot = world_from_sensor.matrix3;

@@ -130,6 +130,18 @@ pub fn pedestrian_instance(id: u32) -> u16 {
     (1 + id).min(u32::from(CHILD_INSTANCE_BASE) - 1) as u16
 }
 
+/// The actor an instance id belongs to, as the tables number it: the pedestrian id (for a pedestrian and the
+/// child walking with it) or the vehicle id; `None` for the static scene. Undoes [`pedestrian_instance`],
+/// [`CHILD_INSTANCE_BASE`] and [`VEHICLE_INSTANCE_BASE`].
+pub fn actor_of_instance(instance: u16) -> Option<u32> {
+    match instance {
+        0 => None,
+        i if i >= VEHICLE_INSTANCE_BASE => Some(u32::from(i - VEHICLE_INSTANCE_BASE)),
+        i if i >= CHILD_INSTANCE_BASE => Some(u32::from(i - CHILD_INSTANCE_BASE)),
+        i => Some(u32::from(i) - 1),
+    }
+}
+
 /// How a primitive's surface is shaded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Material {
@@ -1139,6 +1151,14 @@ mod tests {
         let sq = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
         assert!(point_in_polygon(&sq, Vec2::splat(0.5)));
         assert!(!point_in_polygon(&sq, Vec2::new(1.5, 0.5)));
+    }
+
+    #[test]
+    fn actor_ids_undo_the_instance_numbering() {
+        assert_eq!(actor_of_instance(0), None);
+        assert_eq!(actor_of_instance(pedestrian_instance(7)), Some(7));
+        assert_eq!(actor_of_instance(CHILD_INSTANCE_BASE + 7), Some(7));
+        assert_eq!(actor_of_instance(VEHICLE_INSTANCE_BASE + 3), Some(3));
     }
 
     #[test]

@@ -23,22 +23,11 @@ use crate::dsl::types::{Lidar, LidarFormat, Output};
 use crate::error::Error;
 use crate::exec::observe::LidarFrame;
 use crate::exec::observe::lidar::LidarPoint;
-use crate::exec::observe::scene::{CHILD_INSTANCE_BASE, VEHICLE_INSTANCE_BASE};
+use crate::exec::observe::scene::actor_of_instance;
 use crate::fsutil::{AtomicFile, write_atomically_unsynced};
 
 /// The stream's name in the sensor index and under `sensors/`.
 pub const STREAM: &str = "lidar";
-
-/// The actor a point's instance belongs to, as the tables number it: the pedestrian id (for a pedestrian and
-/// the child walking with it) or the vehicle id; `None` for the static scene.
-pub fn actor_id(instance: u16) -> Option<u32> {
-    match instance {
-        0 => None,
-        i if i >= VEHICLE_INSTANCE_BASE => Some(u32::from(i - VEHICLE_INSTANCE_BASE)),
-        i if i >= CHILD_INSTANCE_BASE => Some(u32::from(i - CHILD_INSTANCE_BASE)),
-        i => Some(u32::from(i) - 1),
-    }
-}
 
 /// The schema of a clip's LiDAR Parquet file.
 pub fn lidar_schema() -> SchemaRef {
@@ -72,7 +61,9 @@ pub fn lidar_batch(clip_id: &str, frame: u32, timestamp_ns: i64, points: &[Lidar
         f(|p| p.cos_incidence),
         Arc::new(UInt8Array::from_iter_values(points.iter().map(|p| p.tag))),
         Arc::new(UInt16Array::from_iter_values(points.iter().map(|p| p.instance))),
-        Arc::new(UInt32Array::from_iter(points.iter().map(|p| actor_id(p.instance)))),
+        Arc::new(UInt32Array::from_iter(
+            points.iter().map(|p| actor_of_instance(p.instance)),
+        )),
     ];
     RecordBatch::try_new(lidar_schema(), columns).expect("columns match their schema")
 }
@@ -179,15 +170,6 @@ impl<'a> ClipLidarWriter<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::exec::observe::scene::pedestrian_instance;
-
-    #[test]
-    fn actor_ids_undo_the_instance_numbering() {
-        assert_eq!(actor_id(0), None);
-        assert_eq!(actor_id(pedestrian_instance(7)), Some(7));
-        assert_eq!(actor_id(CHILD_INSTANCE_BASE + 7), Some(7));
-        assert_eq!(actor_id(VEHICLE_INSTANCE_BASE + 3), Some(3));
-    }
 
     #[test]
     fn carla_bin_is_four_little_endian_floats_per_point() {
