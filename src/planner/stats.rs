@@ -34,9 +34,9 @@ pub const DEPTH_PNG_BYTES_PER_PIXEL: f64 = 0.038;
 pub const SEMANTIC_PNG_BYTES_PER_PIXEL: f64 = 0.019;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
 pub const INSTANCE_PNG_BYTES_PER_PIXEL: f64 = 0.013;
-/// CPU time to render, encode and write all camera streams of one frame, per pixel, release build: 237 CPU-s
-/// for 1,070 frames of 1280 × 720 (BENCHMARKS.md, "Cameras").
-pub const CAMERA_CPU_S_PER_PIXEL: f64 = 2.4e-7;
+/// CPU time to render, encode and write all camera streams of one frame, per pixel, release build (thin LTO):
+/// 124.2 CPU-s for 1,070 frames of 1280 × 720 with the LiDAR, less its 10.4 CPU-s (BENCHMARKS.md, "Cameras").
+pub const CAMERA_CPU_S_PER_PIXEL: f64 = 1.15e-7;
 /// Bytes of the LiDAR Parquet (zstd) per expected point (`pps / fps × (1 − general drop-off)` per frame: rays
 /// that hit nothing and the intensity drop-off are in the figure), measured on `specs/quickstart.yaml`:
 /// 157.2 MB for 1,070 frames (BENCHMARKS.md, "LiDAR").

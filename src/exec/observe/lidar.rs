@@ -123,7 +123,9 @@ pub struct Tracer {
     /// CSR of group ids by azimuth bin (sensor frame, CARLA's azimuth: 0 forward, positive to the right).
     bin_start: Vec<u32>,
     bin_groups: Vec<u32>,
+    /// Scratch of the rebuild: (bin, group) pairs and a fill cursor per bin.
     scratch: Vec<(u32, u32)>,
+    cursor: Vec<u32>,
 }
 
 impl std::fmt::Debug for Tracer {
@@ -250,10 +252,15 @@ impl Tracer {
         for b in 0..AZIMUTH_BINS {
             self.bin_start[b + 1] += self.bin_start[b];
         }
-        // The (bin, group) pairs in order (an in-place sort: no allocation per tick).
-        self.scratch.sort_unstable();
+        // Counting sort of the (bin, group) pairs into the bins, with a cursor per bin kept between ticks.
         self.bin_groups.clear();
-        self.bin_groups.extend(self.scratch.iter().map(|&(_, g)| g));
+        self.bin_groups.resize(self.scratch.len(), 0);
+        self.cursor.clear();
+        self.cursor.extend_from_slice(&self.bin_start);
+        for &(b, g) in &self.scratch {
+            self.bin_groups[self.cursor[b as usize] as usize] = g;
+            self.cursor[b as usize] += 1;
+        }
     }
 
     fn hit_of(tri: &PreTri, t: f32) -> Hit {
