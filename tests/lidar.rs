@@ -159,11 +159,16 @@ struct Clip {
 }
 
 fn quickstart_clip() -> Clip {
+    clip_of(&spec("quickstart.yaml"))
+}
+
+/// The first clip of a spec, simulated, annotated and with its static scene.
+fn clip_of(spec_path: &Path) -> Clip {
     let options = LoadOptions {
         overrides: Vec::new(),
         allow_large: false,
     };
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&spec("quickstart.yaml"), &options).expect("plans");
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(spec_path, &options).expect("plans");
     let script = plan.clips[0].clone();
     let net = towns[&script.town].network.clone();
     let trace = simulate::simulate(&script, &plan.sim, &net);
@@ -178,6 +183,74 @@ fn quickstart_clip() -> Clip {
         stat,
         annotations,
         net,
+    }
+}
+
+/// Möller–Trumbore, written out here independently of the tracer: the distance along the unit ray.
+fn brute_force_hit(t: &Tri, o: Vec3, d: Vec3) -> Option<f32> {
+    let (e1, e2) = (t.v[1] - t.v[0], t.v[2] - t.v[0]);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let s = o - t.v[0];
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = d.dot(q) / det;
+    let dist = e2.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && dist > 1e-4).then_some(dist)
+}
+
+#[test]
+fn the_static_acceleration_structures_return_the_nearest_triangle() {
+    // A built-in town and the real CARLA Town01 (OpenDRIVE heights): rays from sensor-like positions along
+    // the ego's path, in every direction the sensor casts, against every static triangle by brute force.
+    let mut specs = vec![spec("quickstart.yaml")];
+    if common::carla_map("Town01").is_some() {
+        specs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/carla_town01.yaml"));
+    }
+    for spec_path in specs {
+        let c = clip_of(&spec_path);
+        let tracer = Tracer::new(&c.stat);
+        let mut rng = 0x5eed_u64;
+        let mut next = move || {
+            rng = pedsynth::mix::splitmix64(rng);
+            (rng >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut rays, mut hits) = (0, 0);
+        for f in (0..c.trace.ego.len() as u32).step_by(7) {
+            let (pos, yaw) = ego_at(&c.trace, SceneTime::at(f));
+            let pose = observe::scene_from(&c.stat, &c.rig.world_from_lidar(pos, yaw));
+            let o: Vec3 = pose.translation.into();
+            for _ in 0..60 {
+                let azimuth = next() * std::f32::consts::TAU;
+                let elevation = (next() * 40.0 - 25.0).to_radians();
+                let d = Vec3::new(
+                    elevation.cos() * azimuth.cos(),
+                    elevation.cos() * azimuth.sin(),
+                    elevation.sin(),
+                );
+                let expected = c
+                    .stat
+                    .tris
+                    .iter()
+                    .filter_map(|t| brute_force_hit(t, o, d))
+                    .filter(|&t| t < 100.0)
+                    .fold(None, |best: Option<f32>, t| Some(best.map_or(t, |b| b.min(t))));
+                let mut hint = u32::MAX;
+                let got = tracer.cast_static(o, d, 100.0, &mut hint).map(|h| h.distance_m);
+                match (got, expected) {
+                    (Some(g), Some(e)) => {
+                        assert!((g - e).abs() < 1e-3, "{}: frame {f}: {g} vs {e}", spec_path.display())
+                    }
+                    (g, e) => assert_eq!(g, e, "{}: frame {f}, ray {d}", spec_path.display()),
+                }
+                rays += 1;
+                hits += usize::from(expected.is_some());
+            }
+        }
+        assert!(hits * 2 > rays, "{}: {hits} of {rays} rays hit", spec_path.display());
     }
 }
 

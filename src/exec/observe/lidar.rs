@@ -3,10 +3,12 @@
 //! CARLA's semantic LiDAR adds (cosine of the incidence angle, semantic tag, instance), traced against the
 //! scene the cameras render ([`super::scene`]): a pedestrian's points, pixels and box come from one geometry.
 //!
-//! Acceleration: the static triangles of a clip sit in a parry3d BVH built once per clip; the frame's agents
-//! (vehicles and bodies, a few thousand triangles) in a second BVH over groups of [`GROUP`] consecutive
-//! triangles, rebuilt every tick. A ray is cast against the static BVH up to the range, then against the
-//! agents up to the static hit.
+//! Acceleration: a clip's static triangles are built once into two structures: the low ground-hugging ones
+//! (roads, sidewalks, curbs, terrain, markings) into a 2D grid with heights per cell
+//! ([`height_grid`]), the rest (buildings, trees, poles) into a parry3d BVH. The frame's agents (vehicles
+//! and bodies, a few thousand triangles) go per tick into an angular index: groups of [`GROUP`] consecutive
+//! triangles binned by the azimuth under which the sensor sees them. A ray is cast against the ground grid
+//! up to the range, the structures up to the ground hit, then the agents up to the static hit.
 //!
 //! Frames: rays are generated in CARLA's sensor frame (x forward, y right, z up: left-handed, as CARLA writes
 //! its points) and turned into the scene by the sensor's pose (x forward, y left, z up, right-handed) with y
@@ -24,8 +26,12 @@ use rand_distr::{Distribution, StandardNormal};
 use super::scene::{FrameScene, Prim, StaticScene, Tri};
 use crate::dsl::types::Lidar;
 use crate::mix::splitmix64;
+use height_grid::HeightGrid;
 
-/// Triangles per leaf of the agents' BVH (consecutive triangles of one box or capsule lie together).
+mod height_grid;
+
+/// Triangles per group of the agents' index at most (consecutive triangles of one box or capsule lie
+/// together; a group never mixes two agents).
 pub const GROUP: usize = 8;
 
 /// A triangle prepared for the Möller–Trumbore test.
@@ -92,6 +98,10 @@ pub struct Hit {
     pub normal: Vec3,
 }
 
+/// Ground triangles (road, sidewalk, terrain, ground and marking tags) rise at most this much, metres: curbs
+/// are, walls are not.
+const GROUND_HEIGHT_M: f32 = 0.5;
+
 /// Azimuth bins of the agents' angular index (0.5° each).
 const AZIMUTH_BINS: usize = 720;
 
@@ -100,20 +110,25 @@ const AZIMUTH_BINS: usize = 720;
 #[derive(Clone, Copy, Debug)]
 struct AgentGroup {
     aabb: Aabb,
+    /// The group's triangles: `agent_tris[first..end]`.
+    first: u32,
+    end: u32,
     /// Elevation interval in the sensor frame, radians.
     elevation: (f32, f32),
 }
 
-/// Ray casting against a clip's scene: the static triangles in a BVH (built once per clip) and the agents'
-/// triangles in groups indexed by the direction under which the sensor sees them (rebuilt per tick).
+/// Ray casting against a clip's scene: the static triangles in a ground grid and a structures BVH (built once
+/// per clip) and the agents' triangles in groups indexed by the direction under which the sensor sees them
+/// (rebuilt per tick).
 #[derive(Default)]
 pub struct Tracer {
-    /// Static triangles: the ground's (horizontal road, sidewalk and terrain surfaces) first, then the rest.
+    /// Static triangles: the ground's (road, sidewalk, curb, terrain and marking surfaces no higher than
+    /// [`GROUND_HEIGHT_M`]) first, then the rest.
     stat_tris: Vec<PreTri>,
     /// How many of `stat_tris` are ground.
     ground_count: usize,
-    /// BVH of the ground triangles (leaf `i` is triangle `i`).
-    ground_bvh: Option<Bvh>,
+    /// Grid of the ground triangles (index `i` is triangle `i`).
+    ground: HeightGrid,
     /// BVH of the other static triangles (leaf `i` is triangle `ground_count + i`).
     structure_bvh: Option<Bvh>,
     agent_tris: Vec<PreTri>,
@@ -171,11 +186,13 @@ fn slab(aabb: &Aabb, o: Vec3, inv_d: Vec3, max_t: f32) -> bool {
 impl Tracer {
     /// A tracer for a clip's static scene.
     pub fn new(stat: &StaticScene) -> Tracer {
-        // Two BVHs: flat ground boxes and tall structures mixed in one tree make every node tall and wide, so
-        // a ray grazing the ground would enter most of them.
+        // Flat ground boxes and tall structures mixed in one tree would make every node tall and wide, so a
+        // ray grazing the ground would enter most of them: the ground goes into a grid of its own.
         let is_ground = |t: &PreTri| {
             let tag = stat.prims.get(t.prim as usize).map_or(0, |p| p.tag);
-            t.normal.z.abs() > 0.9
+            let z = [t.v0.z, t.v0.z + t.e1.z, t.v0.z + t.e2.z];
+            z.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b)) - z.iter().fold(f32::INFINITY, |a, &b| a.min(b))
+                <= GROUND_HEIGHT_M
                 && matches!(
                     tag,
                     super::scene::tag::ROAD
@@ -189,13 +206,10 @@ impl Tracer {
             stat.tris.iter().map(PreTri::of).partition(is_ground);
         let ground_count = stat_tris.len();
         stat_tris.extend(structures);
-        let bvh = |tris: &[PreTri]| {
-            let leaves: Vec<Aabb> = tris.iter().map(tri_aabb).collect();
-            (!leaves.is_empty()).then(|| Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves))
-        };
+        let leaves: Vec<Aabb> = stat_tris[ground_count..].iter().map(tri_aabb).collect();
         Tracer {
-            ground_bvh: bvh(&stat_tris[..ground_count]),
-            structure_bvh: bvh(&stat_tris[ground_count..]),
+            ground: HeightGrid::new(&stat_tris[..ground_count]),
+            structure_bvh: (!leaves.is_empty()).then(|| Bvh::from_leaves(BvhBuildStrategy::Binned, &leaves)),
             stat_tris,
             ground_count,
             ..Tracer::default()
@@ -212,7 +226,25 @@ impl Tracer {
         let sensor_from_scene = scene_from_sensor.inverse();
         self.groups.clear();
         self.scratch.clear();
-        for (gi, g) in self.agent_tris.chunks(GROUP).enumerate() {
+        // Groups of up to GROUP consecutive triangles of one agent (a group spanning two agents would have a
+        // bounding sphere as large as the distance between them).
+        let instance = |t: &PreTri| {
+            t.prim
+                .checked_sub(frame.mesh.base)
+                .and_then(|i| frame.mesh.prims.get(i as usize))
+                .map(|p| p.instance)
+        };
+        let mut first = 0;
+        while first < self.agent_tris.len() {
+            let who = instance(&self.agent_tris[first]);
+            let mut end = first + 1;
+            while end < self.agent_tris.len() && end - first < GROUP && instance(&self.agent_tris[end]) == who {
+                end += 1;
+            }
+            let g = &self.agent_tris[first..end];
+            let gi = self.groups.len();
+            let (group_first, group_end) = (first as u32, end as u32);
+            first = end;
             let aabb = g[1..].iter().fold(tri_aabb(&g[0]), |a, t| a.merged(&tri_aabb(t)));
             // Bounding sphere in the sensor frame, azimuth measured CARLA's way (y right).
             let c = sensor_from_scene.transform_point3(aabb.center());
@@ -226,7 +258,12 @@ impl Tracer {
                 let a = (r / dist).asin();
                 (e - a, e + a)
             };
-            self.groups.push(AgentGroup { aabb, elevation });
+            self.groups.push(AgentGroup {
+                aabb,
+                first: group_first,
+                end: group_end,
+                elevation,
+            });
             let g = gi as u32;
             if horizontal <= r * 1.001 {
                 self.scratch.extend((0..AZIMUTH_BINS as u32).map(|b| (b, g)));
@@ -283,13 +320,17 @@ impl Tracer {
                 limit = t;
                 *hint as usize
             });
-        let ray = Ray::new(o, d);
-        for (bvh, offset) in [(&self.structure_bvh, self.ground_count), (&self.ground_bvh, 0)] {
-            let Some(bvh) = bvh else { continue };
+        // The ground first: its hit bounds the structures' search.
+        if let Some((i, t)) = self.ground.cast(&self.stat_tris[..self.ground_count], o, d, limit) {
+            limit = t;
+            best = Some(i);
+        }
+        if let Some(bvh) = &self.structure_bvh {
             let found = std::cell::Cell::new(usize::MAX);
             // The best distance so far bounds the search (slightly enlarged, so that an equal hit in the BVH
             // is its own nearest, deterministically).
-            if let Some((_, t)) = bvh.cast_ray(&ray, limit * (1.0 + 1e-6) + 1e-6, |leaf, best_t| {
+            let offset = self.ground_count;
+            if let Some((_, t)) = bvh.cast_ray(&Ray::new(o, d), limit * (1.0 + 1e-6) + 1e-6, |leaf, best_t| {
                 let t = self.stat_tris[offset + leaf as usize].hit(o, d, best_t)?;
                 found.set(offset + leaf as usize);
                 Some(t)
@@ -309,11 +350,10 @@ impl Tracer {
         let inv = d.recip();
         let mut limit = max_m;
         let mut best = None;
-        for (gi, g) in self.groups.iter().enumerate() {
+        for g in &self.groups {
             if slab(&g.aabb, o, inv, limit) {
-                let first = gi * GROUP;
-                let tris = &self.agent_tris[first..(first + GROUP).min(self.agent_tris.len())];
-                best = nearest(tris, first, o, d, &mut limit).or(best);
+                let tris = &self.agent_tris[g.first as usize..g.end as usize];
+                best = nearest(tris, g.first as usize, o, d, &mut limit).or(best);
             }
         }
         best.map(|i| Self::hit_of(&self.agent_tris[i], limit))
@@ -336,9 +376,8 @@ impl Tracer {
             if elevation_rad < g.elevation.0 || elevation_rad > g.elevation.1 || !slab(&g.aabb, o, inv, limit) {
                 continue;
             }
-            let first = gi as usize * GROUP;
-            let tris = &self.agent_tris[first..(first + GROUP).min(self.agent_tris.len())];
-            best = nearest(tris, first, o, d, &mut limit).or(best);
+            let tris = &self.agent_tris[g.first as usize..g.end as usize];
+            best = nearest(tris, g.first as usize, o, d, &mut limit).or(best);
         }
         best.map(|i| Self::hit_of(&self.agent_tris[i], limit))
     }
