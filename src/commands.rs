@@ -320,6 +320,23 @@ pub fn preview(
     emit(out, &text)
 }
 
+/// `pedsynth export FORMAT DIR --out OUT`: a finished dataset in a format other tools read.
+pub fn export(
+    dir: &Path,
+    format: crate::exec::export::Format,
+    to: &Path,
+    link: crate::exec::export::LinkMode,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<(), Error> {
+    let mut warnings = Vec::new();
+    let text = crate::exec::export::export(dir, format, to, link, &mut |w| warnings.push(w))?;
+    for w in warnings {
+        writeln!(err, "{w}").map_err(Error::output)?;
+    }
+    emit(out, &text)
+}
+
 /// Loads a spec file, its towns and its full plan: the programmatic path to a plan (tests, benchmarks, tools).
 pub fn plan_spec_file(
     path: &Path,

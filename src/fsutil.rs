@@ -89,7 +89,7 @@ impl Drop for AtomicFile {
 }
 
 /// The temporary name under which `path` is written: `.<name>.tmp-<pid>` in the same directory.
-fn temporary_path(path: &Path) -> std::path::PathBuf {
+pub(crate) fn temporary_path(path: &Path) -> std::path::PathBuf {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())

@@ -113,6 +113,24 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// Export a finished dataset in a format the field's own tools read unmodified (PIE's `pie_data.py`,
+    /// PedestrianActionBenchmark's pose files).
+    Export {
+        /// Format to write.
+        #[arg(value_enum)]
+        format: pedsynth::exec::export::Format,
+        /// Dataset directory (written by `pedsynth generate`, every clip done).
+        dir: PathBuf,
+        /// Output directory (re-running resumes: complete files are kept).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// How images get there from the dataset's sensors/.
+        #[arg(long, value_enum, default_value = "hard")]
+        link: pedsynth::exec::export::LinkMode,
+        /// Copy images (same as `--link copy`).
+        #[arg(long, conflicts_with = "link")]
+        copy: bool,
+    },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
     /// Inspect towns.
@@ -265,6 +283,20 @@ fn main() -> ExitCode {
                 },
                 &mut out,
             )
+        }
+        Command::Export {
+            format,
+            dir,
+            out: to,
+            link,
+            copy,
+        } => {
+            let link = if copy {
+                pedsynth::exec::export::LinkMode::Copy
+            } else {
+                link
+            };
+            commands::export(&dir, format, &to, link, &mut out, &mut err)
         }
         Command::Schema => commands::schema(&mut out),
         Command::Town {

@@ -11,7 +11,9 @@
 //! - [`write`] — the only code that touches the output directory: layout, tables, sensor files, manifest.
 //! - [`generate`] — orchestration of `pedsynth generate`: clips in parallel, resume, progress.
 //! - [`read`] — code that reads a written dataset (`pedsynth stats`), never re-simulating.
+//! - [`export`] — `pedsynth export`: a written dataset in other tools' layouts (PIE, PedestrianActionBenchmark).
 
+pub mod export;
 pub mod generate;
 pub mod observe;
 pub mod read;

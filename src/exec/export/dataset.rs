@@ -1,0 +1,286 @@
+//! A finished dataset as the exporters see it: the manifest checked (every clip done, every table file's
+//! blake3 as the manifest says), the resolved spec (camera, towns) and the tables an export needs, per clip.
+//! Exporters read only this — never the simulator — so they work on any finished dataset.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use arrow_array::Array;
+
+use crate::dsl::{LoadOptions, Spec};
+use crate::error::{Error, code};
+use crate::exec::read::tables;
+use crate::exec::write::{Layout, Manifest};
+
+/// One annotated pedestrian-frame.
+#[derive(Clone, Debug)]
+pub struct AnnotatedFrame {
+    pub frame: u32,
+    /// `[x_min, y_min, x_max, y_max]`, pixels.
+    pub bbox_px: [f32; 4],
+    /// Crossing label C.
+    pub crossing: bool,
+    pub state: String,
+    pub occlusion: f32,
+    /// Ground speed, m/s.
+    pub speed_mps: f32,
+    /// World ground position.
+    pub x_m: f32,
+    pub y_m: f32,
+    /// Keypoints as written: 17 (COCO) or 18 (OpenPose) `u, v, flag` triplets.
+    pub keypoints: Vec<f32>,
+}
+
+/// One pedestrian with its annotated frames (in frame order).
+#[derive(Clone, Debug)]
+pub struct Pedestrian {
+    pub id: u32,
+    pub age_group: String,
+    pub gender: String,
+    pub crosser: bool,
+    pub intention_frame: Option<u32>,
+    pub frames: Vec<AnnotatedFrame>,
+}
+
+/// The ego's state in one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct EgoFrame {
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub yaw_rad: f64,
+    pub speed_mps: f64,
+    pub accel_mps2: f64,
+}
+
+/// One traffic vehicle in one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct VehicleFrame {
+    pub frame: u32,
+    pub vehicle: u32,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub yaw_rad: f64,
+}
+
+/// One clip's tables.
+#[derive(Clone, Debug)]
+pub struct Clip {
+    pub clip_id: String,
+    pub town: String,
+    pub split: String,
+    pub fps: u32,
+    pub frame_count: u32,
+    /// Indexed by frame.
+    pub ego: Vec<EgoFrame>,
+    /// By pedestrian id.
+    pub pedestrians: BTreeMap<u32, Pedestrian>,
+    /// Sorted by (vehicle, frame).
+    pub vehicles: Vec<VehicleFrame>,
+}
+
+/// A finished dataset.
+pub struct Dataset {
+    pub layout: Layout,
+    pub manifest: Manifest,
+    pub spec: Spec,
+    /// The clips, sorted by id.
+    pub clips: Vec<Clip>,
+}
+
+fn refuse(msg: String) -> Error {
+    Error::new(code::DATASET_INVALID, msg)
+}
+
+impl Dataset {
+    /// Opens a dataset, refusing an unfinished or altered one.
+    pub fn open(dir: &Path) -> Result<Dataset, Error> {
+        let layout = Layout::new(dir);
+        let path = layout.manifest();
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            refuse(format!(
+                "{}: {e} (is {} a pedsynth dataset?)",
+                path.display(),
+                dir.display()
+            ))
+        })?;
+        let manifest = Manifest::parse(&text, &path.display().to_string())?;
+        let pending: Vec<&str> = manifest
+            .clips
+            .iter()
+            .filter(|c| c.status != "done")
+            .map(|c| c.clip_id.as_str())
+            .collect();
+        if !pending.is_empty() {
+            return Err(refuse(format!(
+                "{}: {} of {} clips are not generated yet (first: {}); finish the dataset with `pedsynth generate` first",
+                dir.display(),
+                pending.len(),
+                manifest.clips.len(),
+                pending[0]
+            )));
+        }
+        for c in &manifest.clips {
+            for (table, hash) in &c.files {
+                let file = layout.table(table, &c.clip_id);
+                let bytes = std::fs::read(&file).map_err(|e| refuse(format!("{}: {e}", file.display())))?;
+                if blake3::hash(&bytes).to_hex().as_str() != hash {
+                    return Err(refuse(format!(
+                        "{}: its blake3 differs from the manifest's: the file was changed after `generate` wrote it",
+                        file.display()
+                    )));
+                }
+            }
+        }
+        let spec_path = layout.spec_resolved();
+        let bytes = std::fs::read(&spec_path).map_err(|e| refuse(format!("{}: {e}", spec_path.display())))?;
+        let options = LoadOptions {
+            overrides: Vec::new(),
+            allow_large: true,
+        };
+        let spec = crate::dsl::load_bytes(&bytes, &spec_path.display().to_string(), dir, &options)
+            .map_err(|e| refuse(format!("{}: not a valid spec: {e}", spec_path.display())))?
+            .spec;
+        let mut clips = Vec::with_capacity(manifest.clips.len());
+        for c in &manifest.clips {
+            clips.push(read_clip(&layout, &c.clip_id)?);
+        }
+        clips.sort_by(|a, b| a.clip_id.cmp(&b.clip_id));
+        Ok(Dataset {
+            layout,
+            manifest,
+            spec,
+            clips,
+        })
+    }
+}
+
+fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
+    let file = |t: &str| layout.table(t, clip_id);
+    let mut clip = None;
+    for b in tables::read(&file("clips"), &["town", "split", "fps", "frame_count"])? {
+        let (town, split) = (b.strings("town")?, b.strings("split")?);
+        let (fps, frames) = (b.u32s("fps")?, b.u32s("frame_count")?);
+        if b.rows() > 0 {
+            clip = Some(Clip {
+                clip_id: clip_id.to_owned(),
+                town: town[0].to_owned(),
+                split: split[0].to_owned(),
+                fps: fps.value(0),
+                frame_count: frames.value(0),
+                ego: Vec::new(),
+                pedestrians: BTreeMap::new(),
+                vehicles: Vec::new(),
+            });
+        }
+    }
+    let mut clip = clip.ok_or_else(|| refuse(format!("{}: no row", file("clips").display())))?;
+    let cols = [
+        "frame",
+        "ego_x_m",
+        "ego_y_m",
+        "ego_z_m",
+        "ego_yaw_rad",
+        "ego_speed_mps",
+        "ego_accel_mps2",
+    ];
+    for b in tables::read(&file("frames"), &cols)? {
+        let f = b.u32s("frame")?;
+        let v: Vec<_> = cols[1..].iter().map(|c| b.f64s(c)).collect::<Result<_, _>>()?;
+        for i in 0..b.rows() {
+            if f.value(i) as usize != clip.ego.len() {
+                return Err(refuse(format!("{}: frames out of order", file("frames").display())));
+            }
+            clip.ego.push(EgoFrame {
+                x_m: v[0].value(i),
+                y_m: v[1].value(i),
+                z_m: v[2].value(i),
+                yaw_rad: v[3].value(i),
+                speed_mps: v[4].value(i),
+                accel_mps2: v[5].value(i),
+            });
+        }
+    }
+    let cols = ["pedestrian", "age_group", "gender", "crosser", "intention_frame"];
+    for b in tables::read(&file("pedestrians"), &cols)? {
+        let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
+        let (crosser, intention) = (b.bools("crosser")?, b.u32s("intention_frame")?);
+        for i in 0..b.rows() {
+            clip.pedestrians.insert(
+                id.value(i),
+                Pedestrian {
+                    id: id.value(i),
+                    age_group: age[i].to_owned(),
+                    gender: gender[i].to_owned(),
+                    crosser: crosser.value(i),
+                    intention_frame: (!intention.is_null(i)).then(|| intention.value(i)),
+                    frames: Vec::new(),
+                },
+            );
+        }
+    }
+    let cols = [
+        "frame",
+        "pedestrian",
+        "bbox_x_min",
+        "bbox_y_min",
+        "bbox_x_max",
+        "bbox_y_max",
+        "crossing",
+        "state",
+        "occlusion",
+        "vx_mps",
+        "vy_mps",
+        "x_m",
+        "y_m",
+        "keypoints",
+    ];
+    for b in tables::read(&file("annotations"), &cols)? {
+        let (frame, ped) = (b.u32s("frame")?, b.u32s("pedestrian")?);
+        let bbox: Vec<_> = cols[2..6].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+        let (crossing, state, occlusion) = (b.bools("crossing")?, b.strings("state")?, b.f32s("occlusion")?);
+        let (vx, vy, x, y) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?, b.f32s("x_m")?, b.f32s("y_m")?);
+        let (kp, width) = b.f32_lists("keypoints")?;
+        for i in 0..b.rows() {
+            let p = clip.pedestrians.get_mut(&ped.value(i)).ok_or_else(|| {
+                refuse(format!(
+                    "{}: pedestrian {} is not in the pedestrians table",
+                    file("annotations").display(),
+                    ped.value(i)
+                ))
+            })?;
+            p.frames.push(AnnotatedFrame {
+                frame: frame.value(i),
+                bbox_px: [bbox[0].value(i), bbox[1].value(i), bbox[2].value(i), bbox[3].value(i)],
+                crossing: crossing.value(i),
+                state: state[i].to_owned(),
+                occlusion: occlusion.value(i),
+                speed_mps: vx.value(i).hypot(vy.value(i)),
+                x_m: x.value(i),
+                y_m: y.value(i),
+                keypoints: kp[i * width..(i + 1) * width].to_vec(),
+            });
+        }
+    }
+    for p in clip.pedestrians.values_mut() {
+        p.frames.sort_by_key(|f| f.frame);
+    }
+    let cols = ["frame", "vehicle", "x_m", "y_m", "z_m", "yaw_rad"];
+    for b in tables::read(&file("vehicles"), &cols)? {
+        let (frame, vehicle) = (b.u32s("frame")?, b.u32s("vehicle")?);
+        let v: Vec<_> = cols[2..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+        for i in 0..b.rows() {
+            clip.vehicles.push(VehicleFrame {
+                frame: frame.value(i),
+                vehicle: vehicle.value(i),
+                x_m: f64::from(v[0].value(i)),
+                y_m: f64::from(v[1].value(i)),
+                z_m: f64::from(v[2].value(i)),
+                yaw_rad: f64::from(v[3].value(i)),
+            });
+        }
+    }
+    clip.vehicles.sort_by_key(|v| (v.vehicle, v.frame));
+    Ok(clip)
+}

@@ -1,0 +1,133 @@
+//! `pedsynth export FORMAT DATASET --out DIR`: a finished dataset in the layouts the field's own tools read.
+//!
+//! - [`dataset`] — the dataset as exporters see it (manifest checked, tables per clip, resolved spec).
+//! - [`pie`] — PIE's annotations, attributes, ego-vehicle files and images (`pie_data.py` loads them).
+//! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE export.
+//!
+//! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
+//! renamed, so an interrupted export leaves complete files only and re-running it finishes the job.
+
+pub mod dataset;
+pub mod pab;
+pub mod pie;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use crate::error::Error;
+use crate::planner::TownContext;
+
+/// Export formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// PIE (`pie_data.py`): annotations/, annotations_attributes/, annotations_vehicle/, images/.
+    Pie,
+    /// PedestrianActionBenchmark's poses/pose_setNN.pkl for the PIE export.
+    PabPoses,
+}
+
+/// How images get into an export.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LinkMode {
+    /// Hard links (the default; falls back to a copy across file systems).
+    #[default]
+    Hard,
+    /// Symbolic links to the dataset's files.
+    Symlink,
+    /// Copies.
+    Copy,
+}
+
+impl std::fmt::Display for LinkMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LinkMode::Hard => "hard links",
+            LinkMode::Symlink => "symbolic links",
+            LinkMode::Copy => "copies",
+        })
+    }
+}
+
+/// Writes a file under a temporary name, then renames it (creating its directory).
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
+    }
+    crate::fsutil::write_atomically_unsynced(path, bytes).map_err(|e| Error::write(path, e))
+}
+
+/// Puts `from` at `to` as `mode` says; an existing `to` of the same size is kept (a resumed export).
+pub(crate) fn link_file(from: &Path, to: &Path, mode: LinkMode) -> Result<(), Error> {
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len());
+    if let (Ok(a), Ok(b)) = (size(from), size(to))
+        && a == b
+    {
+        return Ok(());
+    }
+    let _ = std::fs::remove_file(to);
+    let tmp = crate::fsutil::temporary_path(to);
+    let result = match mode {
+        LinkMode::Hard => std::fs::hard_link(from, &tmp).or_else(|_| std::fs::copy(from, &tmp).map(|_| ())),
+        LinkMode::Symlink => {
+            let target = std::path::absolute(from).map_err(|e| Error::read(from, e))?;
+            std::os::unix::fs::symlink(target, &tmp)
+        }
+        LinkMode::Copy => std::fs::copy(from, &tmp).map(|_| ()),
+    };
+    result.and_then(|()| std::fs::rename(&tmp, to)).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::write(to, e)
+    })
+}
+
+/// The dataset's towns, for map attributes; a town that cannot be loaded (an OpenDRIVE file not found
+/// beside the dataset) is left out with a warning.
+pub(crate) fn towns(ds: &dataset::Dataset, warn: &mut dyn FnMut(String)) -> BTreeMap<String, TownContext> {
+    match crate::commands::load_spec_towns(&ds.spec, ds.layout.root()) {
+        Ok(towns) => towns,
+        Err(e) => {
+            warn(format!(
+                "warning: the towns cannot be loaded ({e}); intersection, num_lanes, signalized and \
+                 traffic_direction are written as unknown (midblock, 0, n/a, TW)"
+            ));
+            BTreeMap::new()
+        }
+    }
+}
+
+/// Runs an export; returns the summary lines to print.
+pub fn export(
+    dir: &Path,
+    format: Format,
+    out: &Path,
+    link: LinkMode,
+    warn: &mut dyn FnMut(String),
+) -> Result<String, Error> {
+    let ds = dataset::Dataset::open(dir)?;
+    std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+    Ok(match format {
+        Format::Pie => {
+            let r = pie::export(&ds, out, link, warn)?;
+            format!(
+                "{}: PIE layout of {} clips: {} videos, {} pedestrian tracks, {} vehicle tracks, {} images\n{}\n",
+                out.display(),
+                ds.clips.len(),
+                r.videos,
+                r.pedestrian_tracks,
+                r.vehicle_tracks,
+                r.images,
+                r.images_note
+            )
+        }
+        Format::PabPoses => {
+            let r = pab::export(&ds, out)?;
+            format!(
+                "{}: {} pose files (poses/pose_setNN.pkl), {} pedestrian-frames, {} with a pose\n",
+                out.display(),
+                r.files,
+                r.entries,
+                r.with_pose
+            )
+        }
+    })
+}

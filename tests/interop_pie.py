@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""Interop check: PIE's own loader and PedestrianActionBenchmark's own `get_pose`, unmodified, read
+`pedsynth export pie` and `pedsynth export pab-poses`, and what they return equals our tables.
+
+Usage: python3 tests/interop_pie.py DATASET --pedsynth BIN [--no-poses]
+
+--no-poses skips the pose files (a large dataset's pickles hold 36 floats per annotated pedestrian-frame).
+
+The loaders are imported from ../shared/interfaces (not copied). PedestrianActionBenchmark's utils.py imports
+TensorFlow for an image helper that get_pose does not use; a stub module stands in for it (the file itself is
+unchanged). Our side is read with pyarrow alone. Exits 1 with the first disagreement.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import types
+
+import numpy as np
+import pyarrow.parquet as pq
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED = os.path.join(ROOT, "..", "shared", "interfaces")
+
+COCO_TO_OP18 = [0, None, 6, 8, 10, 5, 7, 9, 12, 14, 16, 11, 13, 15, 1, 2, 3, 4]
+LOOKING = {"LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"}
+
+
+def fail(msg):
+    print(f"interop_pie: FAIL: {msg}")
+    sys.exit(1)
+
+
+def table(dataset, name, columns):
+    d = os.path.join(dataset, "tables", name)
+    rows = []
+    for f in sorted(os.listdir(d)):
+        rows.extend(pq.read_table(os.path.join(d, f), columns=columns).to_pylist())
+    return rows
+
+
+def our_pose36(kp, box):
+    """The normalised OpenPose-18 pose, computed here from the keypoints column independently of pedsynth."""
+    trip = [kp[3 * i : 3 * i + 3] for i in range(len(kp) // 3)]
+    if len(trip) == 17:
+        op = []
+        for j in COCO_TO_OP18:
+            if j is None:
+                l, r = trip[5], trip[6]
+                op.append([(l[0] + r[0]) / 2, (l[1] + r[1]) / 2, min(l[2], r[2])])
+            else:
+                op.append(trip[j])
+    else:
+        op = trip
+    x0, y0, x1, y1 = box
+    out = []
+    for u, v, flag in op:
+        x, y = (u - x0) / (x1 - x0), (v - y0) / (y1 - y0)
+        out.extend([x, y] if flag >= 2 and 0 <= x <= 1 and 0 <= y <= 1 else [0.0, 0.0])
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dataset")
+    ap.add_argument("--pedsynth", required=True)
+    ap.add_argument("--no-poses", action="store_true")
+    args = ap.parse_args()
+    poses_too = not args.no_poses
+
+    work = tempfile.mkdtemp(prefix="interop_pie_")
+    out = os.path.join(work, "pie")
+    for fmt in ["pie", "pab-poses"] if poses_too else ["pie"]:
+        subprocess.run([args.pedsynth, "export", fmt, args.dataset, "--out", out], check=True)
+    export = json.load(open(os.path.join(out, "pedsynth_export.json")))
+    video_of = {v["clip_id"]: (v["set"], v["video"]) for v in export["videos"]}
+    prefix = {
+        v["clip_id"]: f"{int(v['set'][3:])}_{int(v['video'][6:])}" for v in export["videos"]
+    }
+
+    # Our side.
+    clips = {r["clip_id"]: r for r in table(args.dataset, "clips", ["clip_id", "split", "frame_count"])}
+    peds = {
+        (r["clip_id"], r["pedestrian"]): r
+        for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender"])
+    }
+    ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
+                "crossing", "state", "occlusion"] + (["keypoints"] if poses_too else [])
+    tracks = {}
+    for r in table(args.dataset, "annotations", ann_cols):
+        tracks.setdefault((r["clip_id"], r["pedestrian"]), []).append(r)
+    for t in tracks.values():
+        t.sort(key=lambda r: r["frame"])
+    by_pie_id = {f"{prefix[c]}_{p}": (c, p) for (c, p) in tracks}
+
+    # PIE's loader.
+    sys.path.insert(0, os.path.join(SHARED, "pie"))
+    from pie_data import PIE  # noqa: E402
+
+    db = PIE(data_path=out, regen_database=True).generate_database()
+    imdb = PIE(data_path=out)  # the sequences below read the database cached just now
+    seen = 0
+    for clip_id, (set_id, video) in video_of.items():
+        v = db[set_id][video]
+        if v["num_frames"] != clips[clip_id]["frame_count"]:
+            fail(f"{clip_id}: num_frames {v['num_frames']} != {clips[clip_id]['frame_count']}")
+        ours = {f"{prefix[clip_id]}_{p}": t for (c, p), t in tracks.items() if c == clip_id}
+        theirs = v["ped_annotations"]
+        if sorted(ours) != sorted(theirs):
+            fail(f"{clip_id}: pedestrians {sorted(theirs)} != ours {sorted(ours)}")
+        for pid, t in ours.items():
+            a = theirs[pid]
+            if a["frames"] != [r["frame"] for r in t]:
+                fail(f"{pid}: frames differ")
+            for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"],
+                                                a["behavior"]["look"]):
+                want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
+                    fail(f"{pid} frame {r['frame']}: box {box} != {want}")
+                o = r["occlusion"]
+                if occ != (0 if o < 0.25 else 1 if o <= 0.75 else 2):
+                    fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
+                if cross != int(r["crossing"]):
+                    fail(f"{pid} frame {r['frame']}: cross {cross} != C {r['crossing']}")
+                if look != int(r["state"] in LOOKING):
+                    fail(f"{pid} frame {r['frame']}: look {look} for {r['state']}")
+            attrs = a["attributes"]
+            c, p = by_pie_id[pid]
+            ped = peds[(c, p)]
+            if attrs["crossing"] != int(ped["crosser"]):
+                fail(f"{pid}: crossing {attrs['crossing']} != crosser {ped['crosser']}")
+            first_c = next((r["frame"] for r in t if r["crossing"]), None)
+            event = first_c if ped["crosser"] else t[-1]["frame"]
+            if attrs["crossing_point"] != event:
+                fail(f"{pid}: crossing_point {attrs['crossing_point']} != {event}")
+            age = {"child": 0, "young": 1, "adult": 2, "senior": 3}[ped["age_group"]]
+            if attrs["age"] != age or attrs["gender"] != {"female": 1, "male": 2}[ped["gender"]]:
+                fail(f"{pid}: age/gender differ")
+            seen += 1
+    print(f"interop_pie: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables")
+
+    # The benchmark's sequences (its default crossing options) and its get_pose.
+    config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))
+    data_opts = dict(config["data_opts"])
+    sys.modules.setdefault("tensorflow", types.ModuleType("tensorflow"))
+    for name in ["tensorflow.keras", "tensorflow.keras.preprocessing", "tensorflow.keras.preprocessing.image"]:
+        sys.modules.setdefault(name, types.ModuleType(name))
+    sys.modules["tensorflow.keras.preprocessing.image"].load_img = None
+    sys.path.insert(0, os.path.join(SHARED, "pedestrian_action_benchmark"))
+    from utils import get_pose  # noqa: E402
+
+    total = 0
+    for split in ["train", "val", "test"]:
+        seq = imdb.generate_data_trajectory_sequence(split, **data_opts)
+        want = 0
+        for (c, p), t in tracks.items():
+            if clips[c]["split"] != split:
+                continue
+            first_c = next((r["frame"] for r in t if r["crossing"]), None)
+            event = first_c if peds[(c, p)]["crosser"] else t[-1]["frame"]
+            n = sum(1 for r in t if r["frame"] <= event)
+            want += n >= data_opts["min_track_size"]
+        if len(seq["pid"]) != want:
+            fail(f"{split}: {len(seq['pid'])} sequences, the tables give {want}")
+        windows = []  # (pid, image paths, boxes) of 16 frames: get_pose stacks equal-length sequences
+        for pids, images, boxes, acts in zip(seq["pid"], seq["image"], seq["bbox"], seq["activities"]):
+            c, p = by_pie_id[pids[0][0]]
+            t = {r["frame"]: r for r in tracks[(c, p)]}
+            if acts[0][0] != int(peds[(c, p)]["crosser"]):
+                fail(f"{pids[0][0]}: activity {acts[0][0]} != crosser")
+            for img, box in zip(images, boxes):
+                r = t[int(os.path.basename(img).split(".")[0])]
+                want_box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                if max(abs(x - y) for x, y in zip(box, want_box)) > 0.006:
+                    fail(f"{pids[0][0]} {img}: sequence box differs")
+                if "absent" not in export["images"] and not os.path.exists(img):
+                    fail(f"{img}: the loader's image path does not exist")
+            for w in range(0, len(images) - 15, 16):
+                windows.append((pids[w : w + 16], images[w : w + 16], (c, p)))
+        if poses_too and windows:
+            poses = get_pose([w[1] for w in windows], [w[0] for w in windows],
+                             file_path=os.path.join(out, "poses"), data_type=split, dataset="pie")
+            for (pids, images, key), got in zip(windows, poses):
+                t = {r["frame"]: r for r in tracks[key]}
+                for img, g in zip(images, got):
+                    r = t[int(os.path.basename(img).split(".")[0])]
+                    box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                    if np.abs(np.asarray(g, dtype=float) - np.asarray(our_pose36(r["keypoints"], box))).max() > 1e-5:
+                        fail(f"{pids[0][0]} {img}: get_pose differs from our keypoints")
+        total += len(seq["pid"])
+        print(f"interop_pie: {split}: {len(seq['pid'])} crossing sequences, boxes and labels equal; "
+              + (f"get_pose equals our keypoints in {len(windows)} windows of 16 frames" if poses_too else "poses not checked"))
+    if total == 0:
+        fail("no sequence in any split: the check would prove nothing")
+    shutil.rmtree(work)
+
+
+if __name__ == "__main__":
+    main()
