@@ -1,5 +1,5 @@
-//! `pedsynth export` (issue 17), the parts Python does not check (tests/interop_pie.py runs PIE's and
-//! PedestrianActionBenchmark's own loaders on the exports, in CI):
+//! `pedsynth export` (issue 17), the parts Python does not check (tests/interop_pie.py and
+//! tests/interop_jaad.py run PIE's, JAAD's and PedestrianActionBenchmark's own loaders on the exports, in CI):
 //!
 //! - the same dataset exports to byte-identical files, and a re-run over an export keeps it as it is;
 //! - a dataset without cameras exports its annotations and says that images are absent;
@@ -67,10 +67,15 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
 
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     for out in [&a, &b] {
-        for format in ["pie", "pab-poses"] {
-            let (code, stdout, stderr) = export(format, &ds, out);
+        for (format, layout) in [
+            ("pie", "pie"),
+            ("pab-poses", "pie"),
+            ("jaad", "jaad"),
+            ("pab-poses-jaad", "jaad"),
+        ] {
+            let (code, stdout, stderr) = export(format, &ds, &out.join(layout));
             assert_eq!(code, Some(0), "{stderr}");
-            if format == "pie" {
+            if format == "pie" || format == "jaad" {
                 assert!(
                     stdout.contains("images absent: the dataset has no RGB stream"),
                     "{stdout}"
@@ -79,15 +84,19 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         }
     }
     let files = common::all_files(&a);
-    assert!(
-        files.keys().any(|k| k.starts_with("annotations/set01/")),
-        "{:?}",
-        files.keys()
-    );
-    assert!(files.contains_key("poses/pose_set03.pkl") && files.contains_key("pedsynth_export.json"));
+    for file in [
+        "pie/annotations/set01/video_0001_annt.xml",
+        "pie/poses/pose_set03.pkl",
+        "pie/pedsynth_export.json",
+        "jaad/annotations/video_0001.xml",
+        "jaad/poses/pose_set01.pkl",
+        "jaad/split_ids/default/val.txt",
+    ] {
+        assert!(files.contains_key(file), "{file}: {:?}", files.keys());
+    }
     assert!(files == common::all_files(&b), "two exports of one dataset differ");
     // Re-running over an export keeps it byte for byte.
-    let (code, _, stderr) = export("pie", &ds, &a);
+    let (code, _, stderr) = export("pie", &ds, &a.join("pie"));
     assert_eq!(code, Some(0), "{stderr}");
     assert!(files == common::all_files(&a));
 
@@ -145,6 +154,7 @@ fn poses_are_openpose18_normalised_in_the_box_with_hidden_joints_zero() {
         speed_mps: 0.0,
         x_m: 0.0,
         y_m: 0.0,
+        yaw_rad: 0.0,
         keypoints,
     };
     let p = pose36(&frame);

@@ -65,6 +65,19 @@ def our_pose36(kp, box):
     return out
 
 
+def install_pab_get_pose():
+    """PedestrianActionBenchmark's utils.get_pose, imported unmodified; its module imports TensorFlow for an
+    image helper get_pose does not use, so a stub module stands in for TensorFlow."""
+    sys.modules.setdefault("tensorflow", types.ModuleType("tensorflow"))
+    for name in ["tensorflow.keras", "tensorflow.keras.preprocessing", "tensorflow.keras.preprocessing.image"]:
+        sys.modules.setdefault(name, types.ModuleType(name))
+    sys.modules["tensorflow.keras.preprocessing.image"].load_img = None
+    sys.path.insert(0, os.path.join(SHARED, "pedestrian_action_benchmark"))
+    from utils import get_pose  # noqa: E402
+
+    return get_pose
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
@@ -147,12 +160,7 @@ def main():
     # The benchmark's sequences (its default crossing options) and its get_pose.
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))
     data_opts = dict(config["data_opts"])
-    sys.modules.setdefault("tensorflow", types.ModuleType("tensorflow"))
-    for name in ["tensorflow.keras", "tensorflow.keras.preprocessing", "tensorflow.keras.preprocessing.image"]:
-        sys.modules.setdefault(name, types.ModuleType(name))
-    sys.modules["tensorflow.keras.preprocessing.image"].load_img = None
-    sys.path.insert(0, os.path.join(SHARED, "pedestrian_action_benchmark"))
-    from utils import get_pose  # noqa: E402
+    get_pose = install_pab_get_pose()
 
     total = 0
     for split in ["train", "val", "test"]:

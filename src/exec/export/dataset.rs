@@ -27,6 +27,8 @@ pub struct AnnotatedFrame {
     /// World ground position.
     pub x_m: f32,
     pub y_m: f32,
+    /// Body yaw, radians.
+    pub yaw_rad: f32,
     /// Keypoints as written: 17 (COCO) or 18 (OpenPose) `u, v, flag` triplets.
     pub keypoints: Vec<f32>,
 }
@@ -39,6 +41,8 @@ pub struct Pedestrian {
     pub gender: String,
     pub crosser: bool,
     pub intention_frame: Option<u32>,
+    /// Crossing group within the clip.
+    pub group_id: Option<u32>,
     pub frames: Vec<AnnotatedFrame>,
 }
 
@@ -202,10 +206,17 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
             });
         }
     }
-    let cols = ["pedestrian", "age_group", "gender", "crosser", "intention_frame"];
+    let cols = [
+        "pedestrian",
+        "age_group",
+        "gender",
+        "crosser",
+        "intention_frame",
+        "group_id",
+    ];
     for b in tables::read(&file("pedestrians"), &cols)? {
         let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
-        let (crosser, intention) = (b.bools("crosser")?, b.u32s("intention_frame")?);
+        let (crosser, intention, group) = (b.bools("crosser")?, b.u32s("intention_frame")?, b.u32s("group_id")?);
         for i in 0..b.rows() {
             clip.pedestrians.insert(
                 id.value(i),
@@ -215,6 +226,7 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
                     gender: gender[i].to_owned(),
                     crosser: crosser.value(i),
                     intention_frame: (!intention.is_null(i)).then(|| intention.value(i)),
+                    group_id: (!group.is_null(i)).then(|| group.value(i)),
                     frames: Vec::new(),
                 },
             );
@@ -234,6 +246,7 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
         "vy_mps",
         "x_m",
         "y_m",
+        "yaw_rad",
         "keypoints",
     ];
     for b in tables::read(&file("annotations"), &cols)? {
@@ -241,6 +254,7 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
         let bbox: Vec<_> = cols[2..6].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
         let (crossing, state, occlusion) = (b.bools("crossing")?, b.strings("state")?, b.f32s("occlusion")?);
         let (vx, vy, x, y) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?, b.f32s("x_m")?, b.f32s("y_m")?);
+        let yaw = b.f32s("yaw_rad")?;
         let (kp, width) = b.f32_lists("keypoints")?;
         for i in 0..b.rows() {
             let p = clip.pedestrians.get_mut(&ped.value(i)).ok_or_else(|| {
@@ -259,6 +273,7 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
                 speed_mps: vx.value(i).hypot(vy.value(i)),
                 x_m: x.value(i),
                 y_m: y.value(i),
+                yaw_rad: yaw.value(i),
                 keypoints: kp[i * width..(i + 1) * width].to_vec(),
             });
         }

@@ -2,12 +2,14 @@
 //!
 //! - [`dataset`] — the dataset as exporters see it (manifest checked, tables per clip, resolved spec).
 //! - [`pie`] — PIE's annotations, attributes, ego-vehicle files and images (`pie_data.py` loads them).
-//! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE export.
+//! - [`jaad`] — JAAD's five annotation folders, split lists and images (`jaad_data.py` loads them).
+//! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE or the JAAD export.
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
 //! renamed, so an interrupted export leaves complete files only and re-running it finishes the job.
 
 pub mod dataset;
+pub mod jaad;
 pub mod pab;
 pub mod pie;
 
@@ -22,8 +24,12 @@ use crate::planner::TownContext;
 pub enum Format {
     /// PIE (`pie_data.py`): annotations/, annotations_attributes/, annotations_vehicle/, images/.
     Pie,
+    /// JAAD (`jaad_data.py`): annotations*/ (five kinds), split_ids/default/, images/.
+    Jaad,
     /// PedestrianActionBenchmark's poses/pose_setNN.pkl for the PIE export.
     PabPoses,
+    /// PedestrianActionBenchmark's poses/pose_set01.pkl for the JAAD export.
+    PabPosesJaad,
 }
 
 /// How images get into an export.
@@ -80,6 +86,24 @@ pub(crate) fn link_file(from: &Path, to: &Path, mode: LinkMode) -> Result<(), Er
     })
 }
 
+/// Whether the dataset's RGB frames can be linked (PNG), and the line that says what happens to images.
+pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (bool, String) {
+    let rgb = ds.manifest.sensors.get("rgb").map(String::as_str).unwrap_or("disabled");
+    if rgb.starts_with("rendered") && rgb.ends_with(".png") {
+        (true, format!("images linked ({link}) from sensors/rgb"))
+    } else if rgb.starts_with("rendered") {
+        (
+            false,
+            "images absent: the RGB stream is not PNG (the loaders read .png); annotations only".to_owned(),
+        )
+    } else {
+        (
+            false,
+            "images absent: the dataset has no RGB stream; annotations only".to_owned(),
+        )
+    }
+}
+
 /// The dataset's towns, for map attributes; a town that cannot be loaded (an OpenDRIVE file not found
 /// beside the dataset) is left out with a warning.
 pub(crate) fn towns(ds: &dataset::Dataset, warn: &mut dyn FnMut(String)) -> BTreeMap<String, TownContext> {
@@ -119,8 +143,20 @@ pub fn export(
                 r.images_note
             )
         }
-        Format::PabPoses => {
-            let r = pab::export(&ds, out)?;
+        Format::Jaad => {
+            let r = jaad::export(&ds, out, link, warn)?;
+            format!(
+                "{}: JAAD layout of {} clips: {} videos, {} pedestrian tracks, {} images\n{}\n",
+                out.display(),
+                ds.clips.len(),
+                r.videos,
+                r.pedestrian_tracks,
+                r.images,
+                r.images_note
+            )
+        }
+        Format::PabPoses | Format::PabPosesJaad => {
+            let r = pab::export(&ds, out, format == Format::PabPosesJaad)?;
             format!(
                 "{}: {} pose files (poses/pose_setNN.pkl), {} pedestrian-frames, {} with a pose\n",
                 out.display(),

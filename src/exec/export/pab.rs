@@ -1,6 +1,7 @@
-//! `pedsynth export pab-poses`: PedestrianActionBenchmark's pose files (`poses/pose_setNN.pkl`, read by its
-//! unmodified `utils.get_pose`) for the PIE export's sets and videos: `{video: {"<frame:05d>_<PIE id>": 36
-//! floats}}`, OpenPose-18 joints in the benchmark's order (neck = mid-shoulder) from our keypoints, `x, y`
+//! `pedsynth export pab-poses` / `pab-poses-jaad`: PedestrianActionBenchmark's pose files
+//! (`poses/pose_setNN.pkl`, read by its unmodified `utils.get_pose`) for the PIE export's sets and videos, or
+//! for the JAAD export (one `pose_set01.pkl`, the set `get_pose` reads for JAAD): `{video: {"<frame:05d>_<id>":
+//! 36 floats}}`, OpenPose-18 joints in the benchmark's order (neck = mid-shoulder) from our keypoints, `x, y`
 //! normalised within the pedestrian's box, and 0, 0 for a joint that is hidden or outside the box.
 
 use std::collections::BTreeMap;
@@ -47,22 +48,41 @@ pub struct PosesReport {
     pub with_pose: usize,
 }
 
-/// Writes `out/poses/pose_setNN.pkl` for the six PIE sets.
-pub fn export(ds: &Dataset, out: &Path) -> Result<PosesReport, Error> {
-    let videos = assign_videos(&ds.clips)?;
-    let mut sets: BTreeMap<&str, BTreeMap<String, BTreeMap<String, Vec<f64>>>> = SETS
-        .iter()
-        .flat_map(|(_, sets)| sets.iter().map(|s| (*s, BTreeMap::new())))
-        .collect();
+/// Writes `out/poses/pose_setNN.pkl`: the six PIE sets, or JAAD's `set01`.
+pub fn export(ds: &Dataset, out: &Path, jaad: bool) -> Result<PosesReport, Error> {
+    // (set, video, id of each pedestrian) per clip, as the PIE or JAAD export names them.
+    type Names = (String, String, Box<dyn Fn(u32) -> String>);
+    let names: Vec<Names> = if jaad {
+        super::jaad::assign_videos(&ds.clips)
+            .into_iter()
+            .map(|v| {
+                let video = v.video.clone();
+                let id: Box<dyn Fn(u32) -> String> = Box::new(move |p| super::jaad::track_id(&v, p));
+                ("set01".to_owned(), video, id)
+            })
+            .collect()
+    } else {
+        assign_videos(&ds.clips)?
+            .into_iter()
+            .map(|v| {
+                let (set, video) = (v.set.clone(), v.video.clone());
+                let id: Box<dyn Fn(u32) -> String> = Box::new(move |p| track_id(&v, p));
+                (set, video, id)
+            })
+            .collect()
+    };
+    let mut sets: BTreeMap<String, BTreeMap<String, BTreeMap<String, Vec<f64>>>> = if jaad {
+        BTreeMap::from([("set01".to_owned(), BTreeMap::new())])
+    } else {
+        SETS.iter()
+            .flat_map(|(_, sets)| sets.iter().map(|s| (s.to_string(), BTreeMap::new())))
+            .collect()
+    };
     let mut report = PosesReport::default();
-    for (clip, v) in ds.clips.iter().zip(&videos) {
-        let entries = sets
-            .entry(v.set.as_str())
-            .or_default()
-            .entry(v.video.clone())
-            .or_default();
+    for (clip, (set, video, name)) in ds.clips.iter().zip(&names) {
+        let entries = sets.entry(set.clone()).or_default().entry(video.clone()).or_default();
         for p in clip.pedestrians.values() {
-            let id = track_id(v, p.id);
+            let id = name(p.id);
             for f in &p.frames {
                 let pose = pose36(f);
                 report.entries += 1;

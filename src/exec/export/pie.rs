@@ -97,7 +97,7 @@ pub fn occlusion_class(fraction: f32) -> &'static str {
 pub const WALKING_MPS: f32 = 0.3;
 
 /// States in which a pedestrian is looking (at the traffic, so at the ego among the rest).
-const LOOKING_STATES: [&str; 3] = ["LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"];
+pub(crate) const LOOKING_STATES: [&str; 3] = ["LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"];
 
 /// The track's event frame (PIE's `crossing_point`): the first annotated frame with C = 1 for a crosser, the
 /// last annotated frame otherwise — always an annotated frame.
@@ -169,7 +169,7 @@ pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64) -> Place {
     }
 }
 
-fn inside(polygon: &[glam::DVec2], p: glam::DVec2) -> bool {
+pub(crate) fn inside(polygon: &[glam::DVec2], p: glam::DVec2) -> bool {
     let mut inside = false;
     let n = polygon.len();
     for i in 0..n {
@@ -181,7 +181,7 @@ fn inside(polygon: &[glam::DVec2], p: glam::DVec2) -> bool {
     inside
 }
 
-fn xml_escape(s: &str) -> String {
+pub(crate) fn xml_escape(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
@@ -377,7 +377,7 @@ fn write_video(
     Ok((tracks, vehicle_tracks))
 }
 
-fn wrap_pi(a: f64) -> f64 {
+pub(crate) fn wrap_pi(a: f64) -> f64 {
     (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
@@ -432,15 +432,8 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
         videos: videos.len(),
         ..PieReport::default()
     };
-    let rgb = ds.manifest.sensors.get("rgb").map(String::as_str).unwrap_or("disabled");
-    let png_images = rgb.starts_with("rendered") && rgb.ends_with(".png");
-    report.images_note = if png_images {
-        format!("images linked ({link}) from sensors/rgb")
-    } else if rgb.starts_with("rendered") {
-        "images absent: the RGB stream is not PNG (PIE reads .png); annotations only".to_owned()
-    } else {
-        "images absent: the dataset has no RGB stream; annotations only".to_owned()
-    };
+    let (png_images, note) = super::images_note(ds, link);
+    report.images_note = note;
     for (clip, v) in ds.clips.iter().zip(&videos) {
         let net = towns.get(&clip.town).map(|t| &t.network);
         let (peds, vehicles) = write_video(out, clip, v, &camera, net)?;

@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""Interop check: JAAD's own loader and PedestrianActionBenchmark's own `get_pose`, unmodified, read
+`pedsynth export jaad` and `pedsynth export pab-poses-jaad`, and what they return equals our tables.
+
+Usage: python3 tests/interop_jaad.py DATASET --pedsynth BIN [--no-poses]
+
+As tests/interop_pie.py (whose helpers it uses), for JAAD's layout: behaviour-annotated pedestrians ("b" ids),
+`crossing_point` -1 for non-crossers (JAAD's loader then ends their tracks two frames before the last), the
+split lists, and the JAAD set of the pose files.
+"""
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import yaml
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from interop_pie import LOOKING, SHARED, fail, install_pab_get_pose, our_pose36, table  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dataset")
+    ap.add_argument("--pedsynth", required=True)
+    ap.add_argument("--no-poses", action="store_true")
+    args = ap.parse_args()
+    poses_too = not args.no_poses
+
+    work = tempfile.mkdtemp(prefix="interop_jaad_")
+    out = os.path.join(work, "jaad")
+    for fmt in ["jaad", "pab-poses-jaad"] if poses_too else ["jaad"]:
+        subprocess.run([args.pedsynth, "export", fmt, args.dataset, "--out", out], check=True)
+    export = json.load(open(os.path.join(out, "pedsynth_export.json")))
+    video_of = {v["clip_id"]: v["video"] for v in export["videos"]}
+
+    clips = {r["clip_id"]: r for r in table(args.dataset, "clips", ["clip_id", "split", "frame_count"])}
+    peds = {
+        (r["clip_id"], r["pedestrian"]): r
+        for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender"])
+    }
+    ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
+                "crossing", "state", "occlusion"] + (["keypoints"] if poses_too else [])
+    tracks = {}
+    for r in table(args.dataset, "annotations", ann_cols):
+        tracks.setdefault((r["clip_id"], r["pedestrian"]), []).append(r)
+    for t in tracks.values():
+        t.sort(key=lambda r: r["frame"])
+    jaad_id = lambda c, p: f"0_{int(video_of[c][6:])}_{p}b"  # noqa: E731
+    by_id = {jaad_id(c, p): (c, p) for (c, p) in tracks}
+
+    sys.path.insert(0, os.path.join(SHARED, "jaad"))
+    from jaad_data import JAAD  # noqa: E402
+
+    db = JAAD(data_path=out, regen_pkl=True).generate_database()
+    imdb = JAAD(data_path=out)
+    seen = 0
+    for clip_id, video in video_of.items():
+        v = db[video]
+        if v["num_frames"] != clips[clip_id]["frame_count"]:
+            fail(f"{clip_id}: num_frames differ")
+        ours = {jaad_id(c, p): t for (c, p), t in tracks.items() if c == clip_id}
+        theirs = v["ped_annotations"]
+        if sorted(ours) != sorted(theirs):
+            fail(f"{clip_id}: pedestrians {sorted(theirs)} != ours {sorted(ours)}")
+        for pid, t in ours.items():
+            a = theirs[pid]
+            if a["frames"] != [r["frame"] for r in t]:
+                fail(f"{pid}: frames differ")
+            for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"],
+                                                a["behavior"]["look"]):
+                want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
+                    fail(f"{pid} frame {r['frame']}: box {box} != {want}")
+                o = r["occlusion"]
+                if occ != (0 if o < 0.25 else 1 if o <= 0.75 else 2):
+                    fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
+                if cross != int(r["crossing"]) or look != int(r["state"] in LOOKING):
+                    fail(f"{pid} frame {r['frame']}: cross/look differ")
+            ped = peds[by_id[pid]]
+            attrs = a["attributes"]
+            first_c = next((r["frame"] for r in t if r["crossing"]), None)
+            if attrs["crossing"] != int(ped["crosser"]):
+                fail(f"{pid}: crossing {attrs['crossing']} != crosser")
+            if attrs["crossing_point"] != (first_c if ped["crosser"] else -1):
+                fail(f"{pid}: crossing_point {attrs['crossing_point']}")
+            if attrs["age"] != {"child": 0, "young": 1, "adult": 2, "senior": 3}[ped["age_group"]]:
+                fail(f"{pid}: age differs")
+            # The loader keeps appearance values as strings: exactly one side is "1".
+            sides = [a["appearance"][k][0] for k in ["pose_front", "pose_back", "pose_left", "pose_right"]]
+            if sorted(sides) != ["0", "0", "0", "1"]:
+                fail(f"{pid}: appearance sides {sides}")
+            seen += 1
+    print(f"interop_jaad: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables")
+
+    config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))
+    data_opts = dict(config["data_opts"])
+    get_pose = install_pab_get_pose()
+    total = 0
+    for split in ["train", "val", "test"]:
+        if not any(c["split"] == split for c in clips.values()):
+            # JAAD's _get_crossing fails on a split without videos (UnboundLocalError on img_width); the
+            # export warns about it.
+            print(f"interop_jaad: {split}: no clips, skipped")
+            continue
+        seq = imdb.generate_data_trajectory_sequence(split, **data_opts)
+        want = 0
+        for (c, p), t in tracks.items():
+            if clips[c]["split"] != split:
+                continue
+            first_c = next((r["frame"] for r in t if r["crossing"]), None)
+            n = sum(1 for r in t if r["frame"] <= first_c) if peds[(c, p)]["crosser"] else len(t) - 2
+            want += n >= data_opts["min_track_size"]
+        if len(seq["pid"]) != want:
+            fail(f"{split}: {len(seq['pid'])} sequences, the tables give {want}")
+        windows = []
+        for pids, images, boxes, acts in zip(seq["pid"], seq["image"], seq["bbox"], seq["activities"]):
+            c, p = by_id[pids[0][0]]
+            t = {r["frame"]: r for r in tracks[(c, p)]}
+            if acts[0][0] != int(peds[(c, p)]["crosser"]):
+                fail(f"{pids[0][0]}: activity differs")
+            for img, box in zip(images, boxes):
+                r = t[int(os.path.basename(img).split(".")[0])]
+                want_box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                if max(abs(x - y) for x, y in zip(box, want_box)) > 0.006:
+                    fail(f"{pids[0][0]} {img}: sequence box differs")
+                if "absent" not in export["images"] and not os.path.exists(img):
+                    fail(f"{img}: the loader's image path does not exist")
+            for w in range(0, len(images) - 15, 16):
+                windows.append((pids[w : w + 16], images[w : w + 16], (c, p)))
+        if poses_too and windows:
+            poses = get_pose([w[1] for w in windows], [w[0] for w in windows],
+                             file_path=os.path.join(out, "poses"), data_type=split, dataset="jaad")
+            for (pids, images, key), got in zip(windows, poses):
+                t = {r["frame"]: r for r in tracks[key]}
+                for img, g in zip(images, got):
+                    r = t[int(os.path.basename(img).split(".")[0])]
+                    box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                    if np.abs(np.asarray(g, dtype=float) - np.asarray(our_pose36(r["keypoints"], box))).max() > 1e-5:
+                        fail(f"{pids[0][0]} {img}: get_pose differs from our keypoints")
+        total += len(seq["pid"])
+        print(f"interop_jaad: {split}: {len(seq['pid'])} crossing sequences, boxes and labels equal; "
+              + (f"get_pose equals our keypoints in {len(windows)} windows of 16 frames" if poses_too
+                 else "poses not checked"))
+    if total == 0:
+        fail("no sequence in any split: the check would prove nothing")
+    shutil.rmtree(work)
+
+
+if __name__ == "__main__":
+    main()
