@@ -5,7 +5,9 @@
 //! - a dataset without cameras exports its annotations and says that images are absent;
 //! - an unfinished dataset, a table changed after `generate` and a directory that is no dataset are refused
 //!   with exit code 2 and a message naming the problem, never a panic;
-//! - the poses' joints: OpenPose-18 order, neck at mid-shoulder, normalised within the box, hidden joints 0.
+//! - the poses' joints: OpenPose-18 order, neck at mid-shoulder, normalised within the box, hidden joints 0;
+//! - the seed's CSV layout has one row per annotated pedestrian-frame, none duplicated (the seed wrote each
+//!   twice).
 
 mod common;
 
@@ -72,10 +74,11 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
             ("pab-poses", "pie"),
             ("jaad", "jaad"),
             ("pab-poses-jaad", "jaad"),
+            ("seed-csv", "seed"),
         ] {
             let (code, stdout, stderr) = export(format, &ds, &out.join(layout));
             assert_eq!(code, Some(0), "{stderr}");
-            if format == "pie" || format == "jaad" {
+            if ["pie", "jaad", "seed-csv"].contains(&format) {
                 assert!(
                     stdout.contains("images absent: the dataset has no RGB stream"),
                     "{stdout}"
@@ -95,6 +98,27 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         assert!(files.contains_key(file), "{file}: {:?}", files.keys());
     }
     assert!(files == common::all_files(&b), "two exports of one dataset differ");
+    // The seed's CSV: one row per annotated pedestrian-frame, none twice, every row as wide as the header.
+    let view = pedsynth::exec::export::dataset::Dataset::open(&ds).expect("opens");
+    let annotated: usize = view
+        .clips
+        .iter()
+        .flat_map(|c| c.pedestrians.values())
+        .map(|p| p.frames.len())
+        .sum();
+    let labels = String::from_utf8(files["seed/labels.csv"].clone()).expect("utf-8");
+    let mut lines = labels.lines();
+    let width = lines.next().expect("header").split(',').count();
+    assert_eq!(width, 12 + 3 * 17);
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), annotated, "one row per annotated pedestrian-frame");
+    let keys: std::collections::BTreeSet<Vec<&str>> = rows.iter().map(|r| r.split(',').take(3).collect()).collect();
+    assert_eq!(
+        keys.len(),
+        rows.len(),
+        "no duplicate (video_id, frame_id, pedestrian_id)"
+    );
+    assert!(rows.iter().all(|r| r.split(',').count() == width));
     // Re-running over an export keeps it byte for byte.
     let (code, _, stderr) = export("pie", &ds, &a.join("pie"));
     assert_eq!(code, Some(0), "{stderr}");
@@ -155,6 +179,8 @@ fn poses_are_openpose18_normalised_in_the_box_with_hidden_joints_zero() {
         x_m: 0.0,
         y_m: 0.0,
         yaw_rad: 0.0,
+        distance_to_ego_m: 0.0,
+        box3d_m: [0.0; 6],
         keypoints,
     };
     let p = pose36(&frame);

@@ -29,6 +29,10 @@ pub struct AnnotatedFrame {
     pub y_m: f32,
     /// Body yaw, radians.
     pub yaw_rad: f32,
+    /// Ground distance from the ego, metres.
+    pub distance_to_ego_m: f32,
+    /// 3D box: centre (world) and length, width, height, metres.
+    pub box3d_m: [f32; 6],
     /// Keypoints as written: 17 (COCO) or 18 (OpenPose) `u, v, flag` triplets.
     pub keypoints: Vec<f32>,
 }
@@ -43,6 +47,10 @@ pub struct Pedestrian {
     pub intention_frame: Option<u32>,
     /// Crossing group within the clip.
     pub group_id: Option<u32>,
+    /// Crossing behaviour (`normal`, `sudden`, ...).
+    pub behaviour: String,
+    /// First frame with C = 1, annotated or not.
+    pub first_crossing_frame: Option<u32>,
     pub frames: Vec<AnnotatedFrame>,
 }
 
@@ -73,6 +81,7 @@ pub struct VehicleFrame {
 pub struct Clip {
     pub clip_id: String,
     pub town: String,
+    pub weather: String,
     pub split: String,
     pub fps: u32,
     pub frame_count: u32,
@@ -163,13 +172,14 @@ impl Dataset {
 fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
     let file = |t: &str| layout.table(t, clip_id);
     let mut clip = None;
-    for b in tables::read(&file("clips"), &["town", "split", "fps", "frame_count"])? {
-        let (town, split) = (b.strings("town")?, b.strings("split")?);
+    for b in tables::read(&file("clips"), &["town", "weather", "split", "fps", "frame_count"])? {
+        let (town, weather, split) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
         let (fps, frames) = (b.u32s("fps")?, b.u32s("frame_count")?);
         if b.rows() > 0 {
             clip = Some(Clip {
                 clip_id: clip_id.to_owned(),
                 town: town[0].to_owned(),
+                weather: weather[0].to_owned(),
                 split: split[0].to_owned(),
                 fps: fps.value(0),
                 frame_count: frames.value(0),
@@ -213,10 +223,13 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
         "crosser",
         "intention_frame",
         "group_id",
+        "behaviour",
+        "first_crossing_frame",
     ];
     for b in tables::read(&file("pedestrians"), &cols)? {
         let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
         let (crosser, intention, group) = (b.bools("crosser")?, b.u32s("intention_frame")?, b.u32s("group_id")?);
+        let (behaviour, first_c) = (b.strings("behaviour")?, b.u32s("first_crossing_frame")?);
         for i in 0..b.rows() {
             clip.pedestrians.insert(
                 id.value(i),
@@ -227,6 +240,8 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
                     crosser: crosser.value(i),
                     intention_frame: (!intention.is_null(i)).then(|| intention.value(i)),
                     group_id: (!group.is_null(i)).then(|| group.value(i)),
+                    behaviour: behaviour[i].to_owned(),
+                    first_crossing_frame: (!first_c.is_null(i)).then(|| first_c.value(i)),
                     frames: Vec::new(),
                 },
             );
@@ -247,6 +262,13 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
         "x_m",
         "y_m",
         "yaw_rad",
+        "distance_to_ego_m",
+        "box3d_x_m",
+        "box3d_y_m",
+        "box3d_z_m",
+        "box3d_length_m",
+        "box3d_width_m",
+        "box3d_height_m",
         "keypoints",
     ];
     for b in tables::read(&file("annotations"), &cols)? {
@@ -254,7 +276,8 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
         let bbox: Vec<_> = cols[2..6].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
         let (crossing, state, occlusion) = (b.bools("crossing")?, b.strings("state")?, b.f32s("occlusion")?);
         let (vx, vy, x, y) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?, b.f32s("x_m")?, b.f32s("y_m")?);
-        let yaw = b.f32s("yaw_rad")?;
+        let (yaw, distance) = (b.f32s("yaw_rad")?, b.f32s("distance_to_ego_m")?);
+        let box3d: Vec<_> = cols[15..21].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
         let (kp, width) = b.f32_lists("keypoints")?;
         for i in 0..b.rows() {
             let p = clip.pedestrians.get_mut(&ped.value(i)).ok_or_else(|| {
@@ -274,6 +297,8 @@ fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
                 x_m: x.value(i),
                 y_m: y.value(i),
                 yaw_rad: yaw.value(i),
+                distance_to_ego_m: distance.value(i),
+                box3d_m: std::array::from_fn(|k| box3d[k].value(i)),
                 keypoints: kp[i * width..(i + 1) * width].to_vec(),
             });
         }

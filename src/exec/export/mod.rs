@@ -4,6 +4,7 @@
 //! - [`pie`] — PIE's annotations, attributes, ego-vehicle files and images (`pie_data.py` loads them).
 //! - [`jaad`] — JAAD's five annotation folders, split lists and images (`jaad_data.py` loads them).
 //! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE or the JAAD export.
+//! - [`seed_csv`] — the seed system's CSV layout (labels, 3D boxes, ego poses; per clip, weather, dataset).
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
 //! renamed, so an interrupted export leaves complete files only and re-running it finishes the job.
@@ -12,6 +13,7 @@ pub mod dataset;
 pub mod jaad;
 pub mod pab;
 pub mod pie;
+pub mod seed_csv;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,6 +32,8 @@ pub enum Format {
     PabPoses,
     /// PedestrianActionBenchmark's poses/pose_set01.pkl for the JAAD export.
     PabPosesJaad,
+    /// The seed system's CSV layout: <weather>/<town>/<clip>/labels.csv, pedestrians_3d.csv, ego_pose.csv.
+    SeedCsv,
 }
 
 /// How images get into an export.
@@ -151,6 +155,17 @@ pub fn export(
                 ds.clips.len(),
                 r.videos,
                 r.pedestrian_tracks,
+                r.images,
+                r.images_note
+            )
+        }
+        Format::SeedCsv => {
+            let r = seed_csv::export(&ds, out, link)?;
+            format!(
+                "{}: the seed's CSV layout of {} clips: {} label rows, {} images\n{}\n",
+                out.display(),
+                r.clips,
+                r.rows,
                 r.images,
                 r.images_note
             )
