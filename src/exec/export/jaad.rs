@@ -302,6 +302,7 @@ pub fn export(
         ..JaadReport::default()
     };
     let mut splits: BTreeMap<&str, Vec<&str>> = ["train", "val", "test"].into_iter().map(|s| (s, Vec::new())).collect();
+    let progress = super::progress(ds.clips.len());
     for (clip, v) in ds.clips.iter().zip(&videos) {
         let net = towns.get(&clip.town).map(|t| &t.network);
         report.pedestrian_tracks += write_video(out, clip, v, (rgb.width_px, rgb.height_px), net)?;
@@ -317,7 +318,9 @@ pub fn export(
                 }
             }
         }
+        progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
+    progress.finish();
     for (split, list) in &splits {
         if list.is_empty() {
             warn(format!(

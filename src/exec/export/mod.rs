@@ -90,6 +90,12 @@ pub(crate) fn link_file(from: &Path, to: &Path, mode: LinkMode) -> Result<(), Er
     })
 }
 
+/// A progress bar over `clips` clips on a terminal (nothing otherwise).
+pub(crate) fn progress(clips: usize) -> crate::exec::generate::progress::Progress {
+    use std::io::IsTerminal;
+    crate::exec::generate::progress::Progress::new(clips, !std::io::stderr().is_terminal())
+}
+
 /// Whether the dataset's RGB frames can be linked (PNG), and the line that says what happens to images.
 pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (bool, String) {
     let rgb = ds.manifest.sensors.get("rgb").map(String::as_str).unwrap_or("disabled");

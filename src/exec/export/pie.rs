@@ -434,6 +434,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
     };
     let (png_images, note) = super::images_note(ds, link);
     report.images_note = note;
+    let progress = super::progress(ds.clips.len());
     for (clip, v) in ds.clips.iter().zip(&videos) {
         let net = towns.get(&clip.town).map(|t| &t.network);
         let (peds, vehicles) = write_video(out, clip, v, &camera, net)?;
@@ -450,7 +451,9 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
                 }
             }
         }
+        progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
+    progress.finish();
     let sets: BTreeMap<&str, &[&str]> = SETS.iter().copied().collect();
     let record = ExportRecord {
         format: "pie",

@@ -138,6 +138,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<SeedReport, Er
     let header = label_header();
     let mut all = header.clone();
     let mut weathers: std::collections::BTreeMap<&str, String> = std::collections::BTreeMap::new();
+    let progress = super::progress(ds.clips.len());
     for clip in &ds.clips {
         let dir = out.join(&clip.weather).join(&clip.town).join(&clip.clip_id);
         let rows = label_rows(clip);
@@ -159,7 +160,9 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<SeedReport, Er
                 }
             }
         }
+        progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
+    progress.finish();
     for (weather, text) in &weathers {
         write_file(&out.join(weather).join("labels.csv"), text.as_bytes())?;
     }

@@ -3,7 +3,7 @@
 //! and writes the manifest. Re-running on a partly generated dataset of the same spec and plan skips finished
 //! clips, and the result is byte-identical to an uninterrupted run for any number of jobs.
 
-mod progress;
+pub(crate) mod progress;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

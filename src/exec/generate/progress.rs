@@ -1,4 +1,4 @@
-//! Progress of a generate run on stderr: a bar on a terminal, plain lines otherwise, nothing when quiet. The
+//! Progress of a generate run (and of an export) on stderr: a bar on a terminal, plain lines otherwise, nothing when quiet. The
 //! only place that reads the wall clock, and only for what it shows the user (never for what it writes).
 
 use std::io::IsTerminal;
