@@ -65,6 +65,38 @@ def our_pose36(kp, box):
     return out
 
 
+def check_sequences(seq, tracks, peds, by_id, export, out, split, poses_too, get_pose, dataset):
+    """Checks a loader's crossing sequences against the tables: each track's class, every box, every image path
+    (when images were exported), and get_pose on windows of 16 frames (it stacks equal-length sequences)
+    against our keypoints. Returns the number of windows."""
+    windows = []
+    for pids, images, boxes, acts in zip(seq["pid"], seq["image"], seq["bbox"], seq["activities"]):
+        c, p = by_id[pids[0][0]]
+        t = {r["frame"]: r for r in tracks[(c, p)]}
+        if acts[0][0] != int(peds[(c, p)]["crosser"]):
+            fail(f"{pids[0][0]}: activity {acts[0][0]} != crosser")
+        for img, box in zip(images, boxes):
+            r = t[int(os.path.basename(img).split(".")[0])]
+            want_box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+            if max(abs(x - y) for x, y in zip(box, want_box)) > 0.006:
+                fail(f"{pids[0][0]} {img}: sequence box differs")
+            if "absent" not in export["images"] and not os.path.exists(img):
+                fail(f"{img}: the loader's image path does not exist")
+        for w in range(0, len(images) - 15, 16):
+            windows.append((pids[w : w + 16], images[w : w + 16], (c, p)))
+    if poses_too and windows:
+        poses = get_pose([w[1] for w in windows], [w[0] for w in windows],
+                         file_path=os.path.join(out, "poses"), data_type=split, dataset=dataset)
+        for (pids, images, key), got in zip(windows, poses):
+            t = {r["frame"]: r for r in tracks[key]}
+            for img, g in zip(images, got):
+                r = t[int(os.path.basename(img).split(".")[0])]
+                box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+                if np.abs(np.asarray(g, dtype=float) - np.asarray(our_pose36(r["keypoints"], box))).max() > 1e-5:
+                    fail(f"{pids[0][0]} {img}: get_pose differs from our keypoints")
+    return windows
+
+
 def install_pab_get_pose():
     """PedestrianActionBenchmark's utils.get_pose, imported unmodified; its module imports TensorFlow for an
     image helper get_pose does not use, so a stub module stands in for TensorFlow."""
@@ -175,31 +207,7 @@ def main():
             want += n >= data_opts["min_track_size"]
         if len(seq["pid"]) != want:
             fail(f"{split}: {len(seq['pid'])} sequences, the tables give {want}")
-        windows = []  # (pid, image paths, boxes) of 16 frames: get_pose stacks equal-length sequences
-        for pids, images, boxes, acts in zip(seq["pid"], seq["image"], seq["bbox"], seq["activities"]):
-            c, p = by_pie_id[pids[0][0]]
-            t = {r["frame"]: r for r in tracks[(c, p)]}
-            if acts[0][0] != int(peds[(c, p)]["crosser"]):
-                fail(f"{pids[0][0]}: activity {acts[0][0]} != crosser")
-            for img, box in zip(images, boxes):
-                r = t[int(os.path.basename(img).split(".")[0])]
-                want_box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
-                if max(abs(x - y) for x, y in zip(box, want_box)) > 0.006:
-                    fail(f"{pids[0][0]} {img}: sequence box differs")
-                if "absent" not in export["images"] and not os.path.exists(img):
-                    fail(f"{img}: the loader's image path does not exist")
-            for w in range(0, len(images) - 15, 16):
-                windows.append((pids[w : w + 16], images[w : w + 16], (c, p)))
-        if poses_too and windows:
-            poses = get_pose([w[1] for w in windows], [w[0] for w in windows],
-                             file_path=os.path.join(out, "poses"), data_type=split, dataset="pie")
-            for (pids, images, key), got in zip(windows, poses):
-                t = {r["frame"]: r for r in tracks[key]}
-                for img, g in zip(images, got):
-                    r = t[int(os.path.basename(img).split(".")[0])]
-                    box = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
-                    if np.abs(np.asarray(g, dtype=float) - np.asarray(our_pose36(r["keypoints"], box))).max() > 1e-5:
-                        fail(f"{pids[0][0]} {img}: get_pose differs from our keypoints")
+        windows = check_sequences(seq, tracks, peds, by_pie_id, export, out, split, poses_too, get_pose, "pie")
         total += len(seq["pid"])
         print(f"interop_pie: {split}: {len(seq['pid'])} crossing sequences, boxes and labels equal; "
               + (f"get_pose equals our keypoints in {len(windows)} windows of 16 frames" if poses_too else "poses not checked"))

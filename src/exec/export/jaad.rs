@@ -12,8 +12,8 @@ use glam::DVec2;
 use serde::Serialize;
 
 use super::dataset::{Clip, Dataset, EgoFrame};
-use super::pie::{LOOKING_STATES, Place, WALKING_MPS, inside, occlusion_class, place_at, wrap_pi, xml_escape};
-use super::{LinkMode, link_file, write_file};
+use super::pie::{Labels, Place, inside, occlusion_class, place_at, wrap_pi, xml_escape};
+use super::{LinkMode, link_frames, write_file};
 use crate::world::RoadNetwork;
 
 /// Where a clip went.
@@ -138,17 +138,7 @@ fn write_video(
         x.push_str("<track label=\"pedestrian\">\n");
         for f in &p.frames {
             let b = f.bbox_px;
-            let look = if LOOKING_STATES.contains(&f.state.as_str()) {
-                "looking"
-            } else {
-                "not-looking"
-            };
-            let action = if f.speed_mps >= WALKING_MPS {
-                "walking"
-            } else {
-                "standing"
-            };
-            let cross = if f.crossing { "crossing" } else { "not-crossing" };
+            let Labels { look, action, cross } = Labels::of(f);
             let _ = writeln!(
                 x,
                 "<box frame=\"{}\" keyframe=\"1\" occluded=\"{}\" outside=\"0\" xbr=\"{:.2}\" xtl=\"{:.2}\" ybr=\"{:.2}\" \
@@ -308,15 +298,7 @@ pub fn export(
         report.pedestrian_tracks += write_video(out, clip, v, (rgb.width_px, rgb.height_px), net)?;
         splits.entry(v.split.as_str()).or_default().push(v.video.as_str());
         if png_images {
-            let dir = out.join("images").join(&v.video);
-            std::fs::create_dir_all(&dir).map_err(|e| crate::error::Error::write(&dir, e))?;
-            for frame in 0..clip.frame_count {
-                let from = ds.layout.sensor_frame("rgb", &clip.clip_id, frame, "png");
-                if from.exists() {
-                    link_file(&from, &dir.join(format!("{frame:05}.png")), link)?;
-                    report.images += 1;
-                }
-            }
+            report.images += link_frames(ds, clip, &out.join("images").join(&v.video), 5, link)?;
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }

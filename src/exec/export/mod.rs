@@ -114,6 +114,26 @@ pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (bool, Strin
     }
 }
 
+/// Links a clip's RGB frames into `dir` as `<frame>.png` with `digits` digits; returns how many.
+pub(crate) fn link_frames(
+    ds: &dataset::Dataset,
+    clip: &dataset::Clip,
+    dir: &Path,
+    digits: usize,
+    link: LinkMode,
+) -> Result<usize, Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
+    let mut linked = 0;
+    for frame in 0..clip.frame_count {
+        let from = ds.layout.sensor_frame("rgb", &clip.clip_id, frame, "png");
+        if from.exists() {
+            link_file(&from, &dir.join(format!("{frame:0digits$}.png")), link)?;
+            linked += 1;
+        }
+    }
+    Ok(linked)
+}
+
 /// The dataset's towns, for map attributes; a town that cannot be loaded (an OpenDRIVE file not found
 /// beside the dataset) is left out with a warning.
 pub(crate) fn towns(ds: &dataset::Dataset, warn: &mut dyn FnMut(String)) -> BTreeMap<String, TownContext> {

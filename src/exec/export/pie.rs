@@ -12,7 +12,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use super::dataset::{Clip, Dataset, Pedestrian};
-use super::{LinkMode, link_file, write_file};
+use super::{LinkMode, link_frames, write_file};
 use crate::error::{Error, code};
 use crate::exec::observe::rig::Camera;
 use crate::world::{LaneType, RoadNetwork, TravelDirection};
@@ -98,6 +98,35 @@ pub const WALKING_MPS: f32 = 0.3;
 
 /// States in which a pedestrian is looking (at the traffic, so at the ego among the rest).
 pub(crate) const LOOKING_STATES: [&str; 3] = ["LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"];
+
+/// The per-frame behaviour labels PIE and JAAD share, in their words.
+pub struct Labels {
+    /// `looking` in the states that look at the traffic, `not-looking` otherwise.
+    pub look: &'static str,
+    /// `walking` from [`WALKING_MPS`] up, `standing` below.
+    pub action: &'static str,
+    /// `crossing` when C = 1, `not-crossing` otherwise.
+    pub cross: &'static str,
+}
+
+impl Labels {
+    /// The labels of an annotated frame.
+    pub fn of(f: &super::dataset::AnnotatedFrame) -> Labels {
+        Labels {
+            look: if LOOKING_STATES.contains(&f.state.as_str()) {
+                "looking"
+            } else {
+                "not-looking"
+            },
+            action: if f.speed_mps >= WALKING_MPS {
+                "walking"
+            } else {
+                "standing"
+            },
+            cross: if f.crossing { "crossing" } else { "not-crossing" },
+        }
+    }
+}
 
 /// The track's event frame (PIE's `crossing_point`): the first annotated frame with C = 1 for a crosser, the
 /// last annotated frame otherwise — always an annotated frame.
@@ -243,17 +272,7 @@ fn write_video(
         let _ = writeln!(x, "  <track label=\"pedestrian\">");
         for f in &p.frames {
             let b = f.bbox_px;
-            let look = if LOOKING_STATES.contains(&f.state.as_str()) {
-                "looking"
-            } else {
-                "not-looking"
-            };
-            let action = if f.speed_mps >= WALKING_MPS {
-                "walking"
-            } else {
-                "standing"
-            };
-            let cross = if f.crossing { "crossing" } else { "not-crossing" };
+            let Labels { look, action, cross } = Labels::of(f);
             let _ = writeln!(
                 x,
                 "    <box frame=\"{}\" keyframe=\"1\" occluded=\"{}\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
@@ -441,15 +460,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
         report.pedestrian_tracks += peds;
         report.vehicle_tracks += vehicles;
         if png_images {
-            let dir = out.join("images").join(&v.set).join(&v.video);
-            std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
-            for frame in 0..clip.frame_count {
-                let from = ds.layout.sensor_frame("rgb", &clip.clip_id, frame, "png");
-                if from.exists() {
-                    link_file(&from, &dir.join(format!("{frame:05}.png")), link)?;
-                    report.images += 1;
-                }
-            }
+            report.images += link_frames(ds, clip, &out.join("images").join(&v.set).join(&v.video), 5, link)?;
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }

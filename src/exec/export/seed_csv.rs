@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::dataset::{Clip, Dataset};
-use super::{LinkMode, link_file, write_file};
+use super::{LinkMode, link_frames, write_file};
 use crate::error::Error;
 
 /// The seed's `labels.csv` columns, before the pose columns.
@@ -152,13 +152,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<SeedReport, Er
             .push_str(&rows);
         all.push_str(&rows);
         if png_images {
-            for frame in 0..clip.frame_count {
-                let from = ds.layout.sensor_frame("rgb", &clip.clip_id, frame, "png");
-                if from.exists() {
-                    link_file(&from, &dir.join(format!("{frame:06}.png")), link)?;
-                    report.images += 1;
-                }
-            }
+            report.images += link_frames(ds, clip, &dir, 6, link)?;
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
