@@ -20,7 +20,7 @@ import tempfile
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from interop_pie import LOOKING, SHARED, check_sequences, fail, install_pab_get_pose, table  # noqa: E402
+from interop_pie import SHARED, check_sequences, check_track, fail, install_pab_get_pose, table  # noqa: E402
 
 
 def main():
@@ -69,18 +69,7 @@ def main():
             fail(f"{clip_id}: pedestrians {sorted(theirs)} != ours {sorted(ours)}")
         for pid, t in ours.items():
             a = theirs[pid]
-            if a["frames"] != [r["frame"] for r in t]:
-                fail(f"{pid}: frames differ")
-            for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"],
-                                                a["behavior"]["look"]):
-                want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
-                if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
-                    fail(f"{pid} frame {r['frame']}: box {box} != {want}")
-                o = r["occlusion"]
-                if occ != (0 if o < 0.25 else 1 if o <= 0.75 else 2):
-                    fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
-                if cross != int(r["crossing"]) or look != int(r["state"] in LOOKING):
-                    fail(f"{pid} frame {r['frame']}: cross/look differ")
+            check_track(pid, t, a)
             ped = peds[by_id[pid]]
             attrs = a["attributes"]
             first_c = next((r["frame"] for r in t if r["crossing"]), None)

@@ -65,6 +65,24 @@ def our_pose36(kp, box):
     return out
 
 
+def check_track(pid, t, a):
+    """A loader's pedestrian track `a` against our annotation rows `t` of it: frames, boxes, occlusion class,
+    cross and look labels."""
+    if a["frames"] != [r["frame"] for r in t]:
+        fail(f"{pid}: frames differ")
+    for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"], a["behavior"]["look"]):
+        want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
+        if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
+            fail(f"{pid} frame {r['frame']}: box {box} != {want}")
+        o = r["occlusion"]
+        if occ != (0 if o < 0.25 else 1 if o <= 0.75 else 2):
+            fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
+        if cross != int(r["crossing"]):
+            fail(f"{pid} frame {r['frame']}: cross {cross} != C {r['crossing']}")
+        if look != int(r["state"] in LOOKING):
+            fail(f"{pid} frame {r['frame']}: look {look} for {r['state']}")
+
+
 def check_sequences(seq, tracks, peds, by_id, export, out, split, poses_too, get_pose, dataset):
     """Checks a loader's crossing sequences against the tables: each track's class, every box, every image path
     (when images were exported), and get_pose on windows of 16 frames (it stacks equal-length sequences)
@@ -160,20 +178,7 @@ def main():
             fail(f"{clip_id}: pedestrians {sorted(theirs)} != ours {sorted(ours)}")
         for pid, t in ours.items():
             a = theirs[pid]
-            if a["frames"] != [r["frame"] for r in t]:
-                fail(f"{pid}: frames differ")
-            for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"],
-                                                a["behavior"]["look"]):
-                want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
-                if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
-                    fail(f"{pid} frame {r['frame']}: box {box} != {want}")
-                o = r["occlusion"]
-                if occ != (0 if o < 0.25 else 1 if o <= 0.75 else 2):
-                    fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
-                if cross != int(r["crossing"]):
-                    fail(f"{pid} frame {r['frame']}: cross {cross} != C {r['crossing']}")
-                if look != int(r["state"] in LOOKING):
-                    fail(f"{pid} frame {r['frame']}: look {look} for {r['state']}")
+            check_track(pid, t, a)
             attrs = a["attributes"]
             c, p = by_pie_id[pid]
             ped = peds[(c, p)]
