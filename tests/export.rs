@@ -103,7 +103,8 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
     let annotated: usize = view
         .clips
         .iter()
-        .flat_map(|c| c.pedestrians.values())
+        .map(|info| view.load(info).expect("loads"))
+        .flat_map(|c| c.pedestrians.into_values())
         .map(|p| p.frames.len())
         .sum();
     let labels = String::from_utf8(files["seed/labels.csv"].clone()).expect("utf-8");

@@ -76,15 +76,21 @@ pub struct VehicleFrame {
     pub yaw_rad: f64,
 }
 
-/// One clip's tables.
+/// A clip's row of the `clips` table.
 #[derive(Clone, Debug)]
-pub struct Clip {
+pub struct ClipInfo {
     pub clip_id: String,
     pub town: String,
     pub weather: String,
     pub split: String,
     pub fps: u32,
     pub frame_count: u32,
+}
+
+/// One clip's tables (its `clips` row through `Deref`).
+#[derive(Clone, Debug)]
+pub struct Clip {
+    pub info: ClipInfo,
     /// Indexed by frame.
     pub ego: Vec<EgoFrame>,
     /// By pedestrian id.
@@ -93,13 +99,22 @@ pub struct Clip {
     pub vehicles: Vec<VehicleFrame>,
 }
 
-/// A finished dataset.
+impl std::ops::Deref for Clip {
+    type Target = ClipInfo;
+
+    fn deref(&self) -> &ClipInfo {
+        &self.info
+    }
+}
+
+/// A finished dataset: its clips' `clips` rows; the rest of a clip's tables is read when an exporter gets to
+/// it ([`Dataset::load`]), so an export holds one clip at a time.
 pub struct Dataset {
     pub layout: Layout,
     pub manifest: Manifest,
     pub spec: Spec,
     /// The clips, sorted by id.
-    pub clips: Vec<Clip>,
+    pub clips: Vec<ClipInfo>,
 }
 
 fn refuse(msg: String) -> Error {
@@ -157,7 +172,7 @@ impl Dataset {
             .spec;
         let mut clips = Vec::with_capacity(manifest.clips.len());
         for c in &manifest.clips {
-            clips.push(read_clip(&layout, &c.clip_id)?);
+            clips.push(read_info(&layout, &c.clip_id)?);
         }
         clips.sort_by(|a, b| a.clip_id.cmp(&b.clip_id));
         Ok(Dataset {
@@ -169,27 +184,41 @@ impl Dataset {
     }
 }
 
-fn read_clip(layout: &Layout, clip_id: &str) -> Result<Clip, Error> {
-    let file = |t: &str| layout.table(t, clip_id);
+impl Dataset {
+    /// A clip's tables.
+    pub fn load(&self, info: &ClipInfo) -> Result<Clip, Error> {
+        read_clip(&self.layout, info.clone())
+    }
+}
+
+fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
+    let file = layout.table("clips", clip_id);
     let mut clip = None;
-    for b in tables::read(&file("clips"), &["town", "weather", "split", "fps", "frame_count"])? {
+    for b in tables::read(&file, &["town", "weather", "split", "fps", "frame_count"])? {
         let (town, weather, split) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
         let (fps, frames) = (b.u32s("fps")?, b.u32s("frame_count")?);
         if b.rows() > 0 {
-            clip = Some(Clip {
+            clip = Some(ClipInfo {
                 clip_id: clip_id.to_owned(),
                 town: town[0].to_owned(),
                 weather: weather[0].to_owned(),
                 split: split[0].to_owned(),
                 fps: fps.value(0),
                 frame_count: frames.value(0),
-                ego: Vec::new(),
-                pedestrians: BTreeMap::new(),
-                vehicles: Vec::new(),
             });
         }
     }
-    let mut clip = clip.ok_or_else(|| refuse(format!("{}: no row", file("clips").display())))?;
+    clip.ok_or_else(|| refuse(format!("{}: no row", file.display())))
+}
+
+fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
+    let file = |t: &str| layout.table(t, &info.clip_id);
+    let mut clip = Clip {
+        info: info.clone(),
+        ego: Vec::new(),
+        pedestrians: BTreeMap::new(),
+        vehicles: Vec::new(),
+    };
     let cols = [
         "frame",
         "ego_x_m",

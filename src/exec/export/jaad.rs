@@ -11,7 +11,7 @@ use std::path::Path;
 use glam::DVec2;
 use serde::Serialize;
 
-use super::dataset::{Clip, Dataset, EgoFrame};
+use super::dataset::{Clip, ClipInfo, Dataset, EgoFrame};
 use super::pie::{Labels, Place, inside, occlusion_class, place_at, wrap_pi, xml_escape};
 use super::{LinkMode, link_frames, write_file};
 use crate::world::RoadNetwork;
@@ -35,7 +35,7 @@ pub fn track_id(v: &VideoOf, pedestrian: u32) -> String {
 }
 
 /// The videos of the clips (sorted by id).
-pub fn assign_videos(clips: &[Clip]) -> Vec<VideoOf> {
+pub fn assign_videos(clips: &[ClipInfo]) -> Vec<VideoOf> {
     clips
         .iter()
         .enumerate()
@@ -293,7 +293,8 @@ pub fn export(
     };
     let mut splits: BTreeMap<&str, Vec<&str>> = ["train", "val", "test"].into_iter().map(|s| (s, Vec::new())).collect();
     let progress = super::progress(ds.clips.len());
-    for (clip, v) in ds.clips.iter().zip(&videos) {
+    for (info, v) in ds.clips.iter().zip(&videos) {
+        let clip = &ds.load(info)?;
         let net = towns.get(&clip.town).map(|t| &t.network);
         report.pedestrian_tracks += write_video(out, clip, v, (rgb.width_px, rgb.height_px), net)?;
         splits.entry(v.split.as_str()).or_default().push(v.video.as_str());

@@ -71,31 +71,34 @@ pub fn export(ds: &Dataset, out: &Path, jaad: bool) -> Result<PosesReport, Error
             })
             .collect()
     };
-    let mut sets: BTreeMap<String, BTreeMap<String, BTreeMap<String, Vec<f64>>>> = if jaad {
-        BTreeMap::from([("set01".to_owned(), BTreeMap::new())])
+    let set_names: Vec<String> = if jaad {
+        vec!["set01".to_owned()]
     } else {
         SETS.iter()
-            .flat_map(|(_, sets)| sets.iter().map(|s| (s.to_string(), BTreeMap::new())))
+            .flat_map(|(_, sets)| sets.iter().map(|s| s.to_string()))
             .collect()
     };
-    let mut report = PosesReport::default();
-    for (clip, (set, video, name)) in ds.clips.iter().zip(&names) {
-        let entries = sets.entry(set.clone()).or_default().entry(video.clone()).or_default();
-        for p in clip.pedestrians.values() {
-            let id = name(p.id);
-            for f in &p.frames {
-                let pose = pose36(f);
-                report.entries += 1;
-                report.with_pose += usize::from(pose.iter().any(|&x| x != 0.0));
-                entries.insert(format!("{:05}_{id}", f.frame), pose);
-            }
-        }
-    }
     let dir = out.join("poses");
     std::fs::create_dir_all(&dir).map_err(|e| Error::write(&dir, e))?;
-    for (set, videos) in &sets {
+    let mut report = PosesReport::default();
+    // One set at a time: a pickle is one object, so a set's poses are held until it is written.
+    for set in &set_names {
+        let mut videos: BTreeMap<String, BTreeMap<String, Vec<f64>>> = BTreeMap::new();
+        for (info, (_, video, name)) in ds.clips.iter().zip(&names).filter(|(_, (s, _, _))| s == set) {
+            let clip = ds.load(info)?;
+            let entries = videos.entry(video.clone()).or_default();
+            for p in clip.pedestrians.values() {
+                let id = name(p.id);
+                for f in &p.frames {
+                    let pose = pose36(f);
+                    report.entries += 1;
+                    report.with_pose += usize::from(pose.iter().any(|&x| x != 0.0));
+                    entries.insert(format!("{:05}_{id}", f.frame), pose);
+                }
+            }
+        }
         let mut bytes = Vec::new();
-        serde_pickle::to_writer(&mut bytes, videos, serde_pickle::SerOptions::new())
+        serde_pickle::to_writer(&mut bytes, &videos, serde_pickle::SerOptions::new())
             .map_err(|e| Error::new(code::INTERNAL_SERIALIZE, format!("pose_{set}.pkl: {e}")))?;
         write_file(&dir.join(format!("pose_{set}.pkl")), &bytes)?;
         report.files += 1;

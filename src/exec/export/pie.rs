@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use serde::Serialize;
 
-use super::dataset::{Clip, Dataset, Pedestrian};
+use super::dataset::{Clip, ClipInfo, Dataset, Pedestrian};
 use super::{LinkMode, link_frames, write_file};
 use crate::error::{Error, code};
 use crate::exec::observe::rig::Camera;
@@ -37,7 +37,7 @@ pub struct VideoOf {
 
 /// Spreads the clips (sorted by id) over the sets of their split, round robin; videos are numbered from 1
 /// within a set.
-pub fn assign_videos(clips: &[Clip]) -> Result<Vec<VideoOf>, Error> {
+pub fn assign_videos(clips: &[ClipInfo]) -> Result<Vec<VideoOf>, Error> {
     let mut next_set: BTreeMap<&str, usize> = BTreeMap::new();
     let mut next_video: BTreeMap<&str, u32> = BTreeMap::new();
     let mut out = Vec::with_capacity(clips.len());
@@ -454,7 +454,8 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
     let (png_images, note) = super::images_note(ds, link);
     report.images_note = note;
     let progress = super::progress(ds.clips.len());
-    for (clip, v) in ds.clips.iter().zip(&videos) {
+    for (info, v) in ds.clips.iter().zip(&videos) {
+        let clip = &ds.load(info)?;
         let net = towns.get(&clip.town).map(|t| &t.network);
         let (peds, vehicles) = write_video(out, clip, v, &camera, net)?;
         report.pedestrian_tracks += peds;

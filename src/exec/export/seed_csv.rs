@@ -8,12 +8,15 @@
 //! (`000000.png`, linked); per weather `<weather>/labels.csv` and for the dataset `labels.csv`, the combined
 //! rows.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::Path;
 
 use super::dataset::{Clip, Dataset};
 use super::{LinkMode, link_frames, write_file};
 use crate::error::Error;
+use crate::fsutil::AtomicFile;
 
 /// The seed's `labels.csv` columns, before the pose columns.
 pub const LABEL_COLUMNS: [&str; 12] = [
@@ -136,30 +139,43 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<SeedReport, Er
         ..SeedReport::default()
     };
     let header = label_header();
-    let mut all = header.clone();
-    let mut weathers: std::collections::BTreeMap<&str, String> = std::collections::BTreeMap::new();
+    // The combined files are written as the clips go (an export holds one clip at a time), each under a
+    // temporary name until the last clip is in.
+    let combined = |path: &Path| -> Result<AtomicFile, Error> {
+        let mut f = AtomicFile::create(path).map_err(|e| Error::write(path, e))?;
+        f.write_all(header.as_bytes()).map_err(|e| Error::write(path, e))?;
+        Ok(f)
+    };
+    let all_path = out.join("labels.csv");
+    let mut all = combined(&all_path)?;
+    let mut weathers: BTreeMap<String, (std::path::PathBuf, AtomicFile)> = BTreeMap::new();
     let progress = super::progress(ds.clips.len());
-    for clip in &ds.clips {
+    for info in &ds.clips {
+        let clip = &ds.load(info)?;
         let dir = out.join(&clip.weather).join(&clip.town).join(&clip.clip_id);
         let rows = label_rows(clip);
         report.rows += rows.lines().count();
         write_file(&dir.join("labels.csv"), format!("{header}{rows}").as_bytes())?;
         write_file(&dir.join("pedestrians_3d.csv"), pedestrians_3d(clip).as_bytes())?;
         write_file(&dir.join("ego_pose.csv"), ego_pose(clip).as_bytes())?;
-        weathers
-            .entry(&clip.weather)
-            .or_insert_with(|| header.clone())
-            .push_str(&rows);
-        all.push_str(&rows);
+        if !weathers.contains_key(&clip.weather) {
+            let path = out.join(&clip.weather).join("labels.csv");
+            let file = combined(&path)?;
+            weathers.insert(clip.weather.clone(), (path, file));
+        }
+        if let Some((path, file)) = weathers.get_mut(&clip.weather) {
+            file.write_all(rows.as_bytes()).map_err(|e| Error::write(path, e))?;
+        }
+        all.write_all(rows.as_bytes()).map_err(|e| Error::write(&all_path, e))?;
         if png_images {
             report.images += link_frames(ds, clip, &dir, 6, link)?;
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
     progress.finish();
-    for (weather, text) in &weathers {
-        write_file(&out.join(weather).join("labels.csv"), text.as_bytes())?;
+    for (path, file) in weathers.into_values() {
+        file.commit().map_err(|e| Error::write(&path, e))?;
     }
-    write_file(&out.join("labels.csv"), all.as_bytes())?;
+    all.commit().map_err(|e| Error::write(&all_path, e))?;
     Ok(report)
 }
