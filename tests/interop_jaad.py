@@ -9,47 +9,19 @@ As tests/interop_pie.py (whose helpers it uses), for JAAD's layout: behaviour-an
 split lists, and the JAAD set of the pose files.
 """
 
-import argparse
-import json
 import os
 import shutil
-import subprocess
 import sys
-import tempfile
 
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from interop_pie import SHARED, check_sequences, check_track, fail, install_pab_get_pose, table  # noqa: E402
+from interop_pie import SHARED, check_sequences, check_track, fail, install_pab_get_pose, setup  # noqa: E402
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("dataset")
-    ap.add_argument("--pedsynth", required=True)
-    ap.add_argument("--no-poses", action="store_true")
-    args = ap.parse_args()
-    poses_too = not args.no_poses
-
-    work = tempfile.mkdtemp(prefix="interop_jaad_")
-    out = os.path.join(work, "jaad")
-    for fmt in ["jaad", "pab-poses-jaad"] if poses_too else ["jaad"]:
-        subprocess.run([args.pedsynth, "export", fmt, args.dataset, "--out", out], check=True)
-    export = json.load(open(os.path.join(out, "pedsynth_export.json")))
+    args, work, out, export, poses_too, clips, peds, tracks = setup("jaad", ["jaad", "pab-poses-jaad"])
     video_of = {v["clip_id"]: v["video"] for v in export["videos"]}
-
-    clips = {r["clip_id"]: r for r in table(args.dataset, "clips", ["clip_id", "split", "frame_count"])}
-    peds = {
-        (r["clip_id"], r["pedestrian"]): r
-        for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender"])
-    }
-    ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
-                "crossing", "state", "occlusion"] + (["keypoints"] if poses_too else [])
-    tracks = {}
-    for r in table(args.dataset, "annotations", ann_cols):
-        tracks.setdefault((r["clip_id"], r["pedestrian"]), []).append(r)
-    for t in tracks.values():
-        t.sort(key=lambda r: r["frame"])
     jaad_id = lambda c, p: f"0_{int(video_of[c][6:])}_{p}b"  # noqa: E731
     by_id = {jaad_id(c, p): (c, p) for (c, p) in tracks}
 

@@ -128,25 +128,22 @@ def install_pab_get_pose():
     return get_pose
 
 
-def main():
+def setup(name, formats):
+    """Parses the command line, runs `pedsynth export` for `formats` (the first one only with --no-poses) into
+    a temporary directory and reads our side with pyarrow. Returns (args, work dir, export dir,
+    pedsynth_export.json, poses_too, clips by id, pedestrians by (clip, id), annotation rows by (clip, id) in
+    frame order)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
     ap.add_argument("--pedsynth", required=True)
     ap.add_argument("--no-poses", action="store_true")
     args = ap.parse_args()
     poses_too = not args.no_poses
-
-    work = tempfile.mkdtemp(prefix="interop_pie_")
-    out = os.path.join(work, "pie")
-    for fmt in ["pie", "pab-poses"] if poses_too else ["pie"]:
+    work = tempfile.mkdtemp(prefix=f"interop_{name}_")
+    out = os.path.join(work, name)
+    for fmt in formats if poses_too else formats[:1]:
         subprocess.run([args.pedsynth, "export", fmt, args.dataset, "--out", out], check=True)
     export = json.load(open(os.path.join(out, "pedsynth_export.json")))
-    video_of = {v["clip_id"]: (v["set"], v["video"]) for v in export["videos"]}
-    prefix = {
-        v["clip_id"]: f"{int(v['set'][3:])}_{int(v['video'][6:])}" for v in export["videos"]
-    }
-
-    # Our side.
     clips = {r["clip_id"]: r for r in table(args.dataset, "clips", ["clip_id", "split", "frame_count"])}
     peds = {
         (r["clip_id"], r["pedestrian"]): r
@@ -159,6 +156,16 @@ def main():
         tracks.setdefault((r["clip_id"], r["pedestrian"]), []).append(r)
     for t in tracks.values():
         t.sort(key=lambda r: r["frame"])
+    return args, work, out, export, poses_too, clips, peds, tracks
+
+
+def main():
+    args, work, out, export, poses_too, clips, peds, tracks = setup("pie", ["pie", "pab-poses"])
+    video_of = {v["clip_id"]: (v["set"], v["video"]) for v in export["videos"]}
+    frames = table(args.dataset, "frames", ["clip_id", "frame", "ego_speed_mps", "ego_yaw_rad"])
+    prefix = {
+        v["clip_id"]: f"{int(v['set'][3:])}_{int(v['video'][6:])}" for v in export["videos"]
+    }
     by_pie_id = {f"{prefix[c]}_{p}": (c, p) for (c, p) in tracks}
 
     # PIE's loader.
@@ -172,6 +179,16 @@ def main():
         v = db[set_id][video]
         if v["num_frames"] != clips[clip_id]["frame_count"]:
             fail(f"{clip_id}: num_frames {v['num_frames']} != {clips[clip_id]['frame_count']}")
+        # Ego vehicle: PIE's OBD speed (km/h) and yaw (degrees) in every frame.
+        ego = [r for r in frames if r["clip_id"] == clip_id]
+        if sorted(v["vehicle_annotations"]) != [r["frame"] for r in ego]:
+            fail(f"{clip_id}: vehicle frames differ")
+        for r in ego:
+            obd = v["vehicle_annotations"][r["frame"]]
+            if abs(obd["OBD_speed"] - 3.6 * r["ego_speed_mps"]) > 1e-3 or abs(obd["GPS_speed"] - obd["OBD_speed"]) > 0:
+                fail(f"{clip_id} frame {r['frame']}: OBD speed {obd['OBD_speed']} for {r['ego_speed_mps']} m/s")
+            if abs(obd["yaw"] - np.degrees(r["ego_yaw_rad"])) > 1e-3:
+                fail(f"{clip_id} frame {r['frame']}: yaw {obd['yaw']} for {r['ego_yaw_rad']} rad")
         ours = {f"{prefix[clip_id]}_{p}": t for (c, p), t in tracks.items() if c == clip_id}
         theirs = v["ped_annotations"]
         if sorted(ours) != sorted(theirs):
@@ -192,7 +209,8 @@ def main():
             if attrs["age"] != age or attrs["gender"] != {"female": 1, "male": 2}[ped["gender"]]:
                 fail(f"{pid}: age/gender differ")
             seen += 1
-    print(f"interop_pie: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables")
+    print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames in "
+          f"{len(video_of)} videos equal the tables")
 
     # The benchmark's sequences (its default crossing options) and its get_pose.
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))

@@ -106,15 +106,25 @@ const APPEARANCE: [&str; 24] = [
     "umbrella",
 ];
 
-/// Whether a crosswalk lies ahead of the ego within 40 m (JAAD's per-frame `ped_crossing`).
-fn crosswalk_ahead(net: Option<&RoadNetwork>, e: &EgoFrame) -> bool {
-    let Some(net) = net else { return false };
+/// A town's crosswalks as (outline, centre), worked out once per clip.
+fn crosswalks(net: Option<&RoadNetwork>) -> Vec<(&[DVec2], DVec2)> {
+    net.map_or_else(Vec::new, |net| {
+        net.crosswalks
+            .iter()
+            .map(|c| {
+                let centre = c.polygon.iter().copied().sum::<DVec2>() / c.polygon.len().max(1) as f64;
+                (c.polygon.as_slice(), centre)
+            })
+            .collect()
+    })
+}
+
+/// Whether a crosswalk lies ahead of the ego within 40 m, or under it (JAAD's per-frame `ped_crossing`).
+fn crosswalk_ahead(crosswalks: &[(&[DVec2], DVec2)], e: &EgoFrame) -> bool {
     let (p, fwd) = (DVec2::new(e.x_m, e.y_m), DVec2::from_angle(e.yaw_rad));
-    net.crosswalks.iter().any(|c| {
-        let n = c.polygon.len().max(1) as f64;
-        let centre = c.polygon.iter().copied().sum::<DVec2>() / n;
+    crosswalks.iter().any(|&(polygon, centre)| {
         let d = centre - p;
-        inside(&c.polygon, p) || (d.length() < 40.0 && d.dot(fwd) > 0.7 * d.length())
+        inside(polygon, p) || (d.length() < 40.0 && d.dot(fwd) > 0.7 * d.length())
     })
 }
 
@@ -175,7 +185,7 @@ fn write_video(
             .and_then(|c| p.frames.iter().find(|f| f.frame == c))
             .unwrap_or(&p.frames[p.frames.len() - 1]);
         let place = net.map_or(Place::UNKNOWN, |n| place_at(n, f64::from(at.x_m), f64::from(at.y_m)));
-        let on_crosswalk = place.signalized == "C";
+        let on_crosswalk = place.on_crosswalk;
         let _ = writeln!(
             a,
             "<pedestrian age=\"{}\" crossing=\"{}\" crossing_point=\"{}\" decision_point=\"{}\" designated=\"{}\" \
@@ -234,11 +244,12 @@ fn write_video(
     let mut t =
         String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<traffic_scene><road_type>street</road_type>\n");
     let mut veh = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<vehicle_info>\n");
+    let crosswalks = crosswalks(net);
     for (i, e) in clip.ego.iter().enumerate() {
         let _ = writeln!(
             t,
             "<frame id=\"{i}\" ped_crossing=\"{}\" ped_sign=\"0\" stop_sign=\"0\" traffic_light=\"n/a\" />",
-            u8::from(crosswalk_ahead(net, e))
+            u8::from(crosswalk_ahead(&crosswalks, e))
         );
         let _ = writeln!(veh, "<frame action=\"{}\" id=\"{i}\" />", vehicle_action(e));
     }

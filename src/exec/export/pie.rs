@@ -142,6 +142,8 @@ pub struct Place {
     pub num_lanes: u32,
     pub signalized: &'static str,
     pub traffic_direction: &'static str,
+    /// Whether the point lies on a crosswalk.
+    pub on_crosswalk: bool,
 }
 
 impl Place {
@@ -151,6 +153,7 @@ impl Place {
         num_lanes: 0,
         signalized: "n/a",
         traffic_direction: "TW",
+        on_crosswalk: false,
     };
 }
 
@@ -195,6 +198,7 @@ pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64) -> Place {
         num_lanes: driving.len() as u32,
         signalized: if on_crosswalk { "C" } else { "n/a" },
         traffic_direction: if forward && backward { "TW" } else { "OW" },
+        on_crosswalk,
     }
 }
 
@@ -293,6 +297,12 @@ fn write_video(
     }
     let mut vehicle_tracks = 0;
     let prefix = video_prefix(v);
+    // The annotations' camera in each frame, placed once.
+    let cameras: Vec<_> = clip
+        .ego
+        .iter()
+        .map(|e| camera.at(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad))
+        .collect();
     let mut i = 0;
     while i < clip.vehicles.len() {
         let vid = clip.vehicles[i].vehicle;
@@ -300,11 +310,10 @@ fn write_video(
         while i < clip.vehicles.len() && clip.vehicles[i].vehicle == vid {
             let vf = clip.vehicles[i];
             i += 1;
-            let Some(ego) = clip.ego.get(vf.frame as usize) else {
+            let Some(cam) = cameras.get(vf.frame as usize) else {
                 continue;
             };
-            let cam = camera.at(DVec3::new(ego.x_m, ego.y_m, ego.z_m), ego.yaw_rad);
-            if let Some(b) = vehicle_box(&cam, DVec3::new(vf.x_m, vf.y_m, vf.z_m), vf.yaw_rad) {
+            if let Some(b) = vehicle_box(cam, DVec3::new(vf.x_m, vf.y_m, vf.z_m), vf.yaw_rad) {
                 let _ = writeln!(
                     boxes,
                     "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
