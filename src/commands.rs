@@ -222,6 +222,12 @@ pub fn town_show(town: &str, png: Option<&Path>, json: bool, out: &mut dyn Write
     emit(out, &text)
 }
 
+/// `pedsynth town export NAME --xodr OUT`.
+pub fn town_export(town: &str, xodr: &Path, out: &mut dyn Write) -> Result<(), Error> {
+    let text = crate::world::town_export(town, xodr)?;
+    emit(out, &text)
+}
+
 pub use crate::exec::generate::GenerateOptions as GenerateArgs;
 
 /// Reads a plan file (`pedsynth plan --emit`) and the towns it names (relative paths resolve against the

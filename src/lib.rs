@@ -10,3 +10,4 @@ pub mod fsutil;
 pub mod mix;
 pub mod planner;
 pub mod world;
+pub(crate) mod xml;

@@ -183,6 +183,14 @@ enum TownCommand {
         #[arg(long)]
         json: bool,
     },
+    /// Write a built-in town as OpenDRIVE 1.7 (roads, lanes, marks, junctions, crosswalks, buildings).
+    Export {
+        /// Built-in town name (see `pedsynth town list`).
+        town: String,
+        /// The OpenDRIVE file to write.
+        #[arg(long, value_name = "OUT.xodr")]
+        xodr: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -305,6 +313,9 @@ fn main() -> ExitCode {
         Command::Town {
             command: TownCommand::Show { town, png, json },
         } => commands::town_show(&town, png.as_deref(), json, &mut out),
+        Command::Town {
+            command: TownCommand::Export { town, xodr },
+        } => commands::town_export(&town, &xodr, &mut out),
     };
     let code = commands::finish(result, &mut err);
     ExitCode::from(code as u8)

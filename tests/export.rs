@@ -33,21 +33,6 @@ fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
     )
 }
 
-/// A directory removed when dropped.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn path(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn export(format: &str, dataset: &Path, out: &Path) -> (Option<i32>, String, String) {
     pedsynth(&[
         "export".as_ref(),
@@ -60,9 +45,7 @@ fn export(format: &str, dataset: &Path, out: &Path) -> (Option<i32>, String, Str
 
 #[test]
 fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
-    let root = std::env::temp_dir().join(format!("pedsynth-export-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
-    let tmp = Scratch(root);
+    let tmp = common::Scratch::new("export");
     let ds = tmp.path().join("ds");
     let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &common::NO_SENSORS, &ds, None);
     assert_eq!(code, 0, "{stderr}");

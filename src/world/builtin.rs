@@ -166,6 +166,11 @@ pub(crate) fn description(name: &str) -> Option<&'static str> {
     params(name).map(|p| p.description)
 }
 
+/// The raw OpenDRIVE records and the building blocks of a built-in town (what [`build`] builds from).
+pub(crate) fn raw(name: &str) -> Option<(RawNetwork, Vec<Obstacle>)> {
+    params(name).map(|p| generate(&p))
+}
+
 pub(crate) fn build(name: &str) -> Option<RoadNetwork> {
     let p = params(name)?;
     let (raw, obstacles) = generate(&p);
@@ -196,6 +201,7 @@ fn lane(id: i32, lane_type: LaneType, w: f64) -> RawLane {
         widths: width(w),
         speed_mps: None,
         travel: None,
+        links: (None, None),
         pos: 0,
     }
 }
@@ -226,6 +232,32 @@ fn junction_link(id: usize) -> Option<RoadLink> {
         element_id: id.to_string(),
         contact_point: None,
     })
+}
+
+/// Arms E and N of a junction are the start of their through road, W and S its end.
+fn arm_starts_road(arm: usize) -> bool {
+    arm < 2
+}
+
+/// Id of driving lane `k` (0 = nearest the centre) on arm `arm` of a junction, for traffic coming into the
+/// junction (`incoming`) or leaving it. Right-hand traffic: on a road that starts at the junction, incoming
+/// traffic drives against the reference direction, on the left (positive ids).
+fn arm_lane_id(arm: usize, class: &Class, k: usize, incoming: bool) -> i32 {
+    let magnitude = (k + 1 + usize::from(class.median_w > 0.0)) as i32;
+    if arm_starts_road(arm) == incoming {
+        magnitude
+    } else {
+        -magnitude
+    }
+}
+
+/// Link from a connecting road to the through road on arm `arm`, at the end that touches the junction.
+fn road_link(road_id: &str, arm: usize) -> RoadLink {
+    RoadLink {
+        element_type: "road".into(),
+        element_id: road_id.into(),
+        contact_point: Some(if arm_starts_road(arm) { "start" } else { "end" }.into()),
+    }
 }
 
 struct Gen {
@@ -537,7 +569,7 @@ fn generate(p: &Params) -> (RawNetwork, Vec<Obstacle>) {
                 if !pa {
                     continue;
                 }
-                for (ub, pb, cb, jb) in arms {
+                for (kb, (ub, pb, cb, jb)) in arms.into_iter().enumerate() {
                     if !pb || ub == ua {
                         continue;
                     }
@@ -554,20 +586,25 @@ fn generate(p: &Params) -> (RawNetwork, Vec<Obstacle>) {
                         let b = node + ub * jb - left_n(ub) * cb.lane_offset(lb);
                         let ga = connector(a, angle(-ua), b, angle(ub));
                         let w = ca.lane_w;
+                        let incoming = arm_road.get(&(i, j, ka)).cloned().unwrap_or_default();
+                        let outgoing = arm_road.get(&(i, j, kb)).cloned().unwrap_or_default();
+                        let (from_lane, to_lane) = (arm_lane_id(ka, &ca, la, true), arm_lane_id(kb, &cb, lb, false));
+                        let mut connector_lane = lane(-1, LaneType::Driving, w);
+                        connector_lane.links = (Some(from_lane), Some(to_lane));
                         let id = g.road(
                             ga,
-                            vec![lane(-1, LaneType::Driving, w)],
+                            vec![connector_lane],
                             0.5 * w,
                             Some(jid),
                             ca.speed_mps.min(cb.speed_mps),
-                            None,
-                            None,
+                            Some(road_link(&incoming, ka)),
+                            Some(road_link(&outgoing, kb)),
                         );
                         connections.push(JunctionConnection {
-                            incoming_road: arm_road.get(&(i, j, ka)).cloned().unwrap_or_default(),
+                            incoming_road: incoming,
                             connecting_road: id,
                             contact_point: "start".into(),
-                            lane_links: vec![(-(la as i32 + 1), -1)],
+                            lane_links: vec![(from_lane, -1)],
                         });
                     }
                 }

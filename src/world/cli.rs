@@ -1,5 +1,5 @@
-//! Library side of `pedsynth town list` and `pedsynth town show`: text and JSON output, and the PNG map
-//! written atomically (temporary file, then rename). `main.rs` only parses arguments and calls these.
+//! Library side of `pedsynth town list`, `pedsynth town show` and `pedsynth town export`: text and JSON
+//! output, the PNG map and the OpenDRIVE file written atomically (temporary file, then rename). `main.rs` only parses arguments and calls these.
 
 use std::path::Path;
 
@@ -58,6 +58,27 @@ pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<S
         out.push_str(&format!("  map written to {}\n", path.display()));
     }
     Ok(out)
+}
+
+/// `pedsynth town export NAME --xodr OUT`: writes built-in town `name` as OpenDRIVE and returns the line to
+/// print. An OpenDRIVE path or an unknown name is refused (unknown town).
+pub fn town_export(name: &str, xodr: &Path) -> Result<String, WorldError> {
+    let Some(text) = super::opendrive::write::builtin_to_xodr(name)? else {
+        return Err(WorldError::UnknownTown { name: name.into() });
+    };
+    write_atomically(xodr, text.as_bytes())?;
+    let net = RoadNetwork::builtin(name).ok_or_else(|| WorldError::UnknownTown { name: name.into() })?;
+    let s = net.summary();
+    Ok(format!(
+        "{name} written to {} as OpenDRIVE {}.{}: {} roads, {} junctions, {} crosswalks, {} buildings\n",
+        xodr.display(),
+        super::opendrive::write::XODR_REV.0,
+        super::opendrive::write::XODR_REV.1,
+        s.road_count,
+        s.junction_count,
+        s.crosswalk_count,
+        s.obstacle_count
+    ))
 }
 
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), WorldError> {

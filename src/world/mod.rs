@@ -38,7 +38,7 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-pub use cli::{town_list_text, town_show};
+pub use cli::{town_export, town_list_text, town_show};
 pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSample, SpawnPoint};
 
 /// Names of the built-in procedural towns, in the order `pedsynth town list` shows them. They are modelled on

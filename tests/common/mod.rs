@@ -304,3 +304,26 @@ pub fn all_files(dir: &std::path::Path) -> std::collections::BTreeMap<String, Ve
     walk(dir, dir, &mut out);
     out
 }
+
+/// A scratch directory under the system's temporary directory, named after the test and the process, removed
+/// when dropped.
+pub struct Scratch(std::path::PathBuf);
+
+impl Scratch {
+    pub fn new(tag: &str) -> Scratch {
+        let root = std::env::temp_dir().join(format!("pedsynth-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(&root).expect("scratch directory");
+        Scratch(root)
+    }
+
+    pub fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}

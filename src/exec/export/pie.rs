@@ -4,6 +4,7 @@
 //! ego-vehicle (OBD) XML, the images linked from `sensors/rgb`, and `pedsynth_export.json` with the mapping.
 //! Every value comes from the dataset's tables, its resolved spec and its town; DATASET.md lists the mapping.
 
+pub(crate) use crate::xml::escape as xml_escape;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -212,13 +213,6 @@ pub(crate) fn inside(polygon: &[glam::DVec2], p: glam::DVec2) -> bool {
         }
     }
     inside
-}
-
-pub(crate) fn xml_escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// A vehicle's projected box in a frame: the 8 corners of its 3D box, all in front of the camera, the box

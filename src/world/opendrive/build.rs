@@ -1,8 +1,9 @@
 //! Raw OpenDRIVE records → the road-network model: samples every lane section at stations along the
 //! reference line (≤ 2 m apart, closer on curves so that the chord error stays ≤ 2 cm), turns each lane into
 //! a run of [`LanePiece`] quads, resolves travel directions and speed limits, places crosswalks (from
-//! `<object type="crosswalk">`, or synthesised at junction mouths when a file has none) and then derives the
-//! query structures. Used by both sources: the built-in generator emits the same raw records.
+//! `<object type="crosswalk">`, or synthesised at junction mouths when a file has none), takes buildings from
+//! `<object type="building">` (or synthesises them beside the sidewalks when a file has none) and then derives
+//! the query structures. Used by both sources: the built-in generator emits the same raw records.
 
 use glam::DVec2;
 
@@ -10,8 +11,8 @@ use super::geometry::{Poly3At, eval_piecewise};
 use super::parse::{RawNetwork, RawRoad, RawSection};
 use super::{MAX_PIECES, MAX_WIDTH_M};
 use crate::world::{
-    Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, Road, RoadNetwork, TownSource, TravelDirection,
-    WorldError, index, obstacles, routes,
+    Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, ObstacleKind, Road, RoadNetwork, TownSource,
+    TravelDirection, WorldError, index, obstacles, routes,
 };
 
 /// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
@@ -145,8 +146,8 @@ fn stations(road: &RawRoad, a: f64, b: f64, out: &mut Vec<f64>) {
     out.push(b);
 }
 
-/// Builds the model from raw records. `obstacles` come from the built-in generator; for imported files
-/// building blocks are synthesised beside the sidewalks.
+/// Builds the model from raw records. Buildings come from the file's `<object type="building">` records, or
+/// are synthesised beside the sidewalks when it has none.
 pub(crate) fn build(
     raw: RawNetwork,
     name: String,
@@ -174,6 +175,7 @@ pub(crate) fn build_with(
         carriageway_m: 0.0,
     };
     let mut file_crosswalks = Vec::new();
+    let mut file_buildings = Vec::new();
     for (ri, road) in raw.roads.iter().enumerate() {
         let lane_start = lanes.len() as u32;
         for (si, sec) in road.sections.iter().enumerate() {
@@ -264,6 +266,10 @@ pub(crate) fn build_with(
         for o in &road.objects {
             if o.kind.eq_ignore_ascii_case("crosswalk") {
                 file_crosswalks.push(object_polygon(road, ri as u32, o));
+            } else if o.kind.eq_ignore_ascii_case("building")
+                && let Some(b) = building(road, o)
+            {
+                file_buildings.push(b);
             }
         }
         roads.push(Road {
@@ -331,12 +337,38 @@ pub(crate) fn build_with(
     net.index = index::LaneIndex::build(&net);
     net.obstacles = match given_obstacles {
         Some(o) => o,
+        None if !file_buildings.is_empty() => file_buildings,
         None => obstacles::synthesize_buildings(&net),
     };
     net.obstacle_index = obstacles::ObstacleIndex::build(&net.obstacles);
     net.lane_graph = routes::LaneGraph::build(&net);
     net.sidewalk_graph = routes::SidewalkGraph::build(&net);
     Ok(net)
+}
+
+/// A `<object type="building">` as a box: its outline in the object's frame (the bounding box of the corners)
+/// or its length and width around its origin; `None` without a footprint or a height.
+fn building(road: &RawRoad, o: &super::parse::RawObject) -> Option<Obstacle> {
+    let (p, h) = ref_at(road, o.s.clamp(0.0, road.length));
+    let origin = p + left_normal(h) * o.t;
+    let heading_rad = h + o.hdg;
+    let (centre_local, half) = if o.outline.len() >= 3 && !o.outline_in_road_coords {
+        let (lo, hi) = crate::world::bounding_box(o.outline.iter().map(|&(u, v)| DVec2::new(u, v)))?;
+        ((lo + hi) * 0.5, (hi - lo) * 0.5)
+    } else {
+        (DVec2::ZERO, DVec2::new(0.5 * o.length, 0.5 * o.width))
+    };
+    if half.x <= 0.0 || half.y <= 0.0 || o.height <= 0.0 {
+        return None;
+    }
+    Some(Obstacle {
+        kind: ObstacleKind::Building,
+        centre: origin + DVec2::from_angle(heading_rad).rotate(centre_local),
+        half_extents_m: half,
+        heading_rad,
+        base_z_m: eval_piecewise(&road.elevations, o.s) + o.z_offset,
+        height_m: o.height,
+    })
 }
 
 fn object_polygon(road: &RawRoad, ri: u32, o: &super::parse::RawObject) -> Crosswalk {
@@ -371,6 +403,30 @@ fn object_polygon(road: &RawRoad, ri: u32, o: &super::parse::RawObject) -> Cross
 /// Crosswalks across every non-junction road end that meets a junction and has sidewalks on both sides:
 /// 3 m deep, starting 0.5 m from the road end, spanning between the inner sidewalk borders.
 fn synthesize_crosswalks(raw: &RawNetwork, path: &str, xml: &str) -> Result<Vec<Crosswalk>, WorldError> {
+    Ok(crosswalk_corners(raw, path, xml)?
+        .into_iter()
+        .map(|(ri, corners)| {
+            let road = &raw.roads[ri as usize];
+            Crosswalk {
+                polygon: corners
+                    .iter()
+                    .map(|&(s, t)| {
+                        let (p, h) = ref_at(road, s);
+                        p + left_normal(h) * t
+                    })
+                    .collect(),
+                road: ri,
+                synthesized: true,
+            }
+        })
+        .collect())
+}
+
+/// A crosswalk on road `.0` with corners `(s, t)` in road coordinates.
+pub(crate) type CrosswalkCorners = (u32, [(f64, f64); 4]);
+
+/// The crosswalks [`synthesize_crosswalks`] places, as (road index, corners in road coordinates `(s, t)`).
+pub(crate) fn crosswalk_corners(raw: &RawNetwork, path: &str, xml: &str) -> Result<Vec<CrosswalkCorners>, WorldError> {
     let mut out = Vec::new();
     let mut b = Borders {
         lanes: Vec::new(),
@@ -415,15 +471,7 @@ fn synthesize_crosswalks(raw: &RawNetwork, path: &str, xml: &str) -> Result<Vec<
             if !ok {
                 continue;
             }
-            let pt = |s: f64, t: f64| {
-                let (p, h) = ref_at(road, s);
-                p + left_normal(h) * t
-            };
-            out.push(Crosswalk {
-                polygon: vec![pt(s0, ts[0].0), pt(s1, ts[1].0), pt(s1, ts[1].1), pt(s0, ts[0].1)],
-                road: ri as u32,
-                synthesized: true,
-            });
+            out.push((ri as u32, [(s0, ts[0].0), (s1, ts[1].0), (s1, ts[1].1), (s0, ts[0].1)]));
         }
     }
     Ok(out)

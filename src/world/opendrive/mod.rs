@@ -1,10 +1,12 @@
 //! OpenDRIVE (.xodr 1.4–1.7) import: `parse` turns XML into raw records with line numbers, `geometry`
-//! evaluates reference lines and cubic profiles, and `build` turns raw records into the road-network model.
+//! evaluates reference lines and cubic profiles, `build` turns raw records into the road-network model, and
+//! `write` exports a built-in town as OpenDRIVE.
 //! The caps below protect against hostile input (OOM, absurd values).
 
 pub(crate) mod build;
 pub(crate) mod geometry;
 pub(crate) mod parse;
+pub mod write;
 
 /// Largest .xodr file we read.
 pub const MAX_FILE_BYTES: u64 = 256 * 1024 * 1024;

@@ -55,6 +55,8 @@ pub(crate) struct RawLane {
     pub widths: Vec<Poly3At>,
     pub speed_mps: Option<f64>,
     pub travel: Option<TravelDirection>,
+    /// Ids of the predecessor and successor lanes (`<link>`), where given.
+    pub links: (Option<i32>, Option<i32>),
     /// Byte offset of the element in the source (converted to a line only for errors).
     pub pos: u32,
 }
@@ -66,15 +68,17 @@ pub(crate) struct RawJunction {
     pub connections: Vec<JunctionConnection>,
 }
 
-/// An `<object>`; only crosswalks are used.
+/// An `<object>`; crosswalks and buildings are used.
 #[derive(Clone, Debug)]
 pub(crate) struct RawObject {
     pub kind: String,
     pub s: f64,
     pub t: f64,
+    pub z_offset: f64,
     pub hdg: f64,
     pub length: f64,
     pub width: f64,
+    pub height: f64,
     /// Outline corners: (s, t) road coordinates when `road` is true, else (u, v) relative to the object.
     pub outline: Vec<(f64, f64)>,
     pub outline_in_road_coords: bool,
@@ -445,12 +449,19 @@ fn parse_section(cx: &Ctx, sec: Node, lht: bool) -> Result<RawSection, WorldErro
             {
                 travel = Some(TravelDirection::Both);
             }
+            let link_id = |tag: &str| {
+                child(l, "link")
+                    .and_then(|k| child(k, tag))
+                    .and_then(|e| e.attribute("id"))
+                    .and_then(|v| v.trim().parse::<i32>().ok())
+            };
             lanes.push(RawLane {
                 id,
                 lane_type,
                 widths,
                 speed_mps: speed,
                 travel,
+                links: (link_id("predecessor"), link_id("successor")),
                 pos,
             });
         }
@@ -497,8 +508,12 @@ fn parse_object(cx: &Ctx, o: Node) -> Result<RawObject, WorldError> {
     let hdg = cx.num_or(o, "hdg", 0.0)?;
     let length = cx.num_or(o, "length", 0.0)?;
     let width = cx.num_or(o, "width", 0.0)?;
+    let height = cx.num_or(o, "height", 0.0)?;
+    let z_offset = cx.num_or(o, "zOffset", 0.0)?;
     cx.bounded(o, "length", length, 0.0, 1e4)?;
     cx.bounded(o, "width", width, 0.0, 1e4)?;
+    cx.bounded(o, "height", height, 0.0, 1e4)?;
+    cx.bounded(o, "zOffset", z_offset, -1e4, 1e4)?;
     let mut outline = Vec::new();
     let mut road_coords = false;
     let outline_node = child(o, "outline").or_else(|| child(o, "outlines").and_then(|os| child(os, "outline")));
@@ -526,9 +541,11 @@ fn parse_object(cx: &Ctx, o: Node) -> Result<RawObject, WorldError> {
         kind,
         s,
         t,
+        z_offset,
         hdg,
         length,
         width,
+        height,
         outline,
         outline_in_road_coords: road_coords,
     })
