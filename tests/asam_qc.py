@@ -3,6 +3,7 @@
 
     python3 tests/asam_qc.py xodr FILE.xodr [...]     # asam-qc-opendrive (qc_opendrive)
     python3 tests/asam_qc.py xosc FILE.xosc [...]     # asam-qc-openscenarioxml (qc_openscenario)
+    (--quiet: print only problems and the summary line)
 
 Each file gets its own checker configuration (every checker of the bundle runs: the bundles run all their
 checks whatever the configuration lists), then the result file (.xqar) is read back with the checkers' own
@@ -19,6 +20,7 @@ import tempfile
 
 from qc_baselib import Result, StatusType
 
+VERBOSE = True
 BUNDLES = {"xodr": ("qc_opendrive", "xodrBundle"), "xosc": ("qc_openscenario", "xoscBundle")}
 
 
@@ -55,16 +57,20 @@ def check(kind: str, path: str, work: str) -> tuple[list[str], set[str], set[str
             skipped.append(f"{checker.checker_id} ({checker.summary})")
         else:
             problems.append(f"{checker.checker_id}: status {checker.status} ({checker.summary})")
-    print(f"{path}: {len(completed)} checks completed, {len(problems)} problems, {len(skipped)} not applicable to its version")
-    for s in skipped:
-        print(f"  not applicable: {s}")
+    if VERBOSE:
+        print(f"{path}: {len(completed)} checks completed, {len(problems)} problems, {len(skipped)} not applicable to its version")
+        for s in skipped:
+            print(f"  not applicable: {s}")
     return problems, completed, all_ids
 
 
 def main() -> None:
     if len(sys.argv) < 3 or sys.argv[1] not in BUNDLES:
         sys.exit(__doc__)
-    kind, files = sys.argv[1], sys.argv[2:]
+    global VERBOSE
+    VERBOSE = "--quiet" not in sys.argv
+    kind, files = sys.argv[1], [a for a in sys.argv[2:] if a != "--quiet"]
+    checks = 0
     with tempfile.TemporaryDirectory() as work:
         for path in files:
             copies = [path]
@@ -87,8 +93,10 @@ def main() -> None:
                 all_ids |= ids
             if completed != all_ids:
                 sys.exit(f"{path}: checks that never ran: {sorted(all_ids - completed)}")
-            print(f"{path}: all {len(all_ids)} checks of the bundle ran, zero issues")
-    print(f"asam_qc: {len(files)} {kind} files, zero issues")
+            if VERBOSE:
+                print(f"{path}: all {len(all_ids)} checks of the bundle ran, zero issues")
+            checks = len(all_ids)
+    print(f"asam_qc: {len(files)} {kind} files, all {checks} checks of {BUNDLES[kind][0]} ran on each, zero issues")
 
 
 if __name__ == "__main__":

@@ -23,7 +23,15 @@ use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::observe::{body, rig::Camera};
 use pedsynth::exec::simulate;
 
-const TABLES: [&str; 6] = ["clips", "frames", "pedestrians", "annotations", "vehicles", "events"];
+const TABLES: [&str; 7] = [
+    "clips",
+    "frames",
+    "pedestrians",
+    "annotations",
+    "tracks",
+    "vehicles",
+    "events",
+];
 const CROSSING_STATES: [&str; 5] = [
     "CROSSING_ROAD",
     "SUDDEN_CROSSING",
@@ -133,7 +141,7 @@ fn read_table(dir: &Path, table: &str, spec_hash: &str) -> Vec<RecordBatch> {
         assert_eq!(kv["pedsynth.table"], table, "{}", path.display());
         assert_eq!(kv["pedsynth.clip_id"], clip_id, "{}", path.display());
         assert_eq!(kv["pedsynth.spec_hash"], spec_hash, "{}", path.display());
-        assert_eq!(kv["pedsynth.schema_version"], "4", "{}", path.display());
+        assert_eq!(kv["pedsynth.schema_version"], "5", "{}", path.display());
         assert_eq!(kv["pedsynth.version"], env!("CARGO_PKG_VERSION"), "{}", path.display());
         for batch in builder.build().expect("reader") {
             let batch = batch.expect("batch");
@@ -234,6 +242,9 @@ struct AnnRow {
     lane: Option<String>,
 }
 
+/// A `tracks` row: (x, y, state, C, lane type, annotated).
+type TrackRow = (f32, f32, String, bool, Option<String>, bool);
+
 #[derive(Debug, Clone, Copy)]
 struct FrameRow {
     timestamp_ns: i64,
@@ -245,6 +256,7 @@ struct Dataset {
     frames: BTreeMap<(String, u32), FrameRow>,
     pedestrians: BTreeMap<(String, u32), PedRow>,
     annotations: Vec<AnnRow>,
+    tracks: BTreeMap<(String, u32, u32), TrackRow>,
     vehicles: BTreeMap<String, BTreeSet<u32>>,
     contacts: BTreeMap<String, u32>,
 }
@@ -258,6 +270,7 @@ fn read_dataset(dir: &Path) -> Dataset {
         frames: BTreeMap::new(),
         pedestrians: BTreeMap::new(),
         annotations: Vec::new(),
+        tracks: BTreeMap::new(),
         vehicles: BTreeMap::new(),
         contacts: BTreeMap::new(),
     };
@@ -351,6 +364,27 @@ fn read_dataset(dir: &Path) -> Dataset {
                 keypoints: kp.value(i).as_primitive::<Float32Type>().values().to_vec(),
                 lane: lane[i].clone(),
             });
+        }
+    }
+    for b in read_table(dir, "tracks", &spec_hash) {
+        let (ids, frame, ped) = (strs(&b, "clip_id"), u32s(&b, "frame"), u32s(&b, "pedestrian"));
+        let (x, y, state, crossing) = (f32s(&b, "x_m"), f32s(&b, "y_m"), strs(&b, "state"), bools(&b, "crossing"));
+        let (lane, annotated) = (strs(&b, "lane_type"), bools(&b, "annotated"));
+        for i in 0..b.num_rows() {
+            let key = (
+                ids[i].clone().expect("id"),
+                frame[i].expect("frame"),
+                ped[i].expect("pedestrian"),
+            );
+            let row = (
+                x[i],
+                y[i],
+                state[i].clone().expect("state"),
+                crossing[i],
+                lane[i].clone(),
+                annotated[i],
+            );
+            assert!(d.tracks.insert(key.clone(), row).is_none(), "tracks: {key:?} twice");
         }
     }
     for b in read_table(dir, "vehicles", &spec_hash) {
@@ -688,6 +722,39 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
                 labels_from_definition(&states, &lanes, smoothing)
             })
             .collect();
+        // `tracks`: every pedestrian in every frame, with the trace's position and state, C from the
+        // definition, and `annotated` exactly where the annotations table has a row.
+        let annotated: BTreeSet<(u32, u32)> = d
+            .annotations
+            .iter()
+            .filter(|a| a.clip == script.clip_id)
+            .map(|a| (a.frame, a.ped))
+            .collect();
+        let rows = d.tracks.keys().filter(|k| k.0 == script.clip_id).count();
+        assert_eq!(
+            rows,
+            trace.pedestrians.iter().map(Vec::len).sum::<usize>(),
+            "{}: tracks rows",
+            script.clip_id
+        );
+        for (id, frames) in trace.pedestrians.iter().enumerate() {
+            for (f, pf) in frames.iter().enumerate() {
+                let key = (script.clip_id.clone(), f as u32, id as u32);
+                let t = d.tracks.get(&key).unwrap_or_else(|| panic!("tracks: no row {key:?}"));
+                assert_eq!(
+                    (t.0, t.1, t.2.as_str(), t.3, t.4.clone(), t.5),
+                    (
+                        pf.pos.x as f32,
+                        pf.pos.y as f32,
+                        pf.state.name(),
+                        labels[id][f],
+                        pf.lane_type.map(lane_name),
+                        annotated.contains(&(f as u32, id as u32))
+                    ),
+                    "tracks {key:?}"
+                );
+            }
+        }
         for (id, l) in labels.iter().enumerate() {
             let p = &d.pedestrians[&(script.clip_id.clone(), id as u32)];
             assert_eq!(
@@ -931,6 +998,10 @@ fn generate_refuses_directories_it_must_not_write_into() {
     ));
     assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(stderr, "", "--quiet prints nothing on stderr");
+    assert!(
+        !dataset.join("README.md").exists(),
+        "an unfinished dataset gets no card"
+    );
     let before = all_files(&dataset);
 
     // A dataset of another spec.
@@ -977,4 +1048,40 @@ fn stats_protocol_pab_reads_the_tables_and_refuses_undefined_options() {
     let code = commands::finish(commands::stats(&out, false, Some(&short), &mut o), &mut e);
     assert_eq!(code, 2);
     assert!(String::from_utf8_lossy(&e).contains("pedsynth::dataset::protocol_options"));
+}
+
+#[test]
+fn a_finished_dataset_gets_a_card_with_its_licence_counts_and_a_config_per_table() {
+    let tmp = TempDir::new("card");
+    let out = tmp.join("ds");
+    generate_ok(&spec("quickstart.yaml"), &["dataset.license=cc-by-4.0"], &out, 2);
+    let card = std::fs::read_to_string(out.join("README.md")).expect("README.md");
+    let (front, body) = card
+        .strip_prefix("---\n")
+        .and_then(|c| c.split_once("\n---\n"))
+        .expect("front matter");
+    assert!(front.lines().any(|l| l == "license: cc-by-4.0"), "{front}");
+    let d = read_dataset(&out);
+    for table in ["annotations", "tracks", "pedestrians", "frames", "clips"] {
+        assert!(front.contains(&format!("- config_name: {table}\n")), "{table}");
+        for clip in &d.clips {
+            assert!(front.contains(&format!("\"tables/{table}/{}.parquet\"", clip.clip)));
+        }
+    }
+    // No sensors: the empty `sensors` table gets no config (a split without rows cannot be loaded).
+    assert!(!front.contains("config_name: sensors"));
+    assert!(body.contains("`sensors`: one row per sensor file (path, size, SHA-256) (no rows in this dataset)"));
+    let samples: u64 = d.clips.iter().map(|c| c.annotated_samples).sum();
+    assert!(body.contains(&format!("| annotated samples (pedestrian-frames) | {samples} |")), "{body}");
+    assert!(body.contains(&format!("| clips | {} |", d.clips.len())));
+    assert!(!card.contains(tmp.0.to_str().unwrap()), "no absolute path in the card");
+
+    // A licence that is not an identifier is refused, pointing at the value.
+    let text = std::fs::read_to_string(spec("quickstart.yaml")).unwrap();
+    let bad = text.replacen("dataset:\n", "dataset:\n  license: CC BY 4.0\n", 1);
+    let err = pedsynth::dsl::load_bytes(bad.as_bytes(), "bad.yaml", Path::new("specs"), &options(&[]))
+        .err()
+        .expect("refused");
+    let shown = format!("{err:?}");
+    assert!(shown.contains("dataset.license") && shown.contains("CC BY 4.0"), "{shown}");
 }

@@ -11,6 +11,7 @@
 
 mod common;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -58,6 +59,7 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
             ("jaad", "jaad"),
             ("pab-poses-jaad", "jaad"),
             ("seed-csv", "seed"),
+            ("openscenario", "xosc"),
         ] {
             let (code, stdout, stderr) = export(format, &ds, &out.join(layout));
             assert_eq!(code, Some(0), "{stderr}");
@@ -77,6 +79,8 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         "jaad/annotations/video_0001.xml",
         "jaad/poses/pose_set01.pkl",
         "jaad/split_ids/default/val.txt",
+        "xosc/towns/town01_like.xodr",
+        "xosc/town01_like-clear_noon-0000.xosc",
     ] {
         assert!(files.contains_key(file), "{file}: {:?}", files.keys());
     }
@@ -103,6 +107,12 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         "no duplicate (video_id, frame_id, pedestrian_id)"
     );
     assert!(rows.iter().all(|r| r.split(',').count() == width));
+    // OpenSCENARIO: every entity's polyline, evaluated at every frame, is where the tables put it.
+    for info in &view.clips {
+        let clip = view.load(info).expect("loads");
+        let xosc = String::from_utf8(files[&format!("xosc/{}.xosc", clip.clip_id)].clone()).expect("utf-8");
+        check_replay(&clip, &xosc);
+    }
     // Re-running over an export keeps it byte for byte.
     let (code, _, stderr) = export("pie", &ds, &a.join("pie"));
     assert_eq!(code, Some(0), "{stderr}");
@@ -180,4 +190,74 @@ fn poses_are_openpose18_normalised_in_the_box_with_hidden_joints_zero() {
     assert_eq!((p[14], p[15]), (0.0, 0.0), "the hidden left wrist is 0");
     assert_eq!((p[28], p[29]), at(1), "left eye 15th");
     assert_eq!((p[34], p[35]), at(4), "right ear last");
+}
+
+/// Parses an exported .xosc and checks that each entity's polyline, linearly interpolated in time, passes
+/// within the exporter's tolerance (2 cm, 0.02 rad, plus the file's rounding) of every frame of the tables:
+/// the ego from `frames`, vehicles from `vehicles`, pedestrians from `tracks`; and that the scenario declares
+/// exactly these entities, points at the exported town and carries the clip's weather.
+fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
+    use pedsynth::exec::export::openscenario::{TOLERANCE_M, TOLERANCE_RAD};
+    let doc = roxmltree::Document::parse(xosc).expect("well-formed");
+    let logic = doc.descendants().find(|n| n.has_tag_name("LogicFile")).unwrap();
+    assert_eq!(logic.attribute("filepath"), Some(format!("towns/{}.xodr", clip.town).as_str()));
+    let num = |n: roxmltree::Node, a: &str| n.attribute(a).unwrap().parse::<f64>().unwrap();
+    let mut polylines: BTreeMap<String, Vec<[f64; 5]>> = BTreeMap::new();
+    for t in doc.descendants().filter(|n| n.has_tag_name("Trajectory")) {
+        let vertices = t
+            .descendants()
+            .filter(|n| n.has_tag_name("Vertex"))
+            .map(|v| {
+                let w = v.descendants().find(|n| n.has_tag_name("WorldPosition")).unwrap();
+                [num(v, "time"), num(w, "x"), num(w, "y"), num(w, "z"), num(w, "h")]
+            })
+            .collect();
+        polylines.insert(t.attribute("name").unwrap().to_owned(), vertices);
+    }
+    let declared: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("ScenarioObject"))
+        .map(|n| n.attribute("name").unwrap())
+        .collect();
+    let vehicles: std::collections::BTreeSet<u32> = clip.vehicles.iter().map(|v| v.vehicle).collect();
+    assert_eq!(declared.len(), 1 + vehicles.len() + clip.tracks.len());
+    assert_eq!(polylines.len(), declared.len());
+    assert_eq!(clip.tracks.len(), clip.pedestrians.len(), "tracks cover every pedestrian");
+    let at = |name: &str, t: f64| -> [f64; 4] {
+        let p = &polylines[name];
+        let k = p.partition_point(|v| v[0] <= t + 1e-9).clamp(1, p.len() - 1);
+        let (a, b) = (p[k - 1], p[k]);
+        let w = if b[0] > a[0] { ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0) } else { 0.0 };
+        std::array::from_fn(|i| a[i + 1] + (b[i + 1] - a[i + 1]) * w)
+    };
+    let fps = f64::from(clip.fps);
+    let mut checked = 0;
+    let mut check = |name: &str, frame: u32, want: [f64; 4]| {
+        let got = at(name, f64::from(frame) / fps);
+        let d = ((got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2) + (got[2] - want[2]).powi(2)).sqrt();
+        let dh = (got[3] - want[3] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        assert!(
+            d <= TOLERANCE_M + 0.002 && dh.abs() <= TOLERANCE_RAD + 0.001,
+            "{} {name} frame {frame}: polyline {got:?}, table {want:?}",
+            clip.clip_id
+        );
+        checked += 1;
+    };
+    for (f, e) in clip.ego.iter().enumerate() {
+        check("ego", f as u32, [e.x_m, e.y_m, e.z_m, e.yaw_rad]);
+    }
+    for v in &clip.vehicles {
+        check(&format!("vehicle_{}", v.vehicle), v.frame, [v.x_m, v.y_m, v.z_m, v.yaw_rad]);
+    }
+    for (id, track) in &clip.tracks {
+        assert_eq!(track.len(), clip.frame_count as usize, "pedestrian {id}: a row per frame");
+        for f in track {
+            check(&format!("pedestrian_{id}"), f.frame, [f.x_m, f.y_m, f.z_m, f.yaw_rad]);
+        }
+    }
+    assert!(checked > clip.frame_count as usize * 3);
+    let vertices: usize = polylines.values().map(Vec::len).sum();
+    assert!(vertices * 4 < checked, "polylines are simplified ({vertices} vertices for {checked} poses)");
+    let sun = doc.descendants().find(|n| n.has_tag_name("Sun")).unwrap();
+    assert!((num(sun, "elevation") - clip.sun_altitude_deg.to_radians()).abs() < 1e-3);
 }

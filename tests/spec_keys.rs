@@ -24,7 +24,8 @@ use serde_json::{Value as Json, json};
 #[derive(PartialEq)]
 struct Outcome {
     /// The plan's clip scripts, dataset name and target (not its copy of the spec or the simulation
-    /// parameters, which hold every key verbatim: those must prove themselves in the tables).
+    /// parameters, which hold every key verbatim: those must prove themselves in the tables), and the dataset
+    /// card generate would write for it (with placeholder counts).
     plan: String,
     /// blake3 of every table file of every clip (with fixed file metadata, so the spec hash does not count),
     /// and, for the keys of `sensors` and `output`, of the sensor files of the first frames of the first clip.
@@ -67,7 +68,20 @@ impl Walker {
             &own
         };
         let plan = planner::plan(&loaded.spec, "walk", "", towns, None).unwrap_or_else(|p| panic!("plan: {p:?}"));
-        let plan_text = serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio)).expect("json");
+        let manifest: pedsynth::exec::write::manifest::Manifest = serde_json::from_value(json!({
+            "pedsynth_dataset": 1, "pedsynth_version": "walk", "schema_version": 0, "dataset": plan.dataset,
+            "spec_hash": "walk", "plan_hash": "walk", "target_crossing_ratio": plan.target_crossing_ratio,
+            "tables": [], "sensors": {}, "clips": []
+        }))
+        .expect("manifest");
+        let card = pedsynth::exec::write::card::render(
+            &plan.spec,
+            &manifest,
+            &BTreeMap::new(),
+            &BTreeMap::new(),
+            &Default::default(),
+        );
+        let plan_text = serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio, card)).expect("json");
         let tables = with_tables.then(|| {
             let rig = Rig::from_spec(&plan.spec.sensors);
             let meta = FileMeta {
@@ -83,6 +97,7 @@ impl Walker {
                     tables::frames_batch(script, &trace),
                     tables::pedestrians_batch(script, ann),
                     tables::annotations_batch(script, ann, plan.spec.annotations.pose_format),
+                    tables::tracks_batch(script, &trace, ann),
                     tables::vehicles_batch(script, &trace),
                     tables::events_batch(script, &trace),
                     tables::sensor_poses_batch(script, &trace, &rig, &plan.spec.sensors),
@@ -322,6 +337,7 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
                 "format" => &["parquet", "carla_bin"],
                 "dvs_encoding" => &["parquet"],
                 "name" => &["walk", "walk_renamed"],
+                "license" => &["unknown", "cc-by-4.0"],
                 _ if parent_key == "splits" => &["train", "val", "test"],
                 _ => &[],
             };

@@ -250,6 +250,19 @@ impl Validator<'_> {
                     .at(self.span("dataset.name"), "empty name"),
             );
         }
+        let license_ok = !d.license.is_empty()
+            && d.license.len() <= 64
+            && d.license.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+'));
+        if !license_ok {
+            self.problems.push(
+                Problem::new(
+                    code::OUT_OF_RANGE,
+                    format!("`dataset.license` `{}` is not a licence identifier", d.license),
+                )
+                .at(self.span("dataset.license"), "not an identifier")
+                .help("an SPDX-style id as the Hugging Face Hub lists them (cc-by-4.0, cc0-1.0, mit), `other` or `unknown`"),
+            );
+        }
         if d.towns.is_empty() {
             self.problems.push(
                 Problem::new(code::OUT_OF_RANGE, "`dataset.towns` must name at least one town")

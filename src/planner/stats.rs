@@ -18,6 +18,9 @@ pub const ANNOTATION_ROW_BYTES: f64 = 420.0;
 pub const FRAME_ROW_BYTES: f64 = 40.5;
 /// Bytes per `vehicles` row (measured: 14.5).
 pub const VEHICLE_ROW_BYTES: f64 = 14.5;
+/// Bytes per `tracks` row (every pedestrian in every frame: position, velocity, state, C, lane; measured on
+/// `specs/pedsynth_pp.yaml` on 2026-11-24: 24,169,932 bytes for 2,939,923 rows = 8.2).
+pub const TRACK_ROW_BYTES: f64 = 8.2;
 /// Bytes per clip of the one-row `clips` table: mostly Parquet metadata (measured: 8,500).
 pub const CLIP_FILE_BYTES: f64 = 8_500.0;
 /// Bytes per pedestrian of the `pedestrians` table (measured: 924).
@@ -332,6 +335,10 @@ fn estimate_bytes(stats: &PlanStats, spec: &Spec, vehicle_frames: u64) -> SizeEs
         (stats.estimated_annotated_samples as f64 * ANNOTATION_ROW_BYTES) as u64,
     );
     e.tables.insert("frames".into(), (frames * FRAME_ROW_BYTES) as u64);
+    e.tables.insert(
+        "tracks".into(),
+        (stats.pedestrian_frames as f64 * TRACK_ROW_BYTES) as u64,
+    );
     e.tables
         .insert("vehicles".into(), (vehicle_frames as f64 * VEHICLE_ROW_BYTES) as u64);
     e.tables.insert(

@@ -14,6 +14,10 @@ use super::Range;
 pub struct Dataset {
     /// Dataset name (used in the output's metadata).
     pub name: String,
+    /// Licence of the generated data, as the dataset card's `license` field: an SPDX-style identifier as
+    /// Hugging Face lists them (`cc-by-4.0`, `cc0-1.0`, `mit`, ...), `other`, or `unknown` (the default: the
+    /// data is yours to license).
+    pub license: String,
     /// Dataset seed; each clip's seed derives from it and the clip's identity.
     pub seed: u64,
     /// Towns: built-in names or `{name, opendrive: path}` (path relative to the spec file).
@@ -36,6 +40,7 @@ impl Default for Dataset {
     fn default() -> Self {
         Dataset {
             name: "pedsynth".to_owned(),
+            license: "unknown".to_owned(),
             seed: 0,
             towns: BuiltinTown::ALL.iter().map(|t| TownRef::Builtin(*t)).collect(),
             weathers: WeatherSelection::All(AllKeyword::All),

@@ -51,7 +51,21 @@ pub struct Pedestrian {
     pub behaviour: String,
     /// First frame with C = 1, annotated or not.
     pub first_crossing_frame: Option<u32>,
+    /// Body height, metres.
+    pub height_m: f32,
+    /// `adult`, `child` or `adult_with_child`.
+    pub body: String,
     pub frames: Vec<AnnotatedFrame>,
+}
+
+/// One pedestrian in one frame (the `tracks` table: every frame, seen or not).
+#[derive(Clone, Copy, Debug)]
+pub struct TrackFrame {
+    pub frame: u32,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub yaw_rad: f64,
 }
 
 /// The ego's state in one frame.
@@ -85,6 +99,14 @@ pub struct ClipInfo {
     pub split: String,
     pub fps: u32,
     pub frame_count: u32,
+    /// The clip's weather parameters (CARLA's units: degrees and percentages).
+    pub sun_altitude_deg: f64,
+    pub sun_azimuth_deg: f64,
+    pub cloudiness_pct: f64,
+    pub precipitation_pct: f64,
+    pub fog_density_pct: f64,
+    pub wetness_pct: f64,
+    pub wind_intensity_pct: f64,
 }
 
 /// One clip's tables (its `clips` row through `Deref`).
@@ -97,6 +119,9 @@ pub struct Clip {
     pub pedestrians: BTreeMap<u32, Pedestrian>,
     /// Sorted by (vehicle, frame).
     pub vehicles: Vec<VehicleFrame>,
+    /// Every pedestrian's track, by pedestrian id, in frame order (empty for a dataset written before the
+    /// `tracks` table existed).
+    pub tracks: BTreeMap<u32, Vec<TrackFrame>>,
 }
 
 impl std::ops::Deref for Clip {
@@ -194,9 +219,21 @@ impl Dataset {
 fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
     let file = layout.table("clips", clip_id);
     let mut clip = None;
-    for b in tables::read(&file, &["town", "weather", "split", "fps", "frame_count"])? {
+    const WEATHER: [&str; 7] = [
+        "sun_altitude_deg",
+        "sun_azimuth_deg",
+        "cloudiness_pct",
+        "precipitation_pct",
+        "fog_density_pct",
+        "wetness_pct",
+        "wind_intensity_pct",
+    ];
+    let mut cols = vec!["town", "weather", "split", "fps", "frame_count"];
+    cols.extend(WEATHER);
+    for b in tables::read(&file, &cols)? {
         let (town, weather, split) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
         let (fps, frames) = (b.u32s("fps")?, b.u32s("frame_count")?);
+        let w: Vec<_> = WEATHER.iter().map(|c| b.f64s(c)).collect::<Result<_, _>>()?;
         if b.rows() > 0 {
             clip = Some(ClipInfo {
                 clip_id: clip_id.to_owned(),
@@ -205,6 +242,13 @@ fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
                 split: split[0].to_owned(),
                 fps: fps.value(0),
                 frame_count: frames.value(0),
+                sun_altitude_deg: w[0].value(0),
+                sun_azimuth_deg: w[1].value(0),
+                cloudiness_pct: w[2].value(0),
+                precipitation_pct: w[3].value(0),
+                fog_density_pct: w[4].value(0),
+                wetness_pct: w[5].value(0),
+                wind_intensity_pct: w[6].value(0),
             });
         }
     }
@@ -218,6 +262,7 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         ego: Vec::new(),
         pedestrians: BTreeMap::new(),
         vehicles: Vec::new(),
+        tracks: BTreeMap::new(),
     };
     let cols = [
         "frame",
@@ -254,11 +299,14 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         "group_id",
         "behaviour",
         "first_crossing_frame",
+        "height_m",
+        "body",
     ];
     for b in tables::read(&file("pedestrians"), &cols)? {
         let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
         let (crosser, intention, group) = (b.bools("crosser")?, b.u32s("intention_frame")?, b.u32s("group_id")?);
         let (behaviour, first_c) = (b.strings("behaviour")?, b.u32s("first_crossing_frame")?);
+        let (height, body) = (b.f32s("height_m")?, b.strings("body")?);
         for i in 0..b.rows() {
             clip.pedestrians.insert(
                 id.value(i),
@@ -271,6 +319,8 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
                     group_id: (!group.is_null(i)).then(|| group.value(i)),
                     behaviour: behaviour[i].to_owned(),
                     first_crossing_frame: (!first_c.is_null(i)).then(|| first_c.value(i)),
+                    height_m: height.value(i),
+                    body: body[i].to_owned(),
                     frames: Vec::new(),
                 },
             );
@@ -351,5 +401,25 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         }
     }
     clip.vehicles.sort_by_key(|v| (v.vehicle, v.frame));
+    let tracks = file("tracks");
+    if tracks.is_file() {
+        let cols = ["frame", "pedestrian", "x_m", "y_m", "z_m", "yaw_rad"];
+        for b in tables::read(&tracks, &cols)? {
+            let (frame, ped) = (b.u32s("frame")?, b.u32s("pedestrian")?);
+            let v: Vec<_> = cols[2..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            for i in 0..b.rows() {
+                clip.tracks.entry(ped.value(i)).or_default().push(TrackFrame {
+                    frame: frame.value(i),
+                    x_m: f64::from(v[0].value(i)),
+                    y_m: f64::from(v[1].value(i)),
+                    z_m: f64::from(v[2].value(i)),
+                    yaw_rad: f64::from(v[3].value(i)),
+                });
+            }
+        }
+        for t in clip.tracks.values_mut() {
+            t.sort_by_key(|f| f.frame);
+        }
+    }
     Ok(clip)
 }

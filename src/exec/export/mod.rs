@@ -4,6 +4,8 @@
 //! - [`pie`] — PIE's annotations, attributes, ego-vehicle files and images (`pie_data.py` loads them).
 //! - [`jaad`] — JAAD's five annotation folders, split lists and images (`jaad_data.py` loads them).
 //! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE or the JAAD export.
+//! - [`openscenario`] — one ASAM OpenSCENARIO 1.2 file per clip replaying its traces, with the towns as
+//!   OpenDRIVE beside them.
 //! - [`seed_csv`] — the seed system's CSV layout (labels, 3D boxes, ego poses; per clip, weather, dataset).
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
@@ -11,6 +13,7 @@
 
 pub mod dataset;
 pub mod jaad;
+pub mod openscenario;
 pub mod pab;
 pub mod pie;
 pub mod seed_csv;
@@ -34,6 +37,8 @@ pub enum Format {
     PabPosesJaad,
     /// The seed system's CSV layout: <weather>/<town>/<clip>/labels.csv, pedestrians_3d.csv, ego_pose.csv.
     SeedCsv,
+    /// ASAM OpenSCENARIO 1.2: <clip_id>.xosc per clip replaying its traces, towns/<town>.xodr beside them.
+    Openscenario,
 }
 
 /// How images get into an export.
@@ -194,6 +199,18 @@ pub fn export(
                 r.rows,
                 r.images,
                 r.images_note
+            )
+        }
+        Format::Openscenario => {
+            let r = openscenario::export(&ds, out)?;
+            format!(
+                "{}: {} OpenSCENARIO files ({} entities, {} trajectory vertices for {} entity-frames) and {} towns as OpenDRIVE in towns/\n",
+                out.display(),
+                r.scenarios,
+                r.entities,
+                r.vertices,
+                r.frames,
+                r.towns
             )
         }
         Format::PabPoses | Format::PabPosesJaad => {

@@ -113,7 +113,27 @@ pub fn generate(
             Err(e) => failures.push(e),
         }
     }
-    writer.finish()?;
+    let manifest = writer.finish()?;
+    if failures.is_empty() && manifest.clips.iter().all(|c| c.status == "done") {
+        // A finished dataset gets its card (README.md), written after the manifest.
+        let stats = crate::exec::read::stats::compute(&options.out)?;
+        let splits = plan
+            .clips
+            .iter()
+            .map(|c| (c.clip_id.clone(), crate::exec::write::tables::split_name(c.split)))
+            .collect();
+        let layout = crate::exec::write::Layout::new(&options.out);
+        let mut rows = BTreeMap::new();
+        for clip in &plan.clips {
+            for table in crate::exec::write::tables::TABLES {
+                let n = crate::exec::read::tables::row_count(&layout.table(table, &clip.clip_id))?;
+                rows.insert((table.to_owned(), clip.clip_id.clone()), n);
+            }
+        }
+        let card = crate::exec::write::card::render(&plan.spec, &manifest, &splits, &rows, &stats);
+        let path = options.out.join(crate::exec::write::card::CARD_FILE);
+        crate::fsutil::write_atomically(&path, card.as_bytes()).map_err(|e| Error::write(&path, e))?;
+    }
     match failures.len() {
         0 => Ok(report),
         1 => Err(failures.remove(0)),

@@ -95,6 +95,8 @@ pub struct ClipAnnotations {
     pub pedestrians: Vec<PedestrianLabels>,
     /// Counts of pedestrian-frames that failed the visibility gate, by reason.
     pub rejections: Rejections,
+    /// Crossing label C of every pedestrian (by id) in every frame, annotated or not.
+    pub crossing: Vec<Vec<bool>>,
 }
 
 /// Per-frame crossing labels of one pedestrian: raw (state ∧ driving lane), then smoothed.
@@ -279,6 +281,7 @@ pub fn annotate(
         rows: Vec::new(),
         pedestrians: vec![PedestrianLabels::default(); n_peds],
         rejections: Rejections::default(),
+        crossing: Vec::new(),
     };
     for (i, p) in out.pedestrians.iter_mut().enumerate() {
         p.first_crossing_frame = first_crossing[i];
@@ -442,6 +445,7 @@ pub fn annotate(
             });
         }
     }
+    out.crossing = labels;
     out
 }
 

@@ -30,6 +30,14 @@ pub fn files(layout: &Layout, table: &str) -> Result<Vec<PathBuf>, Error> {
     Ok(out)
 }
 
+/// The number of rows of one Parquet file (from its footer).
+pub fn row_count(path: &Path) -> Result<u64, Error> {
+    let file = File::open(path).map_err(|e| Error::read(path, e))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file)
+        .map_err(|e| Error::new(code::DATASET_INVALID, format!("{}: {e}", path.display())))?;
+    Ok(builder.metadata().file_metadata().num_rows().max(0) as u64)
+}
+
 /// The record batches of `columns` of one Parquet file.
 pub fn read(path: &Path, columns: &[&str]) -> Result<Vec<Batch>, Error> {
     let invalid = |e: &dyn std::fmt::Display| Error::new(code::DATASET_INVALID, format!("{}: {e}", path.display()));

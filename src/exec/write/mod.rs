@@ -2,6 +2,7 @@
 //!
 //! - [`layout`] — every path of the dataset, in one place.
 //! - [`manifest`] — `manifest.json`.
+//! - [`card`] — the dataset card `README.md` (Hugging Face front matter) of a finished dataset.
 //! - [`tables`] — the Parquet tables: schemas and record batches.
 //! - [`sensors`] — the camera streams' files, the DVS events and the sensor index table.
 //! - [`lidar`] — the LiDAR's points (a Parquet file per clip, or the seed's `.bin` per frame).
@@ -12,6 +13,7 @@
 //! them, `clips` last): a clip is finished when all of its table files exist, which is what a resumed run
 //! skips, so a clip interrupted while rendering is rendered again whole.
 
+pub mod card;
 pub mod layout;
 pub mod lidar;
 pub mod manifest;
@@ -114,6 +116,7 @@ impl DatasetWriter {
                 "annotations",
                 tables::annotations_batch(script, ann, plan.spec.annotations.pose_format),
             ),
+            ("tracks", tables::tracks_batch(script, trace, ann)),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
             (

@@ -26,13 +26,14 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 4;
+pub const SCHEMA_VERSION: u32 = 5;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 8] = [
+pub const TABLES: [&str; 9] = [
     "frames",
     "pedestrians",
     "annotations",
+    "tracks",
     "vehicles",
     "events",
     "sensor_poses",
@@ -58,6 +59,11 @@ fn lane_name(l: LaneType) -> &'static str {
         LaneType::Biking => "biking",
         LaneType::Other => "other",
     }
+}
+
+/// The name of a split as the tables write it (`train`, `val`, `test`).
+pub fn split_name(split: crate::dsl::types::Split) -> String {
+    snake(&split)
 }
 
 fn snake<T: serde::Serialize>(value: &T) -> String {
@@ -444,6 +450,66 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             f32c(|f| f.speed_mps),
             f32c(|f| f.accel_mps2),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| profile(r.1)))),
+        ],
+    )
+}
+
+/// The `tracks` table: every pedestrian in every frame, seen by the camera or not (the full 3D state that
+/// trajectory models and scenario replays need), ordered by (frame, pedestrian).
+pub fn tracks_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotations) -> RecordBatch {
+    let annotated: std::collections::BTreeSet<(u32, u32)> = ann.rows.iter().map(|r| (r.frame, r.pedestrian)).collect();
+    let rows: Vec<(u32, u32, &crate::exec::trace::PedFrame)> = (0..trace.ego.len())
+        .flat_map(|f| {
+            trace
+                .pedestrians
+                .iter()
+                .enumerate()
+                .filter_map(move |(p, frames)| frames.get(f).map(|x| (f as u32, p as u32, x)))
+        })
+        .collect();
+    let n = rows.len();
+    let f32c = |get: fn(&crate::exec::trace::PedFrame) -> f64| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32)))
+    };
+    let crossing = |f: u32, p: u32| {
+        ann.crossing
+            .get(p as usize)
+            .and_then(|c| c.get(f as usize))
+            .copied()
+            .unwrap_or(false)
+    };
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("pedestrian", DataType::UInt32, false),
+            field("x_m", DataType::Float32, false),
+            field("y_m", DataType::Float32, false),
+            field("z_m", DataType::Float32, false),
+            field("yaw_rad", DataType::Float32, false),
+            field("vx_mps", DataType::Float32, false),
+            field("vy_mps", DataType::Float32, false),
+            field("state", DataType::Utf8, false),
+            field("crossing", DataType::Boolean, false),
+            field("lane_type", DataType::Utf8, true),
+            field("annotated", DataType::Boolean, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.1))),
+            f32c(|f| f.pos.x),
+            f32c(|f| f.pos.y),
+            f32c(|f| f.pos.z),
+            f32c(|f| f.yaw_rad),
+            f32c(|f| f.velocity.x),
+            f32c(|f| f.velocity.y),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.2.state.name()))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(crossing(r.0, r.1))))),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.2.lane_type.map(lane_name)))),
+            Arc::new(BooleanArray::from_iter(
+                rows.iter().map(|r| Some(annotated.contains(&(r.0, r.1)))),
+            )),
         ],
     )
 }
