@@ -368,7 +368,12 @@ fn read_dataset(dir: &Path) -> Dataset {
     }
     for b in read_table(dir, "tracks", &spec_hash) {
         let (ids, frame, ped) = (strs(&b, "clip_id"), u32s(&b, "frame"), u32s(&b, "pedestrian"));
-        let (x, y, state, crossing) = (f32s(&b, "x_m"), f32s(&b, "y_m"), strs(&b, "state"), bools(&b, "crossing"));
+        let (x, y, state, crossing) = (
+            f32s(&b, "x_m"),
+            f32s(&b, "y_m"),
+            strs(&b, "state"),
+            bools(&b, "crossing"),
+        );
         let (lane, annotated) = (strs(&b, "lane_type"), bools(&b, "annotated"));
         for i in 0..b.num_rows() {
             let key = (
@@ -1072,16 +1077,22 @@ fn a_finished_dataset_gets_a_card_with_its_licence_counts_and_a_config_per_table
     assert!(!front.contains("config_name: sensors"));
     assert!(body.contains("`sensors`: one row per sensor file (path, size, SHA-256) (no rows in this dataset)"));
     let samples: u64 = d.clips.iter().map(|c| c.annotated_samples).sum();
-    assert!(body.contains(&format!("| annotated samples (pedestrian-frames) | {samples} |")), "{body}");
+    assert!(
+        body.contains(&format!("| annotated samples (pedestrian-frames) | {samples} |")),
+        "{body}"
+    );
     assert!(body.contains(&format!("| clips | {} |", d.clips.len())));
     assert!(!card.contains(tmp.0.to_str().unwrap()), "no absolute path in the card");
 
     // A licence that is not an identifier is refused, pointing at the value.
     let text = std::fs::read_to_string(spec("quickstart.yaml")).unwrap();
     let bad = text.replacen("dataset:\n", "dataset:\n  license: CC BY 4.0\n", 1);
-    let err = pedsynth::dsl::load_bytes(bad.as_bytes(), "bad.yaml", Path::new("specs"), &options(&[]))
-        .err()
-        .expect("refused");
+    let Err(err) = pedsynth::dsl::load_bytes(bad.as_bytes(), "bad.yaml", Path::new("specs"), &options(&[])) else {
+        panic!("a licence with spaces is refused");
+    };
     let shown = format!("{err:?}");
-    assert!(shown.contains("dataset.license") && shown.contains("CC BY 4.0"), "{shown}");
+    assert!(
+        shown.contains("dataset.license") && shown.contains("CC BY 4.0"),
+        "{shown}"
+    );
 }

@@ -200,7 +200,10 @@ fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
     use pedsynth::exec::export::openscenario::{TOLERANCE_M, TOLERANCE_RAD};
     let doc = roxmltree::Document::parse(xosc).expect("well-formed");
     let logic = doc.descendants().find(|n| n.has_tag_name("LogicFile")).unwrap();
-    assert_eq!(logic.attribute("filepath"), Some(format!("towns/{}.xodr", clip.town).as_str()));
+    assert_eq!(
+        logic.attribute("filepath"),
+        Some(format!("towns/{}.xodr", clip.town).as_str())
+    );
     let num = |n: roxmltree::Node, a: &str| n.attribute(a).unwrap().parse::<f64>().unwrap();
     let mut polylines: BTreeMap<String, Vec<[f64; 5]>> = BTreeMap::new();
     for t in doc.descendants().filter(|n| n.has_tag_name("Trajectory")) {
@@ -222,12 +225,20 @@ fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
     let vehicles: std::collections::BTreeSet<u32> = clip.vehicles.iter().map(|v| v.vehicle).collect();
     assert_eq!(declared.len(), 1 + vehicles.len() + clip.tracks.len());
     assert_eq!(polylines.len(), declared.len());
-    assert_eq!(clip.tracks.len(), clip.pedestrians.len(), "tracks cover every pedestrian");
+    assert_eq!(
+        clip.tracks.len(),
+        clip.pedestrians.len(),
+        "tracks cover every pedestrian"
+    );
     let at = |name: &str, t: f64| -> [f64; 4] {
         let p = &polylines[name];
         let k = p.partition_point(|v| v[0] <= t + 1e-9).clamp(1, p.len() - 1);
         let (a, b) = (p[k - 1], p[k]);
-        let w = if b[0] > a[0] { ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0) } else { 0.0 };
+        let w = if b[0] > a[0] {
+            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         std::array::from_fn(|i| a[i + 1] + (b[i + 1] - a[i + 1]) * w)
     };
     let fps = f64::from(clip.fps);
@@ -247,17 +258,28 @@ fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
         check("ego", f as u32, [e.x_m, e.y_m, e.z_m, e.yaw_rad]);
     }
     for v in &clip.vehicles {
-        check(&format!("vehicle_{}", v.vehicle), v.frame, [v.x_m, v.y_m, v.z_m, v.yaw_rad]);
+        check(
+            &format!("vehicle_{}", v.vehicle),
+            v.frame,
+            [v.x_m, v.y_m, v.z_m, v.yaw_rad],
+        );
     }
     for (id, track) in &clip.tracks {
-        assert_eq!(track.len(), clip.frame_count as usize, "pedestrian {id}: a row per frame");
+        assert_eq!(
+            track.len(),
+            clip.frame_count as usize,
+            "pedestrian {id}: a row per frame"
+        );
         for f in track {
             check(&format!("pedestrian_{id}"), f.frame, [f.x_m, f.y_m, f.z_m, f.yaw_rad]);
         }
     }
     assert!(checked > clip.frame_count as usize * 3);
     let vertices: usize = polylines.values().map(Vec::len).sum();
-    assert!(vertices * 4 < checked, "polylines are simplified ({vertices} vertices for {checked} poses)");
+    assert!(
+        vertices * 4 < checked,
+        "polylines are simplified ({vertices} vertices for {checked} poses)"
+    );
     let sun = doc.descendants().find(|n| n.has_tag_name("Sun")).unwrap();
     assert!((num(sun, "elevation") - clip.sun_altitude_deg.to_radians()).abs() < 1e-3);
 }

@@ -175,6 +175,9 @@ def main():
     db = PIE(data_path=out, regen_database=True).generate_database()
     imdb = PIE(data_path=out)  # the sequences below read the database cached just now
     seen = 0
+    traffic = {}
+    first = db[video_of[next(iter(video_of))][0]][video_of[next(iter(video_of))][1]]
+    width, height = first["width"], first["height"]
     for clip_id, (set_id, video) in video_of.items():
         v = db[set_id][video]
         if v["num_frames"] != clips[clip_id]["frame_count"]:
@@ -189,6 +192,18 @@ def main():
                 fail(f"{clip_id} frame {r['frame']}: OBD speed {obd['OBD_speed']} for {r['ego_speed_mps']} m/s")
             if abs(obd["yaw"] - np.degrees(r["ego_yaw_rad"])) > 1e-3:
                 fail(f"{clip_id} frame {r['frame']}: yaw {obd['yaw']} for {r['ego_yaw_rad']} rad")
+        # Traffic objects (vehicles, crosswalks): PIE's classes, our ids, boxes inside the image, frames in
+        # the clip, each object's frames increasing.
+        for oid, o in v["traffic_annotations"].items():
+            kind = {"v": "vehicle", "cw": "crosswalk"}[oid.rsplit("_", 1)[1].lstrip("0123456789")]
+            if o["obj_class"] != kind or not oid.startswith(prefix[clip_id] + "_"):
+                fail(f"{clip_id}: traffic object {oid} of class {o['obj_class']}")
+            if o["frames"] != sorted(set(o["frames"])) or not all(0 <= f < clips[clip_id]["frame_count"] for f in o["frames"]):
+                fail(f"{clip_id}: traffic object {oid} frames {o['frames'][:5]}...")
+            for b in o["bbox"]:
+                if not (0 <= b[0] < b[2] <= width and 0 <= b[1] < b[3] <= height):
+                    fail(f"{clip_id}: traffic object {oid} box {b} outside the {width}x{height} image")
+            traffic[kind] = traffic.get(kind, 0) + 1
         ours = {f"{prefix[clip_id]}_{p}": t for (c, p), t in tracks.items() if c == clip_id}
         theirs = v["ped_annotations"]
         if sorted(ours) != sorted(theirs):
@@ -210,7 +225,9 @@ def main():
                 fail(f"{pid}: age/gender differ")
             seen += 1
     print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames in "
-          f"{len(video_of)} videos equal the tables")
+          f"{len(video_of)} videos equal the tables; traffic objects {traffic}")
+    if not traffic.get("vehicle") or not traffic.get("crosswalk"):
+        fail(f"no vehicle or no crosswalk track in the whole export: {traffic}")
 
     # The benchmark's sequences (its default crossing options) and its get_pose.
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))

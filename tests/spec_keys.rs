@@ -81,7 +81,8 @@ impl Walker {
             &BTreeMap::new(),
             &Default::default(),
         );
-        let plan_text = serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio, card)).expect("json");
+        let plan_text =
+            serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio, card)).expect("json");
         let tables = with_tables.then(|| {
             let rig = Rig::from_spec(&plan.spec.sensors);
             let meta = FileMeta {

@@ -252,7 +252,9 @@ impl Validator<'_> {
         }
         let license_ok = !d.license.is_empty()
             && d.license.len() <= 64
-            && d.license.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+'));
+            && d.license
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+'));
         if !license_ok {
             self.problems.push(
                 Problem::new(

@@ -118,7 +118,8 @@ pub fn simplify(poses: &[Pose]) -> Vec<Pose> {
                 lerp(a.y_m, b.y_m) - p.y_m,
                 lerp(a.z_m, b.z_m) - p.z_m,
             );
-            (dx * dx + dy * dy + dz * dz).sqrt() <= TOLERANCE_M && (lerp(a.h_rad, b.h_rad) - p.h_rad).abs() <= TOLERANCE_RAD
+            (dx * dx + dy * dy + dz * dz).sqrt() <= TOLERANCE_M
+                && (lerp(a.h_rad, b.h_rad) - p.h_rad).abs() <= TOLERANCE_RAD
         })
     };
     let mut out = vec![poses[0]];
@@ -308,7 +309,14 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
     }
     start_trigger(&mut x, "StartTrigger", "act_start", 0.0, "greaterOrEqual", "none");
     x.push_str("</Act>\n</Story>\n");
-    start_trigger(&mut x, "StopTrigger", "end_of_clip", duration_s, "greaterThan", "rising");
+    start_trigger(
+        &mut x,
+        "StopTrigger",
+        "end_of_clip",
+        duration_s,
+        "greaterThan",
+        "rising",
+    );
     x.push_str("</Storyboard>\n</OpenSCENARIO>\n");
     (x, entities.len(), vertices)
 }
@@ -366,7 +374,10 @@ mod tests {
             p.x_m = 5.0 + (k as f64 - 50.0).max(0.0) * 0.0;
         }
         let kept = simplify(&poses);
-        assert!(kept.len() >= 3 && kept.iter().any(|p| (p.t_s - 5.0).abs() < 0.15), "{kept:?}");
+        assert!(
+            kept.len() >= 3 && kept.iter().any(|p| (p.t_s - 5.0).abs() < 0.15),
+            "{kept:?}"
+        );
         assert_eq!(kept.first(), poses.first());
         assert_eq!(kept.last(), poses.last());
     }

@@ -244,6 +244,22 @@ fn vehicle_box(cam: &crate::exec::observe::rig::CameraPose, pos: DVec3, yaw_rad:
     (b[2] - b[0] >= 2.0 && b[3] - b[1] >= 2.0).then_some(b)
 }
 
+/// A ground polygon's projected box in a frame: every corner 0.5–80 m in front of the camera, the box clipped to
+/// the image; `None` when nothing of it is in the image.
+fn ground_box(cam: &crate::exec::observe::rig::CameraPose, polygon: &[glam::DVec2], z_m: f64) -> Option<[f64; 4]> {
+    let (mut lo, mut hi) = (glam::DVec2::splat(f64::INFINITY), glam::DVec2::splat(f64::NEG_INFINITY));
+    for c in polygon {
+        let p = cam.project(DVec3::new(c.x, c.y, z_m));
+        if p.depth_m < 0.5 || p.depth_m > 80.0 {
+            return None;
+        }
+        (lo, hi) = (lo.min(p.px), hi.max(p.px));
+    }
+    let (w, h) = (f64::from(cam.camera.width_px), f64::from(cam.camera.height_px));
+    let b = [lo.x.max(0.0), lo.y.max(0.0), hi.x.min(w), hi.y.min(h)];
+    (b[2] - b[0] >= 2.0 && b[3] - b[1] >= 2.0).then_some(b)
+}
+
 /// Writes one clip's three XML files; returns the number of pedestrian tracks and vehicle tracks.
 fn write_video(
     out: &Path,
@@ -320,6 +336,37 @@ fn write_video(
         if !boxes.is_empty() {
             vehicle_tracks += 1;
             let _ = write!(x, "  <track label=\"vehicle\">\n{boxes}  </track>\n");
+        }
+    }
+    // Crosswalks of the town near the ego's path, projected like the vehicles: the polygon on the ground.
+    if let Some(net) = net {
+        for (k, cw) in net.crosswalks.iter().enumerate() {
+            let Some((lo, hi)) = crate::world::bounding_box(cw.polygon.iter().copied()) else {
+                continue;
+            };
+            let centre = (lo + hi) * 0.5;
+            if !clip
+                .ego
+                .iter()
+                .any(|e| centre.distance(glam::DVec2::new(e.x_m, e.y_m)) < 80.0)
+            {
+                continue;
+            }
+            let z_m = net.lane_at(centre).map_or(0.0, |h| h.z_m);
+            let mut boxes = String::new();
+            for (frame, cam) in cameras.iter().enumerate() {
+                if let Some(b) = ground_box(cam, &cw.polygon, z_m) {
+                    let _ = writeln!(
+                        boxes,
+                        "    <box frame=\"{frame}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
+                         xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{prefix}_{k}cw</attribute>\n    </box>",
+                        b[0], b[1], b[2], b[3],
+                    );
+                }
+            }
+            if !boxes.is_empty() {
+                let _ = write!(x, "  <track label=\"crosswalk\">\n{boxes}  </track>\n");
+            }
         }
     }
     x.push_str("</annotations>\n");

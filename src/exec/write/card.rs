@@ -143,7 +143,10 @@ pub fn render(
                 stats.achieved_crossing_ratio, manifest.target_crossing_ratio
             ),
         ),
-        ("annotated samples (pedestrian-frames)", stats.annotated_samples.to_string()),
+        (
+            "annotated samples (pedestrian-frames)",
+            stats.annotated_samples.to_string(),
+        ),
         ("annotated samples with C = 1", stats.crossing_samples.to_string()),
         ("towns", stats.towns.join(", ")),
         ("weathers", stats.weathers.join(", ")),

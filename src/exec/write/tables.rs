@@ -506,7 +506,9 @@ pub fn tracks_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotation
             f32c(|f| f.velocity.y),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.2.state.name()))),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(crossing(r.0, r.1))))),
-            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.2.lane_type.map(lane_name)))),
+            Arc::new(StringArray::from_iter(
+                rows.iter().map(|r| r.2.lane_type.map(lane_name)),
+            )),
             Arc::new(BooleanArray::from_iter(
                 rows.iter().map(|r| Some(annotated.contains(&(r.0, r.1)))),
             )),
