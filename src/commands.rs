@@ -299,6 +299,7 @@ pub fn stats(
     out: &mut dyn Write,
 ) -> Result<(), Error> {
     if let Some(options) = protocol {
+        crate::exec::export::dataset::refuse_unverified(dir)?;
         let stats = crate::exec::read::protocol::compute(dir, options)?;
         let text = if json {
             crate::error::to_json(&stats, true)? + "\n"
@@ -307,6 +308,7 @@ pub fn stats(
         };
         return emit(out, &text);
     }
+    crate::exec::export::dataset::refuse_unverified(dir)?;
     let stats = crate::exec::read::stats::compute(dir)?;
     let text = if json {
         crate::error::to_json(&stats, true)? + "\n"
@@ -314,6 +316,39 @@ pub fn stats(
         stats.to_string()
     };
     emit(out, &text)
+}
+
+/// `pedsynth verify DIR [--tables-only]`: prints what was checked; a dataset with problems is an error
+/// (exit 2) that lists them all.
+pub fn verify(dir: &Path, tables_only: bool, out: &mut dyn Write) -> Result<(), Error> {
+    use crate::exec::read::verify::{Depth, verify};
+    let depth = if tables_only { Depth::Tables } else { Depth::Full };
+    let r = verify(dir, depth)?;
+    if !r.problems.is_empty() {
+        let list: Vec<String> = r.problems.iter().map(|p| format!("    {p}")).collect();
+        return Err(Error::new(
+            code::DATASET_INVALID,
+            format!("{}: {} problem(s):\n{}", dir.display(), r.problems.len(), list.join("\n")),
+        )
+        .help("a changed or missing file: regenerate its clip (delete its tables/*/<clip_id>.parquet and re-run `pedsynth generate`)"));
+    }
+    let sensors = if tables_only {
+        "sensor files not read (--tables-only)".to_owned()
+    } else {
+        format!(
+            "{} sensor files ({} bytes) match the index's sizes and SHA-256",
+            r.sensor_files, r.sensor_bytes
+        )
+    };
+    emit(
+        out,
+        &format!(
+            "{}: OK — {} clips complete; {} table files match the manifest's blake3, metadata, schemas, row counts and joins; {sensors}\n",
+            dir.display(),
+            r.clips,
+            r.table_files
+        ),
+    )
 }
 
 /// `pedsynth preview DIR`: a contact sheet or GIF of one clip's camera stream with its labels.

@@ -53,6 +53,8 @@ pub mod code {
     pub const UNKNOWN_TOWN: &str = "pedsynth::world::unknown_town";
     /// `generate --out` names a directory that holds something other than a dataset of this spec and plan.
     pub const DATASET_REFUSED: &str = "pedsynth::dataset::refused";
+    /// `generate --out` names a directory another `generate` is writing into (it holds the lock).
+    pub const DATASET_LOCKED: &str = "pedsynth::dataset::locked";
     /// A dataset that cannot be read as a pedsynth dataset (missing or malformed tables or manifest).
     pub const DATASET_INVALID: &str = "pedsynth::dataset::invalid";
     /// Options of `stats --protocol` that the protocol does not define.
@@ -171,6 +173,10 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::DATASET_REFUSED,
         "`--out` holds something other than a dataset of this spec and plan (nothing is written)",
+    ),
+    environment(
+        code::DATASET_LOCKED,
+        "another `pedsynth generate` is writing into `--out` (it holds `.pedsynth.lock`; nothing is written)",
     ),
     input(
         code::DATASET_INVALID,

@@ -113,6 +113,15 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// Check a dataset: manifest, completeness, every table's hash, metadata, schema, row counts and joins, and
+    /// every sensor file's size and SHA-256; exit 0 when clean, 2 with the list of problems.
+    Verify {
+        /// Dataset directory.
+        dir: PathBuf,
+        /// Skip reading the sensor files (tables only: fast).
+        #[arg(long)]
+        tables_only: bool,
+    },
     /// Export a finished dataset in a format the field's own tools read unmodified (PIE's `pie_data.py`,
     /// PedestrianActionBenchmark's pose files).
     Export {
@@ -306,6 +315,7 @@ fn main() -> ExitCode {
             };
             commands::export(&dir, format, &to, link, &mut out, &mut err)
         }
+        Command::Verify { dir, tables_only } => commands::verify(&dir, tables_only, &mut out),
         Command::Schema => commands::schema(&mut out),
         Command::Town {
             command: TownCommand::List,

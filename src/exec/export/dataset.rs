@@ -146,6 +146,28 @@ fn refuse(msg: String) -> Error {
     Error::new(code::DATASET_INVALID, msg)
 }
 
+/// Refuses a dataset that fails `verify`'s checks of its tables (everything but the sensor files' contents),
+/// listing the problems.
+pub fn refuse_unverified(dir: &Path) -> Result<(), Error> {
+    let report = crate::exec::read::verify::verify(dir, crate::exec::read::verify::Depth::Tables)?;
+    if report.problems.is_empty() {
+        return Ok(());
+    }
+    let shown: Vec<String> = report.problems.iter().take(10).map(|p| format!("  {p}")).collect();
+    let more = report.problems.len().saturating_sub(10);
+    Err(refuse(format!(
+        "{}: {} problem(s) (`pedsynth verify` lists them all):\n{}{}",
+        dir.display(),
+        report.problems.len(),
+        shown.join("\n"),
+        if more > 0 {
+            format!("\n  ... and {more} more")
+        } else {
+            String::new()
+        }
+    )))
+}
+
 impl Dataset {
     /// Opens a dataset, refusing an unfinished or altered one.
     pub fn open(dir: &Path) -> Result<Dataset, Error> {
@@ -159,33 +181,7 @@ impl Dataset {
             ))
         })?;
         let manifest = Manifest::parse(&text, &path.display().to_string())?;
-        let pending: Vec<&str> = manifest
-            .clips
-            .iter()
-            .filter(|c| c.status != "done")
-            .map(|c| c.clip_id.as_str())
-            .collect();
-        if !pending.is_empty() {
-            return Err(refuse(format!(
-                "{}: {} of {} clips are not generated yet (first: {}); finish the dataset with `pedsynth generate` first",
-                dir.display(),
-                pending.len(),
-                manifest.clips.len(),
-                pending[0]
-            )));
-        }
-        for c in &manifest.clips {
-            for (table, hash) in &c.files {
-                let file = layout.table(table, &c.clip_id);
-                let bytes = std::fs::read(&file).map_err(|e| refuse(format!("{}: {e}", file.display())))?;
-                if blake3::hash(&bytes).to_hex().as_str() != hash {
-                    return Err(refuse(format!(
-                        "{}: its blake3 differs from the manifest's: the file was changed after `generate` wrote it",
-                        file.display()
-                    )));
-                }
-            }
-        }
+        refuse_unverified(dir)?;
         let spec_path = layout.spec_resolved();
         let bytes = std::fs::read(&spec_path).map_err(|e| refuse(format!("{}: {e}", spec_path.display())))?;
         let options = LoadOptions {

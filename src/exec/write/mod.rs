@@ -35,6 +35,8 @@ use tables::{FileMeta, TABLES};
 /// An output directory opened for the dataset of one plan.
 #[derive(Debug)]
 pub struct DatasetWriter {
+    /// The directory's lock ([`LOCK_FILE`]), held while the writer lives.
+    _lock: std::fs::File,
     layout: Layout,
     /// The manifest as it was at opening (every clip pending, or the resumed dataset's manifest).
     manifest: Manifest,
@@ -48,8 +50,11 @@ impl DatasetWriter {
     pub fn open(out: &Path, plan: &Plan) -> Result<DatasetWriter, Error> {
         let layout = Layout::new(out);
         let plan_hash = plan_hash(plan)?;
-        let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
+        check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+        let lock = lock_out_dir(&layout)?;
+        // Checked again under the lock: another run may have started the dataset in between.
+        let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         let spec_yaml = crate::dsl::to_yaml(&plan.spec)?;
         let spec_path = layout.spec_resolved();
         write_atomically(&spec_path, spec_yaml.as_bytes()).map_err(|e| Error::write(&spec_path, e))?;
@@ -74,6 +79,7 @@ impl DatasetWriter {
                 .collect(),
         };
         let writer = DatasetWriter {
+            _lock: lock,
             layout,
             manifest,
             meta: FileMeta {
@@ -285,10 +291,41 @@ fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
 }
 
 /// Checks that `out` is missing, empty, or a dataset of the same spec and plan; returns whether it holds one.
+/// Name of the lock file in a dataset directory: `generate` holds an exclusive OS lock on it while it writes,
+/// so a second `generate` into the same directory refuses instead of interleaving; the OS releases the lock
+/// when the process ends, however it ends (kill -9 included). The (empty) file stays.
+pub const LOCK_FILE: &str = ".pedsynth.lock";
+
+/// Takes the directory's lock, or refuses when another process holds it.
+fn lock_out_dir(layout: &Layout) -> Result<std::fs::File, Error> {
+    let path = layout.root().join(LOCK_FILE);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| Error::write(&path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(Error::new(
+            code::DATASET_LOCKED,
+            format!(
+                "another `pedsynth generate` is writing into {} (it holds {LOCK_FILE})",
+                layout.root().display()
+            ),
+        )
+        .help("wait for it to finish, or use another --out; a run that crashed releases the lock by itself")),
+        Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
+    }
+}
+
 fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bool, Error> {
     let out = layout.root();
     let entries = match std::fs::read_dir(out) {
-        Ok(entries) => entries.count(),
+        Ok(entries) => entries
+            .flatten()
+            .filter(|e| e.file_name() != std::ffi::OsStr::new(LOCK_FILE))
+            .count(),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
         Err(e) => return Err(Error::read(out, e)),
     };
