@@ -198,6 +198,11 @@ pub fn compile_plan(spec_path: &Path, options: &LoadOptions, only: Option<&str>)
 pub fn plan(spec_path: &Path, options: &LoadOptions, args: &PlanArgs, out: &mut dyn Write) -> Result<(), Error> {
     let (loaded, plan) = compile_plan(spec_path, options, args.only.as_deref())?;
     if let Some(path) = &args.emit {
+        // The spec's directory relative to the plan file's, so that the plan holds no absolute path and still
+        // finds the spec's OpenDRIVE files wherever the pair is moved together.
+        let mut plan = plan.clone();
+        plan.spec_dir = relative_dir(Path::new(&plan.spec_dir), path.parent().unwrap_or(Path::new("")))
+            .map_err(|e| Error::read(path, e))?;
         let mut json = crate::error::to_json(&plan, true)?;
         json.push('\n');
         crate::fsutil::write_atomically(path, json.as_bytes()).map_err(|e| Error::write(path, e))?;
@@ -253,8 +258,38 @@ pub fn read_plan(path: &Path) -> Result<(Plan, BTreeMap<String, TownContext>), E
         )
         .help("re-plan the spec with this pedsynth"));
     }
-    let towns = load_spec_towns(&plan.spec, Path::new(&plan.spec_dir))?;
+    let spec_dir = path.parent().unwrap_or(Path::new("")).join(&plan.spec_dir);
+    let towns = load_spec_towns(&plan.spec, &spec_dir)?;
     Ok((plan, towns))
+}
+
+/// `target` relative to `base` (both taken as absolute from the working directory and normalised lexically:
+/// `a/b/..` is `a`; symbolic links are not followed), `/`-separated; "." when they are the same directory.
+fn relative_dir(target: &Path, base: &Path) -> std::io::Result<String> {
+    use std::path::Component;
+    let normal = |p: &Path| -> std::io::Result<Vec<String>> {
+        let mut out: Vec<String> = Vec::new();
+        for c in std::path::absolute(p)?.components() {
+            match c {
+                Component::CurDir => {}
+                Component::ParentDir => {
+                    out.pop();
+                }
+                Component::Normal(n) => out.push(n.to_string_lossy().into_owned()),
+                Component::RootDir | Component::Prefix(_) => {}
+            }
+        }
+        Ok(out)
+    };
+    let (t, b) = (normal(target)?, normal(base)?);
+    let common = t.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut parts: Vec<String> = vec!["..".to_owned(); b.len() - common];
+    parts.extend(t[common..].iter().cloned());
+    Ok(if parts.is_empty() {
+        ".".to_owned()
+    } else {
+        parts.join("/")
+    })
 }
 
 /// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.

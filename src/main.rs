@@ -71,6 +71,10 @@ enum Command {
         /// No progress output.
         #[arg(long)]
         quiet: bool,
+        /// Progress as one JSON object per finished clip on stderr (`json`, for cluster logs) instead of a bar
+        /// on a terminal or plain lines otherwise (`auto`).
+        #[arg(long, value_enum, default_value_t = ProgressFormat::Auto)]
+        progress: ProgressFormat,
         #[command(flatten)]
         spec_args: SpecArgs,
     },
@@ -177,6 +181,15 @@ fn parse_pair(text: &str) -> Result<(usize, usize), String> {
     Ok((parse(a)?, parse(b)?))
 }
 
+/// How `generate` reports progress.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum ProgressFormat {
+    /// A bar on a terminal, a line every 5 % of the clips otherwise.
+    Auto,
+    /// One JSON object per finished clip.
+    Json,
+}
+
 #[derive(Subcommand)]
 enum TownCommand {
     /// List the built-in towns.
@@ -248,6 +261,7 @@ fn main() -> ExitCode {
             jobs,
             only,
             quiet,
+            progress,
             spec_args,
         } => {
             let args = commands::GenerateArgs {
@@ -255,6 +269,7 @@ fn main() -> ExitCode {
                 jobs,
                 only,
                 quiet,
+                progress_json: progress == ProgressFormat::Json,
             };
             commands::generate(&input, &load_options(spec_args), &args, &mut out)
         }

@@ -83,12 +83,23 @@ fn kill_9_at_random_moments_then_resume_gives_the_same_bytes() {
             want.keys().filter(|k| !got.contains_key(*k)).collect(),
             got.keys().filter(|k| !want.contains_key(*k)).collect(),
         );
-        assert!(missing.is_empty() && extra.is_empty(), "round {round}: missing {missing:?}, extra {extra:?}");
+        assert!(
+            missing.is_empty() && extra.is_empty(),
+            "round {round}: missing {missing:?}, extra {extra:?}"
+        );
         for (k, v) in &want {
             assert!(got[k] == *v, "round {round}: {k} differs from the uninterrupted run's");
         }
-        let v = Command::new(env!("CARGO_BIN_EXE_pedsynth")).arg("verify").arg(&out).output().unwrap();
-        assert!(v.status.success(), "round {round}: {}", String::from_utf8_lossy(&v.stderr));
+        let v = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+            .arg("verify")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            v.status.success(),
+            "round {round}: {}",
+            String::from_utf8_lossy(&v.stderr)
+        );
         std::fs::remove_dir_all(&out).ok();
     }
     assert!(killed >= 10, "only {killed} kills landed while generate was running");

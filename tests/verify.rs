@@ -1,7 +1,7 @@
 //! `pedsynth verify DIR` passes a freshly generated dataset and names every kind of damage — a changed table, a
 //! changed or missing sensor file, a stray file, an unfinished clip — with exit 2, and `stats` and the exporters
 //! refuse such a dataset; a second `generate` into a directory another one is writing into refuses (the OS lock
-//! on `.pedsynth.lock`) and succeeds once the lock is free.
+//! on `.pedsynth.lock`) and succeeds once the lock is free, reporting progress as JSON lines when asked.
 
 mod common;
 
@@ -172,8 +172,24 @@ fn a_second_generate_into_a_locked_directory_refuses_and_the_lock_frees_with_its
         "nothing written under someone else's lock"
     );
     drop(holder);
-    let (code, _, stderr) = pedsynth(&refs);
+    let mut json_args = refs.clone();
+    json_args.retain(|a| *a != std::ffi::OsStr::new("--quiet"));
+    json_args.extend([std::ffi::OsStr::new("--progress"), std::ffi::OsStr::new("json")]);
+    let (code, _, stderr) = pedsynth(&json_args);
     assert_eq!(code, Some(0), "{stderr}");
+    // --progress json: one JSON object per clip on stderr, for cluster logs.
+    let lines: Vec<serde_json::Value> = stderr
+        .lines()
+        .filter(|l| l.starts_with('{'))
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{stderr}");
+    assert!(
+        lines
+            .iter()
+            .all(|l| l["event"] == "clip_done" && l["total"] == 2 && l["frames"].as_u64() > Some(0))
+    );
+    assert_eq!(lines[1]["done"], 2);
     let (code, _, stderr) = verify(&ds);
     assert_eq!(code, Some(0), "{stderr}");
 }

@@ -208,3 +208,63 @@ fn cli_writes_the_file_and_refuses_unknown_towns() {
         .collect();
     assert_eq!(entries.len(), 1, "no temporary file left behind: {entries:?}");
 }
+
+#[test]
+fn an_exported_town_drives_a_spec_whose_plan_file_lives_elsewhere() {
+    // A spec beside the exported town, a plan emitted into another directory: the plan records the spec's
+    // directory relative to itself (no absolute path), and generating from it finds the map.
+    let dir = common::Scratch::new("xodr-plan");
+    let specs = dir.path().join("specs");
+    std::fs::create_dir_all(&specs).unwrap();
+    std::fs::write(
+        specs.join("town.xodr"),
+        builtin_to_xodr("town02_like").unwrap().unwrap(),
+    )
+    .unwrap();
+    let quickstart =
+        std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml"))
+            .unwrap();
+    let spec = quickstart.replace(
+        "towns: [town01_like]",
+        "towns: [{name: exported, opendrive: town.xodr}]\n  splits: {exported: train}",
+    );
+    assert_ne!(spec, quickstart);
+    std::fs::write(specs.join("spec.yaml"), spec).unwrap();
+    let plan = dir.path().join("plans/p.json");
+    std::fs::create_dir_all(plan.parent().unwrap()).unwrap();
+    let run = |args: &[&std::ffi::OsStr]| {
+        let o = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    };
+    // A plan takes no --set: plan it with the sensors off (fast), then generate from the plan alone.
+    let mut plan_args: Vec<std::ffi::OsString> = vec![
+        "plan".into(),
+        specs.join("spec.yaml").into(),
+        "--emit".into(),
+        plan.clone().into(),
+    ];
+    for o in common::NO_SENSORS {
+        plan_args.push("--set".into());
+        plan_args.push(o.into());
+    }
+    run(&plan_args.iter().map(|a| a.as_os_str()).collect::<Vec<_>>());
+    let text = std::fs::read_to_string(&plan).unwrap();
+    assert!(
+        !text.contains(dir.path().to_str().unwrap()),
+        "the plan holds an absolute path"
+    );
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(json["spec_dir"], "../specs");
+    let out = dir.path().join("ds");
+    run(&[
+        "generate".as_ref(),
+        plan.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--quiet".as_ref(),
+    ]);
+    assert!(out.join("README.md").is_file());
+}

@@ -13,7 +13,7 @@ use crate::dsl::types::{
 };
 
 /// Version of the plan format.
-pub const PLAN_FORMAT_VERSION: u32 = 2;
+pub const PLAN_FORMAT_VERSION: u32 = 3;
 
 /// A compiled dataset: the clip scripts in a stable order (town, weather, index).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -35,7 +35,9 @@ pub struct Plan {
     /// The resolved spec the plan was compiled from (sensors, annotation rules, output encodings), so that a
     /// plan file alone is enough to generate the dataset.
     pub spec: Spec,
-    /// Directory the spec's relative paths (OpenDRIVE maps) resolve against, as it was given.
+    /// Directory the spec's relative paths (OpenDRIVE maps) resolve against: as it was given while planning;
+    /// in a plan file (`plan --emit`), relative to the plan file's directory (format 3; format 2 recorded it
+    /// relative to the working directory).
     pub spec_dir: String,
     /// The clips.
     pub clips: Vec<ClipScript>,

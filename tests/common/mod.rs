@@ -269,6 +269,7 @@ pub fn generate(
         jobs,
         only: None,
         quiet: true,
+        progress_json: false,
     };
     let options = pedsynth::dsl::LoadOptions {
         overrides: overrides.iter().map(|s| s.to_string()).collect(),

@@ -28,6 +28,8 @@ pub struct GenerateOptions {
     pub only: Option<String>,
     /// No progress output.
     pub quiet: bool,
+    /// One JSON line per finished clip on stderr instead of a bar (for cluster logs).
+    pub progress_json: bool,
 }
 
 /// What a run did.
@@ -82,7 +84,11 @@ pub fn generate(
         .filter(|c| !writer.is_clip_done(&c.clip_id))
         .collect();
     let rig = Rig::from_spec(&plan.spec.sensors);
-    let progress = Progress::new(todo.len(), options.quiet);
+    let progress = if options.progress_json {
+        Progress::json(todo.len())
+    } else {
+        Progress::new(todo.len(), options.quiet)
+    };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs.unwrap_or(0))
         .build()

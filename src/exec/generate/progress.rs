@@ -14,6 +14,8 @@ pub(crate) struct Progress {
     started: Instant,
     /// Print a line every this many clips (plain output); None when quiet.
     every: Option<usize>,
+    /// One JSON object per clip instead.
+    json: bool,
 }
 
 impl Progress {
@@ -34,6 +36,20 @@ impl Progress {
             frames: AtomicU64::new(0),
             started: Instant::now(),
             every: (!quiet).then_some((total / 20).max(1)),
+            json: false,
+        }
+    }
+
+    /// Progress as one JSON object per finished clip on stderr (`generate --progress json`).
+    pub fn json(total: usize) -> Self {
+        Progress {
+            bar: None,
+            total,
+            done: AtomicUsize::new(0),
+            frames: AtomicU64::new(0),
+            started: Instant::now(),
+            every: None,
+            json: true,
         }
     }
 
@@ -43,6 +59,21 @@ impl Progress {
         let frames = self.frames.fetch_add(frames, Ordering::Relaxed) + frames;
         let secs = self.started.elapsed().as_secs_f64().max(1e-6);
         let rate = frames as f64 / secs;
+        if self.json {
+            let eta = secs / done as f64 * (self.total - done) as f64;
+            let line = serde_json::json!({
+                "event": "clip_done",
+                "clip_id": clip_id,
+                "done": done,
+                "total": self.total,
+                "frames": frames,
+                "elapsed_s": (secs * 10.0).round() / 10.0,
+                "frames_per_s": rate.round(),
+                "eta_s": eta.round(),
+            });
+            eprintln!("{line}");
+            return;
+        }
         match &self.bar {
             Some(bar) => {
                 bar.set_message(format!("{rate:.0} frames/s"));
