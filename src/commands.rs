@@ -292,8 +292,90 @@ fn relative_dir(target: &Path, base: &Path) -> std::io::Result<String> {
     })
 }
 
+/// A shard from the environment, `((index, count), source)`.
+pub type EnvShard = ((usize, usize), &'static str);
+
+/// Parses `I/N` (shard I of N, 0-based).
+pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let (i, n) = text
+        .split_once('/')
+        .ok_or_else(|| format!("expected I/N (shard I of N, 0-based), found `{text}`"))?;
+    let parse = |x: &str| x.trim().parse::<usize>().map_err(|e| format!("`{x}`: {e}"));
+    let (i, n) = (parse(i)?, parse(n)?);
+    if n == 0 || i >= n {
+        return Err(format!("shard {i} of {n}: I must be in 0..N and N at least 1"));
+    }
+    Ok((i, n))
+}
+
+/// The shard a cluster engine asks for through the environment: a SLURM array task (`SLURM_ARRAY_TASK_ID`
+/// minus `SLURM_ARRAY_TASK_MIN` of `SLURM_ARRAY_TASK_COUNT`) or a Kubernetes Indexed Job pod
+/// (`JOB_COMPLETION_INDEX` of `PEDSYNTH_SHARD_COUNT`, which `pedsynth k8s`-style manifests set to the
+/// completions). Returns the shard and where it came from.
+pub fn shard_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<Option<EnvShard>, Error> {
+    let num = |name: &str| -> Result<Option<usize>, Error> {
+        var(name)
+            .map(|v| {
+                v.trim().parse::<usize>().map_err(|_| {
+                    Error::new(
+                        code::SHARD_INVALID,
+                        format!("{name}={v:?} is not a non-negative integer"),
+                    )
+                })
+            })
+            .transpose()
+    };
+    let check = |i: usize, n: usize, source: &'static str| {
+        if n == 0 || i >= n {
+            Err(Error::new(
+                code::SHARD_INVALID,
+                format!("{source}: shard {i} of {n} is out of range"),
+            ))
+        } else {
+            Ok(Some(((i, n), source)))
+        }
+    };
+    if let Some(id) = num("SLURM_ARRAY_TASK_ID")? {
+        let count = num("SLURM_ARRAY_TASK_COUNT")?.ok_or_else(|| {
+            Error::new(
+                code::SHARD_INVALID,
+                "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not",
+            )
+        })?;
+        let min = num("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+        let i = id.checked_sub(min).ok_or_else(|| {
+            Error::new(
+                code::SHARD_INVALID,
+                format!("SLURM_ARRAY_TASK_ID {id} is below SLURM_ARRAY_TASK_MIN {min}"),
+            )
+        })?;
+        return check(i, count, "SLURM array task");
+    }
+    if let Some(index) = num("JOB_COMPLETION_INDEX")? {
+        let count = num("PEDSYNTH_SHARD_COUNT")?.ok_or_else(|| {
+            Error::new(
+                code::SHARD_INVALID,
+                "JOB_COMPLETION_INDEX is set but PEDSYNTH_SHARD_COUNT (the Job's completions) is not",
+            )
+        })?;
+        return check(index, count, "Kubernetes Indexed Job");
+    }
+    Ok(None)
+}
+
 /// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.
 pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &mut dyn Write) -> Result<(), Error> {
+    let mut args = args.clone();
+    if args.shard.is_none()
+        && let Some(((i, n), source)) = shard_from_env(&|name| std::env::var(name).ok())?
+    {
+        if !args.quiet {
+            // Best effort: the log line says where the shard came from.
+            let _ = writeln!(std::io::stderr(), "shard {i}/{n} (from the {source}'s environment)");
+        }
+        args.shard = Some((i, n));
+    }
+    let args = &args;
     let is_plan = input.extension().is_some_and(|e| e == "json");
     let (plan, towns) = if is_plan {
         if !options.overrides.is_empty() {

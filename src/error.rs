@@ -53,6 +53,8 @@ pub mod code {
     pub const UNKNOWN_TOWN: &str = "pedsynth::world::unknown_town";
     /// `generate --out` names a directory that holds something other than a dataset of this spec and plan.
     pub const DATASET_REFUSED: &str = "pedsynth::dataset::refused";
+    /// A shard (`--shard I/N` or a cluster engine's environment) that does not exist.
+    pub const SHARD_INVALID: &str = "pedsynth::generate::shard";
     /// `generate --out` names a directory another `generate` is writing into (it holds the lock).
     pub const DATASET_LOCKED: &str = "pedsynth::dataset::locked";
     /// A dataset that cannot be read as a pedsynth dataset (missing or malformed tables or manifest).
@@ -173,6 +175,10 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::DATASET_REFUSED,
         "`--out` holds something other than a dataset of this spec and plan (nothing is written)",
+    ),
+    input(
+        code::SHARD_INVALID,
+        "a shard that does not exist (`--shard I/N` with I >= N, or a cluster engine's environment that says so)",
     ),
     environment(
         code::DATASET_LOCKED,

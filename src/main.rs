@@ -75,6 +75,11 @@ enum Command {
         /// on a terminal or plain lines otherwise (`auto`).
         #[arg(long, value_enum, default_value_t = ProgressFormat::Auto)]
         progress: ProgressFormat,
+        /// Generate shard I of N (0-based) of the plan's clips, balanced by estimated cost; shards of one run
+        /// may write into one --out at once. Without it, read from SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT
+        /// (minus SLURM_ARRAY_TASK_MIN) or Kubernetes' JOB_COMPLETION_INDEX / PEDSYNTH_SHARD_COUNT when set.
+        #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+        shard: Option<(usize, usize)>,
         #[command(flatten)]
         spec_args: SpecArgs,
     },
@@ -181,6 +186,10 @@ fn parse_pair(text: &str) -> Result<(usize, usize), String> {
     Ok((parse(a)?, parse(b)?))
 }
 
+fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    pedsynth::commands::parse_shard(text)
+}
+
 /// How `generate` reports progress.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 enum ProgressFormat {
@@ -262,6 +271,7 @@ fn main() -> ExitCode {
             only,
             quiet,
             progress,
+            shard,
             spec_args,
         } => {
             let args = commands::GenerateArgs {
@@ -270,6 +280,7 @@ fn main() -> ExitCode {
                 only,
                 quiet,
                 progress_json: progress == ProgressFormat::Json,
+                shard,
             };
             commands::generate(&input, &load_options(spec_args), &args, &mut out)
         }

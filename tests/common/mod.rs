@@ -270,6 +270,7 @@ pub fn generate(
         only: None,
         quiet: true,
         progress_json: false,
+        shard: None,
     };
     let options = pedsynth::dsl::LoadOptions {
         overrides: overrides.iter().map(|s| s.to_string()).collect(),

@@ -5,7 +5,7 @@
 
 pub(crate) mod progress;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 
 use rayon::prelude::*;
@@ -30,6 +30,51 @@ pub struct GenerateOptions {
     pub quiet: bool,
     /// One JSON line per finished clip on stderr instead of a bar (for cluster logs).
     pub progress_json: bool,
+    /// Generate only shard `.0` of `.1` (0-based) of the plan's clips, balanced by estimated cost.
+    pub shard: Option<(usize, usize)>,
+}
+
+/// The clips of shard `index` of `count`: clips sorted by estimated CPU cost (largest first, then by id) go one
+/// by one to the shard with the least cost so far (the lowest index on a tie). Deterministic: every shard of
+/// a run computes the same assignment from the plan alone.
+pub fn shard_clips(plan: &Plan, index: usize, count: usize) -> BTreeSet<String> {
+    use crate::planner::stats::{CAMERA_CPU_S_PER_PIXEL, GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S, LIDAR_CPU_S_PER_RAY};
+    let s = &plan.spec.sensors;
+    let pixels = if s.cameras_enabled() {
+        f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px)
+    } else {
+        0.0
+    };
+    let rays = if s.lidar.enabled {
+        f64::from(s.lidar.points_per_second) / f64::from(plan.spec.dataset.fps.max(1))
+    } else {
+        0.0
+    };
+    let mut clips: Vec<(f64, &str)> = plan
+        .clips
+        .iter()
+        .map(|c| {
+            let frames = f64::from(c.frame_count);
+            let cost = frames * c.pedestrians.len() as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
+                + frames * pixels * CAMERA_CPU_S_PER_PIXEL
+                + frames * rays * LIDAR_CPU_S_PER_RAY
+                + frames * 1e-6;
+            (cost, c.clip_id.as_str())
+        })
+        .collect();
+    clips.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(b.1)));
+    let mut load = vec![0.0f64; count.max(1)];
+    let mut out = BTreeSet::new();
+    for (cost, id) in clips {
+        let k = (0..load.len())
+            .min_by(|&a, &b| load[a].total_cmp(&load[b]).then(a.cmp(&b)))
+            .unwrap_or(0);
+        load[k] += cost;
+        if k == index {
+            out.insert(id.to_owned());
+        }
+    }
+    out
 }
 
 /// What a run did.
@@ -72,11 +117,13 @@ pub fn generate(
             ));
         }
     }
-    let writer = DatasetWriter::open(&options.out, plan)?;
+    let writer = DatasetWriter::open(&options.out, plan, options.shard.is_some())?;
+    let shard = options.shard.map(|(i, n)| shard_clips(plan, i, n));
     let selected: Vec<&ClipScript> = plan
         .clips
         .iter()
         .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
+        .filter(|c| shard.as_ref().is_none_or(|s| s.contains(&c.clip_id)))
         .collect();
     let todo: Vec<&ClipScript> = selected
         .iter()
@@ -119,6 +166,9 @@ pub fn generate(
             Err(e) => failures.push(e),
         }
     }
+    // Shards of one run finish in any order: the manifest (derived from the files on disk) and the card are
+    // written under the manifest lock, so the last one to finish writes the complete ones.
+    let _guard = writer.manifest_lock()?;
     let manifest = writer.finish()?;
     if failures.is_empty() && manifest.clips.iter().all(|c| c.status == "done") {
         // A finished dataset gets its card (README.md), written after the manifest.

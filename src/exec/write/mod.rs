@@ -47,13 +47,20 @@ impl DatasetWriter {
     /// Opens `out` for `plan`: `out` must be missing, empty, or a dataset of the same spec and plan (which is
     /// then resumed, after removing the temporary files an interrupted run left). Writes `spec.resolved.yaml`
     /// and, for a new dataset, a manifest with every clip pending.
-    pub fn open(out: &Path, plan: &Plan) -> Result<DatasetWriter, Error> {
+    ///
+    /// A whole run holds an exclusive lock on [`LOCK_FILE`]; a shard (`shared`) holds a shared one, so shards
+    /// of one run write side by side while a whole run and a shard exclude each other. Temporaries are removed
+    /// only when nothing else holds the lock (a running shard's are in use).
+    pub fn open(out: &Path, plan: &Plan, shared: bool) -> Result<DatasetWriter, Error> {
         let layout = Layout::new(out);
         let plan_hash = plan_hash(plan)?;
         check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
-        let lock = lock_out_dir(&layout)?;
-        // Checked again under the lock: another run may have started the dataset in between.
+        let (lock, alone) = lock_out_dir(&layout, shared)?;
+        // Checked again under the locks: another run, or another shard of this one, may have started the
+        // dataset in between; the manifest lock makes a shard wait until the first one has written the initial
+        // manifest.
+        let manifest_guard = lock_manifest(&layout)?;
         let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         let spec_yaml = crate::dsl::to_yaml(&plan.spec)?;
         let spec_path = layout.spec_resolved();
@@ -86,12 +93,23 @@ impl DatasetWriter {
                 spec_hash: plan.spec_hash.clone(),
             },
         };
-        if existing {
+        if existing && alone {
             writer.remove_temporaries()?;
-        } else {
+        }
+        if shared && alone {
+            share_lock(&writer._lock, &writer.layout)?;
+        }
+        if !existing {
             writer.write_manifest(&writer.manifest)?;
         }
+        drop(manifest_guard);
         Ok(writer)
+    }
+
+    /// Waits for and takes the lock that serialises manifest (and card) writes between shards; released when
+    /// the returned file is dropped.
+    pub fn manifest_lock(&self) -> Result<std::fs::File, Error> {
+        lock_manifest(&self.layout)
     }
 
     /// The dataset's layout.
@@ -295,9 +313,41 @@ fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
 /// so a second `generate` into the same directory refuses instead of interleaving; the OS releases the lock
 /// when the process ends, however it ends (kill -9 included). The (empty) file stays.
 pub const LOCK_FILE: &str = ".pedsynth.lock";
+/// Name of the lock file that serialises manifest writes between shards writing into one directory.
+pub const MANIFEST_LOCK_FILE: &str = ".pedsynth.manifest.lock";
 
-/// Takes the directory's lock, or refuses when another process holds it.
-fn lock_out_dir(layout: &Layout) -> Result<std::fs::File, Error> {
+/// Waits for and takes the manifest lock ([`MANIFEST_LOCK_FILE`]).
+fn lock_manifest(layout: &Layout) -> Result<std::fs::File, Error> {
+    let path = layout.root().join(MANIFEST_LOCK_FILE);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| Error::write(&path, e))?;
+    file.lock().map_err(|e| Error::write(&path, e))?;
+    Ok(file)
+}
+
+/// Turns a shard's exclusive lock (taken while it cleaned up alone) into a shared one.
+fn share_lock(file: &std::fs::File, layout: &Layout) -> Result<(), Error> {
+    let path = layout.root().join(LOCK_FILE);
+    file.unlock().map_err(|e| Error::write(&path, e))?;
+    file.try_lock_shared().map_err(|_| {
+        Error::new(
+            code::DATASET_LOCKED,
+            format!(
+                "another `pedsynth generate` took {} while this shard started",
+                layout.root().display()
+            ),
+        )
+    })
+}
+
+/// Takes the directory's lock (exclusive for a whole run, shared for a shard), or refuses when another
+/// process holds it in a conflicting way. Returns the lock and whether this process is alone; a shard that
+/// is alone gets the exclusive lock, to clean up before it shares it ([`share_lock`]).
+fn lock_out_dir(layout: &Layout, shared: bool) -> Result<(std::fs::File, bool), Error> {
     let path = layout.root().join(LOCK_FILE);
     let file = std::fs::OpenOptions::new()
         .create(true)
@@ -305,8 +355,31 @@ fn lock_out_dir(layout: &Layout) -> Result<std::fs::File, Error> {
         .write(true)
         .open(&path)
         .map_err(|e| Error::write(&path, e))?;
+    let busy = |file: std::fs::File| -> Result<(std::fs::File, bool), Error> {
+        drop(file);
+        Err(Error::new(
+            code::DATASET_LOCKED,
+            format!(
+                "another `pedsynth generate` is writing into {} (it holds {LOCK_FILE})",
+                layout.root().display()
+            ),
+        )
+        .help("wait for it to finish, or use another --out; a run that crashed releases the lock by itself"))
+    };
+    if shared {
+        // Alone: keep the exclusive lock until the caller has cleaned up, then it shares (`share_lock`).
+        return match file.try_lock() {
+            Ok(()) => Ok((file, true)),
+            Err(std::fs::TryLockError::WouldBlock) => match file.try_lock_shared() {
+                Ok(()) => Ok((file, false)),
+                Err(std::fs::TryLockError::WouldBlock) => busy(file),
+                Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
+            },
+            Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
+        };
+    }
     match file.try_lock() {
-        Ok(()) => Ok(file),
+        Ok(()) => Ok((file, true)),
         Err(std::fs::TryLockError::WouldBlock) => Err(Error::new(
             code::DATASET_LOCKED,
             format!(
@@ -324,7 +397,10 @@ fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bo
     let entries = match std::fs::read_dir(out) {
         Ok(entries) => entries
             .flatten()
-            .filter(|e| e.file_name() != std::ffi::OsStr::new(LOCK_FILE))
+            .filter(|e| {
+                e.file_name() != std::ffi::OsStr::new(LOCK_FILE)
+                    && e.file_name() != std::ffi::OsStr::new(MANIFEST_LOCK_FILE)
+            })
             .count(),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
         Err(e) => return Err(Error::read(out, e)),
