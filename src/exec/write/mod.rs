@@ -56,11 +56,14 @@ impl DatasetWriter {
         let plan_hash = plan_hash(plan)?;
         check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
+        // The manifest lock is taken first and held through the start: it makes a shard wait while the first
+        // one cleans up and writes the initial manifest (holding the directory lock exclusively for that
+        // moment), instead of finding the directory lock taken and refusing; nothing blocks on the directory
+        // lock while holding the manifest lock, so the two cannot deadlock.
+        let manifest_guard = lock_manifest(&layout)?;
         let (lock, alone) = lock_out_dir(&layout, shared)?;
         // Checked again under the locks: another run, or another shard of this one, may have started the
-        // dataset in between; the manifest lock makes a shard wait until the first one has written the initial
-        // manifest.
-        let manifest_guard = lock_manifest(&layout)?;
+        // dataset in between.
         let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
         let spec_yaml = crate::dsl::to_yaml(&plan.spec)?;
         let spec_path = layout.spec_resolved();
@@ -93,7 +96,7 @@ impl DatasetWriter {
                 spec_hash: plan.spec_hash.clone(),
             },
         };
-        if existing && alone {
+        if alone {
             writer.remove_temporaries()?;
         }
         if shared && alone {
@@ -316,15 +319,21 @@ pub const LOCK_FILE: &str = ".pedsynth.lock";
 /// Name of the lock file that serialises manifest writes between shards writing into one directory.
 pub const MANIFEST_LOCK_FILE: &str = ".pedsynth.manifest.lock";
 
-/// Waits for and takes the manifest lock ([`MANIFEST_LOCK_FILE`]).
-fn lock_manifest(layout: &Layout) -> Result<std::fs::File, Error> {
-    let path = layout.root().join(MANIFEST_LOCK_FILE);
+/// Opens (creating it empty) the lock file `name` of the dataset directory.
+fn open_lock_file(layout: &Layout, name: &str) -> Result<(std::fs::File, std::path::PathBuf), Error> {
+    let path = layout.root().join(name);
     let file = std::fs::OpenOptions::new()
         .create(true)
         .truncate(false)
         .write(true)
         .open(&path)
         .map_err(|e| Error::write(&path, e))?;
+    Ok((file, path))
+}
+
+/// Waits for and takes the manifest lock ([`MANIFEST_LOCK_FILE`]).
+fn lock_manifest(layout: &Layout) -> Result<std::fs::File, Error> {
+    let (file, path) = open_lock_file(layout, MANIFEST_LOCK_FILE)?;
     file.lock().map_err(|e| Error::write(&path, e))?;
     Ok(file)
 }
@@ -348,13 +357,7 @@ fn share_lock(file: &std::fs::File, layout: &Layout) -> Result<(), Error> {
 /// process holds it in a conflicting way. Returns the lock and whether this process is alone; a shard that
 /// is alone gets the exclusive lock, to clean up before it shares it ([`share_lock`]).
 fn lock_out_dir(layout: &Layout, shared: bool) -> Result<(std::fs::File, bool), Error> {
-    let path = layout.root().join(LOCK_FILE);
-    let file = std::fs::OpenOptions::new()
-        .create(true)
-        .truncate(false)
-        .write(true)
-        .open(&path)
-        .map_err(|e| Error::write(&path, e))?;
+    let (file, path) = open_lock_file(layout, LOCK_FILE)?;
     let busy = |file: std::fs::File| -> Result<(std::fs::File, bool), Error> {
         drop(file);
         Err(Error::new(
@@ -397,10 +400,7 @@ fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bo
     let entries = match std::fs::read_dir(out) {
         Ok(entries) => entries
             .flatten()
-            .filter(|e| {
-                e.file_name() != std::ffi::OsStr::new(LOCK_FILE)
-                    && e.file_name() != std::ffi::OsStr::new(MANIFEST_LOCK_FILE)
-            })
+            .filter(|e| !is_startup_file(&e.file_name().to_string_lossy()))
             .count(),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(false),
         Err(e) => return Err(Error::read(out, e)),
@@ -433,6 +433,18 @@ fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bo
     Ok(true)
 }
 
+/// Whether a top-level file name is one that a starting `generate` writes before the manifest (locks, the
+/// resolved spec, temporaries): a directory holding only these is a dataset that never got its manifest (a
+/// start that crashed, or another shard starting right now), not someone else's directory.
+fn is_startup_file(name: &str) -> bool {
+    let own_temporary = [layout::SPEC_RESOLVED, layout::MANIFEST].iter().any(|file| {
+        name.strip_prefix('.')
+            .and_then(|n| n.strip_prefix(file))
+            .is_some_and(|rest| is_temporary(&format!(".{file}{rest}")) && rest.starts_with(".tmp-"))
+    });
+    name == LOCK_FILE || name == MANIFEST_LOCK_FILE || name == layout::SPEC_RESOLVED || own_temporary
+}
+
 /// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
 /// `fsutil::write_atomically`) or another `*.tmp` file.
 fn is_temporary(name: &str) -> bool {
@@ -455,5 +467,18 @@ mod tests {
         assert!(!is_temporary("manifest.json"));
         assert!(!is_temporary(".x.tmp-"));
         assert!(!is_temporary(".x.tmp-12a"));
+    }
+
+    #[test]
+    fn only_pedsynths_own_startup_files_count_as_an_empty_directory() {
+        assert!(is_startup_file(LOCK_FILE));
+        assert!(is_startup_file(MANIFEST_LOCK_FILE));
+        assert!(is_startup_file("spec.resolved.yaml"));
+        assert!(is_startup_file(".spec.resolved.yaml.tmp-311"));
+        assert!(is_startup_file(".manifest.json.tmp-4"));
+        assert!(!is_startup_file("manifest.json"));
+        assert!(!is_startup_file("notes.tmp"));
+        assert!(!is_startup_file(".thesis.tex.tmp-12"));
+        assert!(!is_startup_file(".manifest.json.tmp-"));
     }
 }
