@@ -363,6 +363,88 @@ pub fn shard_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<Option<Env
     Ok(None)
 }
 
+/// The plan and towns of a spec file (.yaml, compiled) or a plan file (.json, read and checked).
+fn load_input(input: &Path, options: &LoadOptions) -> Result<(Plan, BTreeMap<String, TownContext>), Error> {
+    if input.extension().is_some_and(|e| e == "json") {
+        if !options.overrides.is_empty() {
+            return Err(
+                Error::new(code::PLAN_OVERRIDE, "--set applies to specs, not to a plan file")
+                    .help("re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"),
+            );
+        }
+        read_plan(input)
+    } else {
+        let loaded = dsl::load_file(input, options)?;
+        let towns = load_towns(&loaded)?;
+        Ok((compile(&loaded, &towns, None)?, towns))
+    }
+}
+
+/// `pedsynth merge SPEC|PLAN --out DIR [SHARD_DIR...]`: completes a dataset from shard directories.
+pub fn merge(
+    input: &Path,
+    options: &LoadOptions,
+    dir: &Path,
+    shards: &[PathBuf],
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    let (plan, _) = load_input(input, options)?;
+    let r = crate::exec::generate::merge::merge(&plan, dir, shards)?;
+    emit(
+        out,
+        &format!(
+            "{}: {} clips merged ({} files, {} bytes linked or copied), {} already there; manifest and card written\nnext: pedsynth verify {}\n",
+            dir.display(),
+            r.merged,
+            r.files,
+            r.bytes,
+            r.kept,
+            dir.display()
+        ),
+    )
+}
+
+/// Writes `text` to `file` atomically (made executable when `executable`), or to `out` when no file is given.
+fn emit_to(file: Option<&Path>, text: &str, executable: bool, out: &mut dyn Write) -> Result<(), Error> {
+    let Some(path) = file else {
+        return emit(out, text);
+    };
+    crate::fsutil::write_atomically(path, text.as_bytes()).map_err(|e| Error::write(path, e))?;
+    #[cfg(unix)]
+    if executable {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)).map_err(|e| Error::write(path, e))?;
+    }
+    Ok(())
+}
+
+/// `pedsynth slurm SPEC|PLAN --out DIR --array N ...`: writes the submit script.
+pub fn slurm(
+    input: &Path,
+    options: &LoadOptions,
+    slurm: &crate::exec::generate::cluster::SlurmOptions,
+    script: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    let (plan, _) = load_input(input, options)?;
+    let text = crate::exec::generate::cluster::slurm_script(&plan, slurm)?;
+    emit_to(script, &text, true, out)
+}
+
+/// `pedsynth k8s SPEC --out DIR --completions N --pvc NAME ...`: writes the Indexed Job manifest.
+pub fn k8s(
+    input: &Path,
+    options: &LoadOptions,
+    k8s: &crate::exec::generate::cluster::K8sOptions,
+    manifest: Option<&Path>,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    let (plan, _) = load_input(input, options)?;
+    let spec_yaml = dsl::to_yaml(&plan.spec)?;
+    let text = crate::exec::generate::cluster::k8s_manifest(&plan, &spec_yaml, k8s)?;
+    emit_to(manifest, &text, false, out)
+}
+
 /// `pedsynth generate SPEC|PLAN --out DIR`: plans (or reads a plan), simulates, annotates and writes.
 pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &mut dyn Write) -> Result<(), Error> {
     let mut args = args.clone();
@@ -376,20 +458,7 @@ pub fn generate(input: &Path, options: &LoadOptions, args: &GenerateArgs, out: &
         args.shard = Some((i, n));
     }
     let args = &args;
-    let is_plan = input.extension().is_some_and(|e| e == "json");
-    let (plan, towns) = if is_plan {
-        if !options.overrides.is_empty() {
-            return Err(
-                Error::new(code::PLAN_OVERRIDE, "--set applies to specs, not to a plan file")
-                    .help("re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"),
-            );
-        }
-        read_plan(input)?
-    } else {
-        let loaded = dsl::load_file(input, options)?;
-        let towns = load_towns(&loaded)?;
-        (compile(&loaded, &towns, None)?, towns)
-    };
+    let (plan, towns) = load_input(input, options)?;
     let report = crate::exec::generate::generate(&plan, &towns, args)?;
     emit(
         out,

@@ -55,6 +55,10 @@ pub mod code {
     pub const DATASET_REFUSED: &str = "pedsynth::dataset::refused";
     /// A shard (`--shard I/N` or a cluster engine's environment) that does not exist.
     pub const SHARD_INVALID: &str = "pedsynth::generate::shard";
+    /// `pedsynth merge` was given a directory that is not a dataset of the same spec and plan.
+    pub const MERGE_MISMATCH: &str = "pedsynth::merge::mismatch";
+    /// `pedsynth merge` found clips that no directory has finished.
+    pub const MERGE_INCOMPLETE: &str = "pedsynth::merge::incomplete";
     /// `generate --out` names a directory another `generate` is writing into (it holds the lock).
     pub const DATASET_LOCKED: &str = "pedsynth::dataset::locked";
     /// A dataset that cannot be read as a pedsynth dataset (missing or malformed tables or manifest).
@@ -179,6 +183,14 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::SHARD_INVALID,
         "a shard that does not exist (`--shard I/N` with I >= N, or a cluster engine's environment that says so)",
+    ),
+    input(
+        code::MERGE_MISMATCH,
+        "`pedsynth merge` was given a directory that is not a dataset of the same spec and plan",
+    ),
+    input(
+        code::MERGE_INCOMPLETE,
+        "`pedsynth merge` found clips finished in no directory given (the manifest lists them as pending)",
     ),
     environment(
         code::DATASET_LOCKED,

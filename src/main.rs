@@ -83,6 +83,89 @@ enum Command {
         #[command(flatten)]
         spec_args: SpecArgs,
     },
+    /// Complete a dataset from shards generated into separate directories (or finish a shared --out): link or
+    /// copy every clip --out lacks from a directory where it is finished, then write the manifest and card.
+    Merge {
+        /// Spec file (.yaml) or plan file (.json) the shards were generated from.
+        input: PathBuf,
+        /// The dataset to complete (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Shard directories (`generate --shard I/N --out SHARD_DIR`); none: only finish --out.
+        shards: Vec<PathBuf>,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
+    /// Write a SLURM submit script: a job array generating cost-balanced shards into one --out on shared
+    /// storage, and a merge job after it.
+    Slurm {
+        /// Spec file (.yaml) or plan file (.json), as the jobs will name it.
+        input: PathBuf,
+        /// Dataset directory, as the jobs will name it (on storage every node sees).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Array tasks (shards).
+        #[arg(long, value_name = "N")]
+        array: usize,
+        /// CPUs per task.
+        #[arg(long, value_name = "N", default_value_t = 4)]
+        cpus: u32,
+        /// Wall-time limit per task (sbatch --time); default: three times the plan's estimate plus 10 minutes.
+        #[arg(long, value_name = "TIME")]
+        time: Option<String>,
+        /// Memory per task (sbatch --mem, e.g. 8G).
+        #[arg(long, value_name = "SIZE")]
+        mem: Option<String>,
+        /// Partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// The pedsynth executable on the nodes.
+        #[arg(long, value_name = "PATH", default_value = "pedsynth")]
+        pedsynth: String,
+        /// Write the script here (executable) instead of standard output.
+        #[arg(long, value_name = "FILE")]
+        script: Option<PathBuf>,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
+    /// Write a Kubernetes Indexed Job manifest (with the resolved spec in a ConfigMap) generating cost-balanced
+    /// shards into one dataset directory on a ReadWriteMany volume.
+    K8s {
+        /// Spec file (.yaml).
+        input: PathBuf,
+        /// Dataset directory inside the volume (mounted at /data).
+        #[arg(long, value_name = "DIR")]
+        out: String,
+        /// Completions (shards).
+        #[arg(long, value_name = "N")]
+        completions: usize,
+        /// Pods at once (default: all).
+        #[arg(long, value_name = "N")]
+        parallelism: Option<usize>,
+        /// Container image with `pedsynth` on its PATH.
+        #[arg(long, default_value = "ghcr.io/pedsynth/pedsynth:latest")]
+        image: String,
+        /// CPUs per pod.
+        #[arg(long, value_name = "N", default_value_t = 4)]
+        cpus: u32,
+        /// Memory per pod (Kubernetes quantity).
+        #[arg(long, value_name = "QUANTITY", default_value = "4Gi")]
+        memory: String,
+        /// PersistentVolumeClaim (ReadWriteMany) holding the dataset.
+        #[arg(long, value_name = "NAME")]
+        pvc: String,
+        /// Job name (default: from the dataset's name).
+        #[arg(long)]
+        name: Option<String>,
+        /// Read the spec from this path inside the volume instead of a ConfigMap (needed for OpenDRIVE towns).
+        #[arg(long, value_name = "PATH")]
+        spec_on_volume: Option<String>,
+        /// Write the manifest here instead of standard output.
+        #[arg(long, value_name = "FILE")]
+        manifest: Option<PathBuf>,
+        #[command(flatten)]
+        spec_args: SpecArgs,
+    },
     /// Dataset statistics computed from the written tables (or a benchmark's sampling of them, --protocol).
     Stats {
         /// Dataset directory.
@@ -340,6 +423,65 @@ fn main() -> ExitCode {
                 link
             };
             commands::export(&dir, format, &to, link, &mut out, &mut err)
+        }
+        Command::Merge {
+            input,
+            out: dir,
+            shards,
+            spec_args,
+        } => commands::merge(&input, &load_options(spec_args), &dir, &shards, &mut out),
+        Command::Slurm {
+            input,
+            out: dir,
+            array,
+            cpus,
+            time,
+            mem,
+            partition,
+            pedsynth,
+            script,
+            spec_args,
+        } => {
+            let options = load_options(spec_args);
+            let slurm = pedsynth::exec::generate::cluster::SlurmOptions {
+                input: input.display().to_string(),
+                overrides: options.overrides.clone(),
+                out: dir.display().to_string(),
+                array,
+                cpus,
+                time,
+                mem,
+                partition,
+                pedsynth,
+            };
+            commands::slurm(&input, &options, &slurm, script.as_deref(), &mut out)
+        }
+        Command::K8s {
+            input,
+            out: dir,
+            completions,
+            parallelism,
+            image,
+            cpus,
+            memory,
+            pvc,
+            name,
+            spec_on_volume,
+            manifest,
+            spec_args,
+        } => {
+            let k8s = pedsynth::exec::generate::cluster::K8sOptions {
+                name,
+                completions,
+                parallelism,
+                image,
+                cpus,
+                memory,
+                pvc,
+                out: dir,
+                spec_on_volume,
+            };
+            commands::k8s(&input, &load_options(spec_args), &k8s, manifest.as_deref(), &mut out)
         }
         Command::Verify { dir, tables_only } => commands::verify(&dir, tables_only, &mut out),
         Command::Schema => commands::schema(&mut out),

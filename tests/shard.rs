@@ -99,6 +99,71 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     }
     assert!(a.contains_key("README.md") && a.keys().filter(|k| k.starts_with("tables/clips/")).count() == 6);
 
+    // Shards into separate directories (node-local scratch), then `pedsynth merge`.
+    let parts: Vec<PathBuf> = (0..3).map(|i| tmp.path().join(format!("part{i}"))).collect();
+    let children: Vec<_> = parts
+        .iter()
+        .enumerate()
+        .map(|(i, dir)| command(dir).arg("--shard").arg(format!("{i}/3")).spawn().unwrap())
+        .collect();
+    for child in children {
+        let o = child.wait_with_output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let merge = |out: &Path, dirs: &[PathBuf]| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_pedsynth"));
+        c.arg("merge")
+            .arg(spec("quickstart.yaml"))
+            .arg("--out")
+            .arg(out)
+            .args(dirs);
+        for o in overrides {
+            c.arg("--set").arg(o);
+        }
+        c.output().unwrap()
+    };
+    let merged = tmp.path().join("merged");
+    // Two of three shards: the clips of the third are missing, reported, and pending in the manifest.
+    let o = merge(&merged, &parts[..2]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("pedsynth::merge::incomplete"), "{stderr}");
+    let missing = shard_clips(&plan_of(&overrides), 2, 3);
+    assert!(missing.iter().all(|id| stderr.contains(id.as_str())), "{stderr}");
+    let manifest = std::fs::read_to_string(merged.join("manifest.json")).unwrap();
+    assert_eq!(manifest.matches("\"pending\"").count(), missing.len(), "{manifest}");
+    assert!(!merged.join("README.md").exists(), "no card for an incomplete dataset");
+    // The third shard too: complete, byte-identical to the single run.
+    let o = merge(&merged, &parts[2..]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let c = common::all_files(&merged);
+    assert_eq!(a.keys().collect::<Vec<_>>(), c.keys().collect::<Vec<_>>());
+    for (k, v) in &a {
+        assert!(c[k] == *v, "{k} differs between the single run and the merged shards");
+    }
+    // A directory of another spec is refused before anything is linked.
+    let o = merge(
+        &tmp.path().join("merged2"),
+        &[parts[0].clone(), tmp.path().join("bad-source")],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("pedsynth::merge::mismatch"));
+    let o = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+        .arg("merge")
+        .arg(spec("quickstart.yaml"))
+        .arg("--out")
+        .arg(tmp.path().join("merged3"))
+        .arg(&single)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "another plan: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("pedsynth::merge::mismatch"));
+
     // A shard that does not exist.
     let o = command(&tmp.path().join("bad"))
         .arg("--shard")
@@ -106,6 +171,17 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// The plan of the quickstart with `overrides`.
+fn plan_of(overrides: &[&str]) -> pedsynth::planner::Plan {
+    let options = pedsynth::dsl::LoadOptions {
+        overrides: overrides.iter().map(|s| s.to_string()).collect(),
+        ..Default::default()
+    };
+    commands::compile_plan(&spec("quickstart.yaml"), &options, None)
+        .unwrap_or_else(|e| panic!("{}", e.render()))
+        .1
 }
 
 #[test]

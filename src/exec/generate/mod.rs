@@ -3,6 +3,8 @@
 //! and writes the manifest. Re-running on a partly generated dataset of the same spec and plan skips finished
 //! clips, and the result is byte-identical to an uninterrupted run for any number of jobs.
 
+pub mod cluster;
+pub mod merge;
 pub(crate) mod progress;
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -38,6 +40,21 @@ pub struct GenerateOptions {
 /// by one to the shard with the least cost so far (the lowest index on a tie). Deterministic: every shard of
 /// a run computes the same assignment from the plan alone.
 pub fn shard_clips(plan: &Plan, index: usize, count: usize) -> BTreeSet<String> {
+    let (assignment, _) = assign_shards(plan, count);
+    assignment
+        .into_iter()
+        .filter(|&(_, k)| k == index)
+        .map(|(id, _)| id.to_owned())
+        .collect()
+}
+
+/// The estimated CPU seconds of each of `count` shards ([`shard_clips`]'s assignment).
+pub fn shard_cpu_s(plan: &Plan, count: usize) -> Vec<f64> {
+    assign_shards(plan, count).1
+}
+
+/// Each clip's shard and each shard's estimated CPU seconds.
+fn assign_shards(plan: &Plan, count: usize) -> (Vec<(&str, usize)>, Vec<f64>) {
     use crate::planner::stats::{CAMERA_CPU_S_PER_PIXEL, GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S, LIDAR_CPU_S_PER_RAY};
     let s = &plan.spec.sensors;
     let pixels = if s.cameras_enabled() {
@@ -64,17 +81,15 @@ pub fn shard_clips(plan: &Plan, index: usize, count: usize) -> BTreeSet<String> 
         .collect();
     clips.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(b.1)));
     let mut load = vec![0.0f64; count.max(1)];
-    let mut out = BTreeSet::new();
+    let mut assignment = Vec::with_capacity(clips.len());
     for (cost, id) in clips {
         let k = (0..load.len())
             .min_by(|&a, &b| load[a].total_cmp(&load[b]).then(a.cmp(&b)))
             .unwrap_or(0);
         load[k] += cost;
-        if k == index {
-            out.insert(id.to_owned());
-        }
+        assignment.push((id, k));
     }
-    out
+    (assignment, load)
 }
 
 /// What a run did.
@@ -169,16 +184,33 @@ pub fn generate(
     // Shards of one run finish in any order: the manifest (derived from the files on disk) and the card are
     // written under the manifest lock, so the last one to finish writes the complete ones.
     let _guard = writer.manifest_lock()?;
+    finish_dataset(plan, &writer, &options.out, failures.is_empty())?;
+    match failures.len() {
+        0 => Ok(report),
+        1 => Err(failures.remove(0)),
+        _ => Err(Error::Many(failures)),
+    }
+}
+
+/// Writes the manifest (derived from the files on disk) and, when every clip is finished and `card` holds,
+/// the dataset card (README.md, after the manifest). The caller holds the manifest lock. Returns whether every
+/// clip is finished.
+pub(crate) fn finish_dataset(
+    plan: &Plan,
+    writer: &DatasetWriter,
+    out: &std::path::Path,
+    card: bool,
+) -> Result<bool, Error> {
     let manifest = writer.finish()?;
-    if failures.is_empty() && manifest.clips.iter().all(|c| c.status == "done") {
-        // A finished dataset gets its card (README.md), written after the manifest.
-        let stats = crate::exec::read::stats::compute(&options.out)?;
+    let complete = manifest.clips.iter().all(|c| c.status == "done");
+    if card && complete {
+        let stats = crate::exec::read::stats::compute(out)?;
         let splits = plan
             .clips
             .iter()
             .map(|c| (c.clip_id.clone(), crate::exec::write::tables::split_name(c.split)))
             .collect();
-        let layout = crate::exec::write::Layout::new(&options.out);
+        let layout = writer.layout();
         let mut rows = BTreeMap::new();
         for clip in &plan.clips {
             for table in crate::exec::write::tables::TABLES {
@@ -187,12 +219,8 @@ pub fn generate(
             }
         }
         let card = crate::exec::write::card::render(&plan.spec, &manifest, &splits, &rows, &stats);
-        let path = options.out.join(crate::exec::write::card::CARD_FILE);
+        let path = out.join(crate::exec::write::card::CARD_FILE);
         crate::fsutil::write_atomically(&path, card.as_bytes()).map_err(|e| Error::write(&path, e))?;
     }
-    match failures.len() {
-        0 => Ok(report),
-        1 => Err(failures.remove(0)),
-        _ => Err(Error::Many(failures)),
-    }
+    Ok(complete)
 }

@@ -115,6 +115,11 @@ impl DatasetWriter {
         lock_manifest(&self.layout)
     }
 
+    /// The spec and plan hashes of the dataset being written.
+    pub fn manifest_hashes(&self) -> (&str, &str) {
+        (&self.manifest.spec_hash, &self.manifest.plan_hash)
+    }
+
     /// The dataset's layout.
     pub fn layout(&self) -> &Layout {
         &self.layout
