@@ -184,7 +184,11 @@ pub fn generate(
     // Shards of one run finish in any order: the manifest (derived from the files on disk) and the card are
     // written under the manifest lock, so the last one to finish writes the complete ones.
     let _guard = writer.manifest_lock()?;
-    finish_dataset(plan, &writer, &options.out, failures.is_empty())?;
+    // A manifest that cannot be written (the disk that failed a clip is full) joins the clips' failures
+    // instead of hiding them.
+    if let Err(e) = finish_dataset(plan, &writer, &options.out, failures.is_empty()) {
+        failures.push(e);
+    }
     match failures.len() {
         0 => Ok(report),
         1 => Err(failures.remove(0)),

@@ -402,6 +402,13 @@ fn lock_out_dir(layout: &Layout, shared: bool) -> Result<(std::fs::File, bool), 
 
 fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bool, Error> {
     let out = layout.root();
+    if out.exists() && !out.is_dir() {
+        return Err(Error::new(
+            code::IO_WRITE,
+            format!("cannot write into {}: it is a file, not a directory", out.display()),
+        )
+        .help("give --out a directory: a new one, or a dataset of this spec to resume"));
+    }
     let entries = match std::fs::read_dir(out) {
         Ok(entries) => entries
             .flatten()
