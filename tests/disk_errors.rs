@@ -119,12 +119,8 @@ fn nothing_half_written(dir: &Path) {
                 .unwrap();
         for batch in index {
             let paths = batch.strings("path").unwrap();
-            for i in 0..batch.rows() {
-                assert!(
-                    files.contains_key(paths[i]),
-                    "clip {id} is marked finished without {}",
-                    paths[i]
-                );
+            for path in paths.iter().take(batch.rows()) {
+                assert!(files.contains_key(*path), "clip {id} is marked finished without {path}");
             }
         }
     }
