@@ -34,13 +34,20 @@ pub struct TownContext {
     pub network: RoadNetwork,
     /// Vehicle spawn candidates (driving lanes outside junctions).
     pub spawn_points: Vec<SpawnPoint>,
+    /// The network's [`RoadNetwork::fingerprint`], recorded in plans.
+    pub fingerprint: String,
 }
 
 impl TownContext {
     /// Prepares a town for planning.
     pub fn new(network: RoadNetwork) -> Self {
         let spawn_points = network.driving_spawn_points(10.0);
-        TownContext { network, spawn_points }
+        let fingerprint = network.fingerprint();
+        TownContext {
+            network,
+            spawn_points,
+            fingerprint,
+        }
     }
 }
 
@@ -159,6 +166,10 @@ pub fn plan(
         sim: SimParams::from_spec(spec),
         spec: spec.clone(),
         spec_dir: spec_dir.to_owned(),
+        towns: towns
+            .iter()
+            .map(|(name, t)| (name.clone(), t.fingerprint.clone()))
+            .collect(),
         clips,
     })
 }

@@ -13,7 +13,7 @@ use crate::dsl::types::{
 };
 
 /// Version of the plan format.
-pub const PLAN_FORMAT_VERSION: u32 = 3;
+pub const PLAN_FORMAT_VERSION: u32 = 4;
 
 /// A compiled dataset: the clip scripts in a stable order (town, weather, index).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -39,6 +39,9 @@ pub struct Plan {
     /// in a plan file (`plan --emit`), relative to the plan file's directory (format 3; format 2 recorded it
     /// relative to the working directory).
     pub spec_dir: String,
+    /// Each town's [`crate::world::RoadNetwork::fingerprint`] (format 4): a plan is refused for a map that
+    /// differs from the one it was made for.
+    pub towns: std::collections::BTreeMap<String, String>,
     /// The clips.
     pub clips: Vec<ClipScript>,
 }

@@ -446,6 +446,34 @@ impl RoadNetwork {
         builtin::build(name)
     }
 
+    /// A fingerprint of the town's geometry and topology (blake3 of the JSON of its roads, lanes, pieces,
+    /// junctions, crosswalks and obstacles; not its name or source path): a plan records it for every town, so
+    /// that a plan made for another version of a map is refused instead of indexing the wrong lanes.
+    pub fn fingerprint(&self) -> String {
+        #[derive(Serialize)]
+        struct Geometry<'a> {
+            roads: &'a [Road],
+            lanes: &'a [Lane],
+            pieces: &'a [LanePiece],
+            junctions: &'a [Junction],
+            crosswalks: &'a [Crosswalk],
+            obstacles: &'a [Obstacle],
+        }
+        let geometry = Geometry {
+            roads: &self.roads,
+            lanes: &self.lanes,
+            pieces: &self.pieces,
+            junctions: &self.junctions,
+            crosswalks: &self.crosswalks,
+            obstacles: &self.obstacles,
+        };
+        let mut hasher = blake3::Hasher::new();
+        // Serialising plain data into a hasher cannot fail; were it to, the fingerprint would still differ
+        // from any real town's.
+        serde_json::to_writer(&mut hasher, &geometry).ok();
+        hasher.finalize().to_hex().to_string()
+    }
+
     /// Loads an OpenDRIVE file. This is the only function of the world module that does IO.
     pub fn from_xodr_file(path: &Path) -> Result<RoadNetwork, WorldError> {
         let shown = path.display().to_string();
