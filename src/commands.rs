@@ -246,22 +246,23 @@ pub const MAX_PLAN_BYTES: u64 = 1 << 30;
 /// may hold a subset of the clips (`plan --emit --only`), never clips its spec does not make. Every problem is
 /// reported at once.
 pub fn read_plan(path: &Path) -> Result<(Plan, BTreeMap<String, TownContext>), Error> {
+    let bytes = crate::fsutil::read_capped(path, MAX_PLAN_BYTES).map_err(|e| Error::read(path, e))?;
+    read_plan_bytes(&bytes, path)
+}
+
+/// [`read_plan`] of a plan file's bytes; `path` names it in messages, and the plan's `spec_dir` resolves
+/// against its directory.
+pub fn read_plan_bytes(bytes: &[u8], path: &Path) -> Result<(Plan, BTreeMap<String, TownContext>), Error> {
     let invalid = |what: String| {
         Error::new(code::PLAN_INVALID, format!("{}: {what}", path.display()))
             .help("make a plan with `pedsynth plan SPEC --emit PLAN.json`, and do not edit it")
     };
-    let size = std::fs::metadata(path).map_err(|e| Error::read(path, e))?.len();
-    if size > MAX_PLAN_BYTES {
-        return Err(invalid(format!(
-            "{size} bytes, more than a plan can be ({MAX_PLAN_BYTES})"
-        )));
-    }
-    let text = std::fs::read_to_string(path).map_err(|e| Error::read(path, e))?;
+    let text = std::str::from_utf8(bytes).map_err(|e| invalid(format!("not a pedsynth plan (not UTF-8: {e})")))?;
     #[derive(serde::Deserialize)]
     struct Head {
         format_version: u32,
     }
-    let head: Head = serde_json::from_str(&text).map_err(|e| invalid(format!("not a pedsynth plan: {e}")))?;
+    let head: Head = serde_json::from_str(text).map_err(|e| invalid(format!("not a pedsynth plan: {e}")))?;
     if head.format_version != planner::PLAN_FORMAT_VERSION {
         return Err(Error::new(
             code::PLAN_UNSUPPORTED_VERSION,
@@ -274,7 +275,7 @@ pub fn read_plan(path: &Path) -> Result<(Plan, BTreeMap<String, TownContext>), E
         )
         .help("re-plan the spec with this pedsynth"));
     }
-    let plan: Plan = serde_json::from_str(&text).map_err(|e| invalid(format!("not a pedsynth plan: {e}")))?;
+    let plan: Plan = serde_json::from_str(text).map_err(|e| invalid(format!("not a pedsynth plan: {e}")))?;
     if plan.pedsynth_version != env!("CARGO_PKG_VERSION") {
         return Err(Error::new(
             code::PLAN_UNSUPPORTED_VERSION,

@@ -16,6 +16,24 @@ pub fn write_atomically_unsynced(path: &Path, bytes: &[u8]) -> std::io::Result<(
     write_atomically_with(path, bytes, false)
 }
 
+/// Reads a whole file of at most `cap_bytes`, and refuses (`ErrorKind::FileTooLarge`) a larger one after
+/// reading `cap_bytes + 1`: a size from the metadata is not enough, since `/dev/zero`, a FIFO or a file that
+/// grows report no size or a wrong one, and an untrusted path must not make the program read without bound.
+pub fn read_capped(path: &Path, cap_bytes: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path)?;
+    let hint = file.metadata().map_or(0, |m| m.len()).min(cap_bytes);
+    let mut bytes = Vec::with_capacity(usize::try_from(hint).unwrap_or(0));
+    file.take(cap_bytes.saturating_add(1)).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > cap_bytes {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!("larger than {cap_bytes} bytes"),
+        ));
+    }
+    Ok(bytes)
+}
+
 /// A file written in pieces that appears at its path complete or not at all: it is written under a temporary
 /// name in the same directory and renamed by [`AtomicFile::commit`]; dropped uncommitted, the temporary file
 /// is removed. Counts and hashes (SHA-256) what is written, so the caller can index the file without reading

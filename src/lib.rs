@@ -7,6 +7,8 @@ pub mod dsl;
 pub mod error;
 pub mod exec;
 pub mod fsutil;
+#[doc(hidden)]
+pub mod fuzz;
 pub mod mix;
 pub mod planner;
 pub mod world;

@@ -488,9 +488,20 @@ impl RoadNetwork {
                 message: format!("file is {} bytes, the cap is {}", meta.len(), opendrive::MAX_FILE_BYTES),
             });
         }
-        let bytes = std::fs::read(path).map_err(|source| WorldError::Io {
-            path: shown.clone(),
-            source,
+        // Read with the cap too: a FIFO or a device reports no size.
+        let bytes = crate::fsutil::read_capped(path, opendrive::MAX_FILE_BYTES).map_err(|source| {
+            if source.kind() == std::io::ErrorKind::FileTooLarge {
+                WorldError::XodrTooLarge {
+                    path: shown.clone(),
+                    line: 1,
+                    message: format!("the file is larger than the cap of {} bytes", opendrive::MAX_FILE_BYTES),
+                }
+            } else {
+                WorldError::Io {
+                    path: shown.clone(),
+                    source,
+                }
+            }
         })?;
         let xml = String::from_utf8(bytes).map_err(|e| WorldError::XodrSyntax {
             path: shown.clone(),
