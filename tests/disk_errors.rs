@@ -12,30 +12,15 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const SETS: &[&str] = &[
-    "dataset.clips.count=4",
-    "dataset.clip_duration_s=[1, 2]",
-    "sensors.depth.enabled=false",
-    "sensors.semantic.enabled=false",
-    "sensors.instance.enabled=false",
-    "sensors.dvs.enabled=false",
-    "sensors.rgb.width_px=320",
-    "sensors.rgb.height_px=180",
-    "sensors.lidar.points_per_second=100000",
-];
-
 fn generate(out: &Path) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_pedsynth"));
     c.arg("generate")
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml"))
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/cluster_small.yaml"))
         .arg("--out")
         .arg(out)
         .arg("--quiet")
         .arg("--jobs")
         .arg("2");
-    for s in SETS {
-        c.arg("--set").arg(s);
-    }
     c
 }
 
@@ -179,7 +164,7 @@ fn a_full_disk_fails_cleanly_and_the_same_command_resumes_after_freeing_space() 
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     eprintln!(
-        "disk full: {total} bytes in all, {done_before} of 4 clips finished before the disk filled; resumed to identical bytes"
+        "disk full: {total} bytes in all, {done_before} of 6 clips finished before the disk filled; resumed to identical bytes"
     );
 }
 

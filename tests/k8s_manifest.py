@@ -25,17 +25,8 @@ import kubernetes_validate
 import yaml
 
 REPO = pathlib.Path(__file__).resolve().parent.parent
-SETS = [
-    "dataset.clips.count=6",
-    "dataset.clip_duration_s=[1, 2]",
-    "sensors.depth.enabled=false",
-    "sensors.semantic.enabled=false",
-    "sensors.instance.enabled=false",
-    "sensors.dvs.enabled=false",
-    "sensors.rgb.width_px=320",
-    "sensors.rgb.height_px=180",
-    "sensors.lidar.points_per_second=100000",
-]
+# An override, to check that it reaches the pods (through the resolved spec in the ConfigMap).
+SETS = ["dataset.seed=8"]
 VERSIONS = ["1.33.0", "1.37.0"]
 
 
@@ -57,10 +48,10 @@ def main():
     ap.add_argument("--pedsynth", required=True)
     args = ap.parse_args()
     pedsynth = str(pathlib.Path(args.pedsynth).resolve())
-    spec = REPO / "specs" / "quickstart.yaml"
+    spec = REPO / "tests" / "data" / "specs" / "cluster_small.yaml"
     completions = 3
     text = subprocess.run(
-        [pedsynth, "k8s", str(spec), "--out", "datasets/quickstart", "--completions", str(completions),
+        [pedsynth, "k8s", str(spec), "--out", "datasets/small", "--completions", str(completions),
          "--pvc", "pedsynth-data", "--cpus", "1", "--memory", "2Gi", *set_args()],
         check=True, capture_output=True, text=True,
     ).stdout
@@ -128,7 +119,7 @@ def main():
         single = tmp / "single"
         subprocess.run([pedsynth, "generate", str(spec), "--out", str(single), "--quiet", *set_args()],
                        check=True, stdout=subprocess.DEVNULL)
-        a, b = files(single), files(data_dir / "datasets" / "quickstart")
+        a, b = files(single), files(data_dir / "datasets" / "small")
         if a != b:
             differ = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
             sys.exit(f"k8s: {len(differ)} files differ from a local run: {differ[:10]}")

@@ -1,6 +1,8 @@
 //! Sharded generation: `--shard I/N` splits the plan's clips into disjoint shards balanced by estimated cost;
 //! three shards started at once into one `--out` produce a dataset byte-identical to a single run (tables,
-//! sensors, manifest, card); SLURM's and Kubernetes' environments select the shard; bad shards are refused.
+//! sensors, manifest, card), and so do three shards written into separate directories and combined by
+//! `pedsynth merge` (which reports the clips of a missing shard and refuses directories of another spec);
+//! SLURM's and Kubernetes' environments select the shard; bad shards are refused.
 
 mod common;
 
@@ -55,28 +57,14 @@ fn shards_are_disjoint_complete_and_balanced_by_cost() {
 #[test]
 fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     let tmp = common::Scratch::new("shard");
-    let overrides = [
-        "dataset.clips.count=6",
-        "dataset.clip_duration_s=[1, 2]",
-        "sensors.depth.enabled=false",
-        "sensors.semantic.enabled=false",
-        "sensors.instance.enabled=false",
-        "sensors.dvs.enabled=false",
-        "sensors.rgb.width_px=320",
-        "sensors.rgb.height_px=180",
-        "sensors.lidar.points_per_second=100000",
-    ];
     let command = |out: &Path| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_pedsynth"));
         c.arg("generate")
-            .arg(spec("quickstart.yaml"))
+            .arg(small())
             .arg("--out")
             .arg(out)
             .arg("--jobs")
             .arg("1");
-        for o in overrides {
-            c.arg("--set").arg(o);
-        }
         c.stdout(Stdio::null()).stderr(Stdio::piped());
         c
     };
@@ -112,14 +100,7 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     }
     let merge = |out: &Path, dirs: &[PathBuf]| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_pedsynth"));
-        c.arg("merge")
-            .arg(spec("quickstart.yaml"))
-            .arg("--out")
-            .arg(out)
-            .args(dirs);
-        for o in overrides {
-            c.arg("--set").arg(o);
-        }
+        c.arg("merge").arg(small()).arg("--out").arg(out).args(dirs);
         c.output().unwrap()
     };
     let merged = tmp.path().join("merged");
@@ -128,7 +109,8 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("pedsynth::merge::incomplete"), "{stderr}");
-    let missing = shard_clips(&plan_of(&overrides), 2, 3);
+    let (_, small_plan) = commands::compile_plan(&small(), &Default::default(), None).unwrap();
+    let missing = shard_clips(&small_plan, 2, 3);
     assert!(missing.iter().all(|id| stderr.contains(id.as_str())), "{stderr}");
     let manifest = std::fs::read_to_string(merged.join("manifest.json")).unwrap();
     assert_eq!(manifest.matches("\"pending\"").count(), missing.len(), "{manifest}");
@@ -141,7 +123,7 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     for (k, v) in &a {
         assert!(c[k] == *v, "{k} differs between the single run and the merged shards");
     }
-    // A directory of another spec is refused before anything is linked.
+    // A directory that is not a dataset, and a dataset of another spec (the quickstart's), are refused.
     let o = merge(
         &tmp.path().join("merged2"),
         &[parts[0].clone(), tmp.path().join("bad-source")],
@@ -173,15 +155,9 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
-/// The plan of the quickstart with `overrides`.
-fn plan_of(overrides: &[&str]) -> pedsynth::planner::Plan {
-    let options = pedsynth::dsl::LoadOptions {
-        overrides: overrides.iter().map(|s| s.to_string()).collect(),
-        ..Default::default()
-    };
-    commands::compile_plan(&spec("quickstart.yaml"), &options, None)
-        .unwrap_or_else(|e| panic!("{}", e.render()))
-        .1
+/// The small spec of the cluster tests (six short clips, small RGB, sparse LiDAR).
+fn small() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/cluster_small.yaml")
 }
 
 #[test]

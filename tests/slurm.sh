@@ -9,10 +9,9 @@
 set -euo pipefail
 pedsynth="$(realpath "$1")"
 repo="$(cd "$(dirname "$0")/.." && pwd)"
-spec="$repo/specs/quickstart.yaml"
-sets=(--set dataset.clips.count=6 --set 'dataset.clip_duration_s=[1, 2]' --set sensors.depth.enabled=false
-  --set sensors.semantic.enabled=false --set sensors.instance.enabled=false --set sensors.dvs.enabled=false
-  --set sensors.rgb.width_px=320 --set sensors.rgb.height_px=180 --set sensors.lidar.points_per_second=100000)
+spec="$repo/tests/data/specs/cluster_small.yaml"
+# An override, to check that the script passes it on to every task and to the merge job.
+sets=(--set dataset.seed=8)
 
 if ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
   apt-get update -qq
