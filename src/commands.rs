@@ -302,14 +302,12 @@ pub fn read_plan_bytes(bytes: &[u8], path: &Path) -> Result<(Plan, BTreeMap<Stri
         problems.push("its spec does not hash to its spec_hash (the spec or the hash was edited)".to_owned());
     }
     let towns = load_spec_towns(&loaded.spec, &spec_dir)?;
-    let names = |m: &dyn Fn() -> Vec<String>| m().join(", ");
-    let planned: Vec<String> = plan.towns.keys().cloned().collect();
-    let loaded_names: Vec<String> = towns.keys().cloned().collect();
-    if planned != loaded_names {
+    if !plan.towns.keys().eq(towns.keys()) {
+        let names = |keys: Vec<&String>| keys.iter().map(|k| k.as_str()).collect::<Vec<_>>().join(", ");
         problems.push(format!(
             "it records towns [{}] but its spec loads [{}]",
-            names(&|| planned.clone()),
-            names(&|| loaded_names.clone())
+            names(plan.towns.keys().collect()),
+            names(towns.keys().collect())
         ));
     }
     for (town, fingerprint) in &plan.towns {
@@ -644,8 +642,8 @@ pub fn stats(
     protocol: Option<&crate::exec::read::protocol::PabOptions>,
     out: &mut dyn Write,
 ) -> Result<(), Error> {
+    crate::exec::export::dataset::refuse_unverified(dir)?;
     if let Some(options) = protocol {
-        crate::exec::export::dataset::refuse_unverified(dir)?;
         let stats = crate::exec::read::protocol::compute(dir, options)?;
         let text = if json {
             crate::error::to_json(&stats, true)? + "\n"
@@ -654,7 +652,6 @@ pub fn stats(
         };
         return emit(out, &text);
     }
-    crate::exec::export::dataset::refuse_unverified(dir)?;
     let stats = crate::exec::read::stats::compute(dir)?;
     let text = if json {
         crate::error::to_json(&stats, true)? + "\n"

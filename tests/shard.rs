@@ -145,6 +145,33 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert!(String::from_utf8_lossy(&o.stderr).contains("pedsynth::merge::mismatch"));
+    // A damaged sensor file in a shard (a new file, so the copies already merged keep their bytes): the merge
+    // refuses that clip, which stays unfinished.
+    let png = std::fs::read_dir(parts[0].join("sensors/rgb"))
+        .unwrap()
+        .flatten()
+        .next()
+        .unwrap()
+        .path()
+        .join("000000.png");
+    let mut bytes = std::fs::read(&png).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 1;
+    std::fs::remove_file(&png).unwrap();
+    std::fs::write(&png, &bytes).unwrap();
+    let damaged = tmp.path().join("merged4");
+    let o = merge(&damaged, &parts);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("its SHA-256 differs from the index's"), "{stderr}");
+    let clip = png
+        .parent()
+        .unwrap()
+        .file_name()
+        .unwrap()
+        .to_string_lossy()
+        .into_owned();
+    assert!(!damaged.join(format!("tables/clips/{clip}.parquet")).exists());
 
     // A shard that does not exist.
     let o = command(&tmp.path().join("bad"))

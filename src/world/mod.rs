@@ -477,18 +477,7 @@ impl RoadNetwork {
     /// Loads an OpenDRIVE file. This is the only function of the world module that does IO.
     pub fn from_xodr_file(path: &Path) -> Result<RoadNetwork, WorldError> {
         let shown = path.display().to_string();
-        let meta = std::fs::metadata(path).map_err(|source| WorldError::Io {
-            path: shown.clone(),
-            source,
-        })?;
-        if meta.len() > opendrive::MAX_FILE_BYTES {
-            return Err(WorldError::XodrTooLarge {
-                path: shown,
-                line: 1,
-                message: format!("file is {} bytes, the cap is {}", meta.len(), opendrive::MAX_FILE_BYTES),
-            });
-        }
-        // Read with the cap too: a FIFO or a device reports no size.
+        // Capped while reading: a FIFO or a device reports no size, a growing file a wrong one.
         let bytes = crate::fsutil::read_capped(path, opendrive::MAX_FILE_BYTES).map_err(|source| {
             if source.kind() == std::io::ErrorKind::FileTooLarge {
                 WorldError::XodrTooLarge {

@@ -8,8 +8,6 @@
 
 use std::path::{Path, PathBuf};
 
-use sha2::{Digest, Sha256};
-
 use crate::error::{Error, code};
 use crate::exec::write::manifest::Manifest;
 use crate::exec::write::tables::TABLES;
@@ -108,35 +106,25 @@ fn check_source(source: &Layout, (spec_hash, plan_hash): (&str, &str)) -> Result
 /// Links or copies one finished clip: sensor files first (each checked against the clip's index), tables
 /// after them, `clips` last.
 fn copy_clip(source: &Layout, out: &Layout, id: &str, report: &mut MergeReport) -> Result<(), Error> {
-    let index = source.table("sensors", id);
-    for batch in crate::exec::read::tables::read(&index, &["path", "bytes", "sha256"])? {
-        let (paths, sizes, shas) = (batch.strings("path")?, batch.u64s("bytes")?, batch.strings("sha256")?);
-        for i in 0..batch.rows() {
-            let rel = paths[i];
-            if rel.starts_with('/') || rel.split('/').any(|c| c == ".." || c.is_empty()) {
-                return Err(Error::new(
-                    code::DATASET_INVALID,
-                    format!("{}: path {rel:?} leaves the dataset", index.display()),
-                ));
-            }
-            let from = source.root().join(rel);
-            let data = std::fs::read(&from).map_err(|e| Error::read(&from, e))?;
-            if data.len() as u64 != sizes.value(i)
-                || crate::exec::write::sensors::hex(&Sha256::digest(&data)) != shas[i]
-            {
-                return Err(Error::new(
-                    code::DATASET_INVALID,
-                    format!(
-                        "{}: size or SHA-256 differs from the clip's sensor index",
-                        from.display()
-                    ),
-                )
-                .help("regenerate the clip in that shard (delete its tables/*/<clip_id>.parquet, re-run it)"));
-            }
-            link_or_copy(&from, &out.root().join(rel), &data)?;
+    let mut problems = Vec::new();
+    crate::exec::read::verify::read_sensor_files(
+        source,
+        id,
+        |rel, data| {
+            link_or_copy(&source.root().join(rel), &out.root().join(rel), data)?;
             report.files += 1;
             report.bytes += data.len() as u64;
-        }
+            Ok(())
+        },
+        |problem| problems.push(problem),
+    )?;
+    if !problems.is_empty() {
+        // No table is copied, so the clip stays unfinished in --out.
+        return Err(Error::new(
+            code::DATASET_INVALID,
+            format!("{}: clip {id}: {}", source.root().display(), problems.join("; ")),
+        )
+        .help("regenerate the clip in that shard (delete its tables/*/<clip_id>.parquet, re-run it)"));
     }
     // `clips` is the last table (its presence marks a finished clip).
     debug_assert_eq!(TABLES.last(), Some(&"clips"));

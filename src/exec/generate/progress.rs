@@ -43,13 +43,8 @@ impl Progress {
     /// Progress as one JSON object per finished clip on stderr (`generate --progress json`).
     pub fn json(total: usize) -> Self {
         Progress {
-            bar: None,
-            total,
-            done: AtomicUsize::new(0),
-            frames: AtomicU64::new(0),
-            started: Instant::now(),
-            every: None,
             json: true,
+            ..Progress::new(total, true)
         }
     }
 

@@ -292,26 +292,45 @@ fn check_sensors(
     bytes: &mut u64,
     p: &mut Vec<String>,
 ) -> Result<(), Error> {
+    read_sensor_files(
+        layout,
+        id,
+        |_, data| {
+            *files += 1;
+            *bytes += data.len() as u64;
+            Ok(())
+        },
+        |problem| p.push(problem),
+    )
+}
+
+/// Reads every file of clip `id`'s sensor index, in index order, and checks it against its row (the path stays
+/// inside the dataset, the file exists, its size and SHA-256 are the indexed ones): `good` gets each file that
+/// passes (its path relative to the dataset, its bytes), `bad` a description of each one that does not. Shared
+/// by `verify` and `merge`, which must agree on what a good sensor file is.
+pub(crate) fn read_sensor_files(
+    layout: &Layout,
+    id: &str,
+    mut good: impl FnMut(&str, &[u8]) -> Result<(), Error>,
+    mut bad: impl FnMut(String),
+) -> Result<(), Error> {
     for b in tables::read(&layout.table("sensors", id), &["path", "bytes", "sha256"])? {
         let (path, size, sha) = (b.strings("path")?, b.u64s("bytes")?, b.strings("sha256")?);
         for i in 0..b.rows() {
             let rel = path[i];
-            if rel.starts_with('/') || rel.split('/').any(|c| c == "..") {
-                p.push(format!("tables/sensors/{id}.parquet: path {rel:?} leaves the dataset"));
+            if rel.starts_with('/') || rel.split('/').any(|c| c == ".." || c.is_empty()) {
+                bad(format!("tables/sensors/{id}.parquet: path {rel:?} leaves the dataset"));
                 continue;
             }
-            let full = layout.root().join(rel);
-            match std::fs::read(&full) {
-                Err(e) => p.push(format!("{rel}: {e}")),
-                Ok(data) => {
-                    *files += 1;
-                    *bytes += data.len() as u64;
-                    if data.len() as u64 != size.value(i) {
-                        p.push(format!("{rel}: {} bytes, the index says {}", data.len(), size.value(i)));
-                    } else if crate::exec::write::sensors::hex(&Sha256::digest(&data)) != sha[i] {
-                        p.push(format!("{rel}: its SHA-256 differs from the index's"));
-                    }
+            match std::fs::read(layout.root().join(rel)) {
+                Err(e) => bad(format!("{rel}: {e}")),
+                Ok(data) if data.len() as u64 != size.value(i) => {
+                    bad(format!("{rel}: {} bytes, the index says {}", data.len(), size.value(i)));
                 }
+                Ok(data) if crate::exec::write::sensors::hex(&Sha256::digest(&data)) != sha[i] => {
+                    bad(format!("{rel}: its SHA-256 differs from the index's"));
+                }
+                Ok(data) => good(rel, &data)?,
             }
         }
     }

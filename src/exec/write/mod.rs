@@ -316,7 +316,6 @@ fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
     .collect()
 }
 
-/// Checks that `out` is missing, empty, or a dataset of the same spec and plan; returns whether it holds one.
 /// Name of the lock file in a dataset directory: `generate` holds an exclusive OS lock on it while it writes,
 /// so a second `generate` into the same directory refuses instead of interleaving; the OS releases the lock
 /// when the process ends, however it ends (kill -9 included). The (empty) file stays.
@@ -362,44 +361,33 @@ fn share_lock(file: &std::fs::File, layout: &Layout) -> Result<(), Error> {
 /// process holds it in a conflicting way. Returns the lock and whether this process is alone; a shard that
 /// is alone gets the exclusive lock, to clean up before it shares it ([`share_lock`]).
 fn lock_out_dir(layout: &Layout, shared: bool) -> Result<(std::fs::File, bool), Error> {
+    use std::fs::TryLockError::{Error as Failed, WouldBlock};
     let (file, path) = open_lock_file(layout, LOCK_FILE)?;
-    let busy = |file: std::fs::File| -> Result<(std::fs::File, bool), Error> {
-        drop(file);
-        Err(Error::new(
+    let busy = || {
+        Error::new(
             code::DATASET_LOCKED,
             format!(
                 "another `pedsynth generate` is writing into {} (it holds {LOCK_FILE})",
                 layout.root().display()
             ),
         )
-        .help("wait for it to finish, or use another --out; a run that crashed releases the lock by itself"))
+        .help("wait for it to finish, or use another --out; a run that crashed releases the lock by itself")
     };
-    if shared {
-        // Alone: keep the exclusive lock until the caller has cleaned up, then it shares (`share_lock`).
-        return match file.try_lock() {
-            Ok(()) => Ok((file, true)),
-            Err(std::fs::TryLockError::WouldBlock) => match file.try_lock_shared() {
-                Ok(()) => Ok((file, false)),
-                Err(std::fs::TryLockError::WouldBlock) => busy(file),
-                Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
-            },
-            Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
-        };
-    }
+    // Alone (even a shard): the exclusive lock; a shard keeps it until it has cleaned up, then shares it
+    // (`share_lock`). Not alone: a shard joins the others' shared lock; a whole run refuses.
     match file.try_lock() {
         Ok(()) => Ok((file, true)),
-        Err(std::fs::TryLockError::WouldBlock) => Err(Error::new(
-            code::DATASET_LOCKED,
-            format!(
-                "another `pedsynth generate` is writing into {} (it holds {LOCK_FILE})",
-                layout.root().display()
-            ),
-        )
-        .help("wait for it to finish, or use another --out; a run that crashed releases the lock by itself")),
-        Err(std::fs::TryLockError::Error(e)) => Err(Error::write(&path, e)),
+        Err(WouldBlock) if shared => match file.try_lock_shared() {
+            Ok(()) => Ok((file, false)),
+            Err(WouldBlock) => Err(busy()),
+            Err(Failed(e)) => Err(Error::write(&path, e)),
+        },
+        Err(WouldBlock) => Err(busy()),
+        Err(Failed(e)) => Err(Error::write(&path, e)),
     }
 }
 
+/// Checks that `out` is missing, empty, or a dataset of the same spec and plan; returns whether it holds one.
 fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bool, Error> {
     let out = layout.root();
     if out.exists() && !out.is_dir() {
@@ -449,12 +437,15 @@ fn check_out_dir(layout: &Layout, spec_hash: &str, plan_hash: &str) -> Result<bo
 /// resolved spec, temporaries): a directory holding only these is a dataset that never got its manifest (a
 /// start that crashed, or another shard starting right now), not someone else's directory.
 fn is_startup_file(name: &str) -> bool {
-    let own_temporary = [layout::SPEC_RESOLVED, layout::MANIFEST].iter().any(|file| {
+    let own_temporary = |file: &str| {
         name.strip_prefix('.')
             .and_then(|n| n.strip_prefix(file))
-            .is_some_and(|rest| is_temporary(&format!(".{file}{rest}")) && rest.starts_with(".tmp-"))
-    });
-    name == LOCK_FILE || name == MANIFEST_LOCK_FILE || name == layout::SPEC_RESOLVED || own_temporary
+            .and_then(|rest| rest.strip_prefix(".tmp-"))
+            .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()))
+    };
+    [LOCK_FILE, MANIFEST_LOCK_FILE, layout::SPEC_RESOLVED].contains(&name)
+        || own_temporary(layout::SPEC_RESOLVED)
+        || own_temporary(layout::MANIFEST)
 }
 
 /// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
