@@ -9,7 +9,7 @@ use glam::DVec2;
 
 use super::geometry::{Poly3At, eval_piecewise};
 use super::parse::{RawNetwork, RawRoad, RawSection};
-use super::{MAX_PIECES, MAX_WIDTH_M};
+use super::{MAX_LANE_OFFSET_M, MAX_PIECES, MAX_WIDTH_M};
 use crate::world::{
     Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, ObstacleKind, Road, RoadNetwork, TownSource,
     TravelDirection, WorldError, index, obstacles, routes,
@@ -73,6 +73,16 @@ fn borders_at(
     out: &mut Borders,
 ) -> Result<(), WorldError> {
     let lo = eval_piecewise(&road.lane_offsets, s);
+    if lo.abs() > MAX_LANE_OFFSET_M || !lo.is_finite() {
+        return Err(WorldError::XodrInvalid {
+            path: path.into(),
+            line: line_of(xml, road.pos),
+            message: format!(
+                "the lane offset of road {:?} is {lo:.1} m at s={s:.2} (cap {MAX_LANE_OFFSET_M} m)",
+                road.id
+            ),
+        });
+    }
     out.lanes.clear();
     out.lanes.resize(sec.lanes.len(), (0.0, 0.0, 0.0));
     let (mut tl, mut tr) = (lo, lo);

@@ -18,5 +18,9 @@ pub const MAX_PIECES: usize = 4_000_000;
 pub const MAX_LENGTH_M: f64 = 100_000.0;
 /// Widest lane.
 pub const MAX_WIDTH_M: f64 = 50.0;
+/// Largest lane offset (`<laneOffset>`, the shift of the lane reference line from the road's; real maps use a
+/// few metres). Without it a cubic offset sends the lanes millions of metres away, and everything sampled
+/// along the lanes (spawn points every 10 m) grows without bound (found by the fuzzer).
+pub const MAX_LANE_OFFSET_M: f64 = 200.0;
 /// Largest absolute coordinate.
 pub const MAX_ABS_COORD_M: f64 = 10_000_000.0;
