@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use crate::dsl::types::TownRef;
 use crate::dsl::{self, LoadOptions, LoadedSpec, validate};
 use crate::error::{Error, code};
-use crate::planner::{self, Plan, TownContext};
+use crate::planner::{self, Plan, PreparedPlan, TownContext};
 use crate::world::RoadNetwork;
 
 /// Process exit codes.
@@ -165,25 +165,27 @@ pub struct PlanArgs {
 /// Compiles the plan of a loaded spec and its towns (`only`: just that clip).
 fn compile(loaded: &LoadedSpec, towns: &BTreeMap<String, TownContext>, only: Option<&str>) -> Result<Plan, Error> {
     let spec_dir = loaded.base_dir.display().to_string();
-    planner::plan(&loaded.spec, &loaded.hash()?, &spec_dir, towns, only).map_err(|problems| {
-        let unknown_clip = problems.len() == 1 && problems[0].reason == planner::NO_SUCH_CLIP;
-        if unknown_clip {
-            return Error::new(code::PLAN_UNKNOWN_CLIP, problems[0].to_string())
-                .help("`pedsynth plan SPEC --json` lists the clip ids");
-        }
-        let list: Vec<String> = problems.iter().map(|p| format!("    {p}")).collect();
-        Error::new(
-            code::PLAN_INFEASIBLE,
-            format!(
-                "{}: the spec cannot be planned ({} problem{}):\n{}",
-                loaded.name,
-                problems.len(),
-                if problems.len() == 1 { "" } else { "s" },
-                list.join("\n")
-            ),
-        )
-        .help("widen the spawn distances, lower the pedestrian or vehicle counts, or use a larger town")
-    })
+    planner::plan(&loaded.spec, &loaded.hash()?, &spec_dir, towns, only).map_err(|p| plan_problems(&loaded.name, &p))
+}
+
+/// The error of a spec whose plan has problems.
+fn plan_problems(name: &str, problems: &[planner::PlanProblem]) -> Error {
+    let unknown_clip = problems.len() == 1 && problems[0].reason == planner::NO_SUCH_CLIP;
+    if unknown_clip {
+        return Error::new(code::PLAN_UNKNOWN_CLIP, problems[0].to_string())
+            .help("`pedsynth plan SPEC --json` lists the clip ids");
+    }
+    let list: Vec<String> = problems.iter().map(|p| format!("    {p}")).collect();
+    Error::new(
+        code::PLAN_INFEASIBLE,
+        format!(
+            "{name}: the spec cannot be planned ({} problem{}):\n{}",
+            problems.len(),
+            if problems.len() == 1 { "" } else { "s" },
+            list.join("\n")
+        ),
+    )
+    .help("widen the spawn distances, lower the pedestrian or vehicle counts, or use a larger town")
 }
 
 /// Loads a spec and its towns and compiles the plan.
@@ -521,8 +523,10 @@ pub fn shard_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<Option<Env
     Ok(None)
 }
 
-/// The plan and towns of a spec file (.yaml, compiled) or a plan file (.json, read and checked).
-fn load_input(input: &Path, options: &LoadOptions) -> Result<(Plan, BTreeMap<String, TownContext>), Error> {
+/// The plan and towns of a spec file (.yaml, compiled) or a plan file (.json, read and checked), prepared for
+/// generation: a spec's clip scripts are compiled again one at a time when needed, not held
+/// ([`planner::PreparedPlan`]).
+fn load_input(input: &Path, options: &LoadOptions) -> Result<(PreparedPlan, BTreeMap<String, TownContext>), Error> {
     if input.extension().is_some_and(|e| e == "json") {
         if !options.overrides.is_empty() {
             return Err(
@@ -530,11 +534,19 @@ fn load_input(input: &Path, options: &LoadOptions) -> Result<(Plan, BTreeMap<Str
                     .help("re-plan with `pedsynth plan SPEC --set ... --emit PLAN`"),
             );
         }
-        read_plan(input)
+        let (plan, towns) = read_plan(input)?;
+        let name = input.display().to_string();
+        Ok((
+            PreparedPlan::from_plan(plan).map_err(|p| plan_problems(&name, &p))?,
+            towns,
+        ))
     } else {
         let loaded = dsl::load_file(input, options)?;
         let towns = load_towns(&loaded)?;
-        Ok((compile(&loaded, &towns, None)?, towns))
+        let spec_dir = loaded.base_dir.display().to_string();
+        let lazy = planner::LazyPlan::compile(&loaded.spec, &loaded.hash()?, &spec_dir, &towns);
+        let plan = PreparedPlan::new(lazy, &towns).map_err(|p| plan_problems(&loaded.name, &p))?;
+        Ok((plan, towns))
     }
 }
 
@@ -598,7 +610,7 @@ pub fn k8s(
     out: &mut dyn Write,
 ) -> Result<(), Error> {
     let (plan, _) = load_input(input, options)?;
-    let spec_yaml = dsl::to_yaml(&plan.spec)?;
+    let spec_yaml = dsl::to_yaml(&plan.header().spec)?;
     let text = crate::exec::generate::cluster::k8s_manifest(&plan, &spec_yaml, k8s)?;
     emit_to(manifest, &text, false, out)
 }

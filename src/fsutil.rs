@@ -66,9 +66,21 @@ impl AtomicFile {
 
     /// Moves the complete file to its path (not fsynced: see [`write_atomically_unsynced`]); returns its size
     /// and SHA-256.
-    pub fn commit(mut self) -> std::io::Result<(u64, [u8; 32])> {
+    pub fn commit(self) -> std::io::Result<(u64, [u8; 32])> {
+        self.commit_with(false)
+    }
+
+    /// [`AtomicFile::commit`] after an fsync of the file, as [`write_atomically`] does.
+    pub fn commit_synced(self) -> std::io::Result<(u64, [u8; 32])> {
+        self.commit_with(true)
+    }
+
+    fn commit_with(mut self, sync: bool) -> std::io::Result<(u64, [u8; 32])> {
         if let Some(file) = self.file.as_mut() {
             file.flush()?;
+            if sync {
+                file.get_ref().sync_all()?;
+            }
         }
         // Closed before the rename; on failure the temporary file goes too.
         self.file = None;

@@ -11,5 +11,6 @@ pub mod fsutil;
 pub mod fuzz;
 pub mod mix;
 pub mod planner;
+pub mod stream_json;
 pub mod world;
 pub(crate) mod xml;

@@ -12,6 +12,7 @@ use std::process::{Command, Stdio};
 
 use pedsynth::commands::{self, shard_from_env};
 use pedsynth::exec::generate::shard_clips;
+use pedsynth::planner::PreparedPlan;
 
 fn spec(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("specs").join(name)
@@ -21,8 +22,9 @@ fn spec(name: &str) -> PathBuf {
 fn shards_are_disjoint_complete_and_balanced_by_cost() {
     let (_, plan) = commands::compile_plan(&spec("pedsynth_pp.yaml"), &Default::default(), None)
         .unwrap_or_else(|e| panic!("{}", e.render()));
+    let prepared = PreparedPlan::from_plan(plan.clone()).expect("prepared");
     for n in [1, 3, 8] {
-        let shards: Vec<BTreeSet<String>> = (0..n).map(|i| shard_clips(&plan, i, n)).collect();
+        let shards: Vec<BTreeSet<String>> = (0..n).map(|i| shard_clips(&prepared, i, n)).collect();
         let all: BTreeSet<&String> = shards.iter().flatten().collect();
         assert_eq!(all.len(), plan.clips.len(), "{n} shards cover every clip");
         assert_eq!(
@@ -48,7 +50,7 @@ fn shards_are_disjoint_complete_and_balanced_by_cost() {
         );
         assert_eq!(
             shards,
-            (0..n).map(|i| shard_clips(&plan, i, n)).collect::<Vec<_>>(),
+            (0..n).map(|i| shard_clips(&prepared, i, n)).collect::<Vec<_>>(),
             "deterministic"
         );
     }
@@ -110,7 +112,7 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("pedsynth::merge::incomplete"), "{stderr}");
     let (_, small_plan) = commands::compile_plan(&small(), &Default::default(), None).unwrap();
-    let missing = shard_clips(&small_plan, 2, 3);
+    let missing = shard_clips(&PreparedPlan::from_plan(small_plan).unwrap(), 2, 3);
     assert!(missing.iter().all(|id| stderr.contains(id.as_str())), "{stderr}");
     let manifest = std::fs::read_to_string(merged.join("manifest.json")).unwrap();
     assert_eq!(manifest.matches("\"pending\"").count(), missing.len(), "{manifest}");

@@ -10,6 +10,7 @@
 //! `--only CLIP_ID` re-plans exactly the same script.
 
 pub mod identity;
+pub mod prepared;
 pub mod quota;
 pub mod script;
 pub mod seeds;
@@ -26,6 +27,7 @@ use rand_chacha::ChaCha20Rng;
 use crate::dsl::types::{ClipsPer, Spec, TownRef, WeatherRef};
 use crate::world::{LaneType, RoadNetwork};
 use crate::world::{Route, Side, SpawnPoint};
+pub use prepared::{ClipSummary, PreparedPlan, plan_hash};
 pub use script::*;
 
 /// A town ready for planning: its road network and derived spawn candidates.
@@ -77,6 +79,11 @@ struct Stratum {
     clip_ids: Vec<String>,
 }
 
+/// The id of clip `k` of the stratum (`town`, `weather`): `<town>-<weather>-<NNNN>`.
+fn clip_id(town: &TownRef, weather: &WeatherRef, k: usize) -> String {
+    format!("{}-{}-{k:04}", town.name(), weather.name())
+}
+
 /// Which clips the spec asks for, grouped by stratum, in plan order.
 fn strata(spec: &Spec) -> Vec<Stratum> {
     let weathers = spec.dataset.weathers.resolved();
@@ -100,9 +107,7 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
                     }
                 }
             };
-            let ids = (0..n)
-                .map(|k| format!("{}-{}-{k:04}", town.name(), weather.name()))
-                .collect();
+            let ids = (0..n).map(|k| clip_id(town, weather, k)).collect();
             cells.insert((ti, wi), ids);
         }
     }
@@ -118,7 +123,7 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
 }
 
 /// Compiles `spec` into a plan; `spec_dir` is recorded for resolving the spec's relative paths. `towns` maps each town name of the spec to its prepared road network.
-/// With `only`, plans just that clip (its stratum is allocated in full, so the script is identical).
+/// With `only`, plans just that clip (its stratum's draws are made in full, so the script is identical).
 pub fn plan(
     spec: &Spec,
     spec_hash: &str,
@@ -126,72 +131,220 @@ pub fn plan(
     towns: &BTreeMap<String, TownContext>,
     only: Option<&str>,
 ) -> Result<Plan, Vec<PlanProblem>> {
-    let mut clips = Vec::new();
+    let lazy = LazyPlan::compile(spec, spec_hash, spec_dir, towns);
+    let indices: Vec<usize> = match only {
+        Some(id) => vec![lazy.position(id).ok_or_else(|| {
+            vec![PlanProblem {
+                clip_id: id.to_owned(),
+                reason: NO_SUCH_CLIP.to_owned(),
+            }]
+        })?],
+        None => (0..lazy.len()).collect(),
+    };
+    let mut clips = Vec::with_capacity(indices.len());
     let mut problems = Vec::new();
-    let all = strata(spec);
-    if let Some(id) = only
-        && !all.iter().any(|s| s.clip_ids.iter().any(|c| c == id))
-    {
-        return Err(vec![PlanProblem {
-            clip_id: id.to_owned(),
-            reason: NO_SUCH_CLIP.to_owned(),
-        }]);
-    }
-    for stratum in &all {
-        if only.is_some_and(|id| !stratum.clip_ids.iter().any(|c| c == id)) {
-            continue;
-        }
-        let Some(town) = towns.get(stratum.town.name()) else {
-            problems.push(PlanProblem {
-                clip_id: "*".to_owned(),
-                reason: format!("town `{}` was not loaded", stratum.town.name()),
-            });
-            continue;
-        };
-        match plan_stratum(spec, stratum, town) {
-            Ok(scripts) => clips.extend(scripts.into_iter().filter(|c| only.is_none_or(|id| c.clip_id == id))),
-            Err(mut p) => problems.append(&mut p),
+    for i in indices {
+        match lazy.script(i, towns) {
+            Ok(script) => clips.push(script.into_owned()),
+            Err(p) => problems.push(p),
         }
     }
+    // A town that was not loaded is one problem, not one per clip.
+    problems.dedup();
     if !problems.is_empty() {
         return Err(problems);
     }
-    Ok(Plan {
-        format_version: PLAN_FORMAT_VERSION,
-        pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
-        dataset: spec.dataset.name.clone(),
-        seed: spec.dataset.seed,
-        spec_hash: spec_hash.to_owned(),
-        target_crossing_ratio: spec.crossing.target_ratio,
-        sim: SimParams::from_spec(spec),
-        spec: spec.clone(),
-        spec_dir: spec_dir.to_owned(),
-        towns: towns
+    let mut plan = lazy.into_header();
+    plan.clips = clips;
+    Ok(plan)
+}
+
+/// A compiled plan whose clip scripts are not held: each is compiled again when asked for, from the draws of
+/// its stratum, which cost about a tenth of the scripts' memory — so `generate` works through any number of
+/// clips in bounded memory. A plan read from a file holds its scripts instead. Either way, [`LazyPlan::script`]
+/// returns the script [`plan`] would put in the plan, bit for bit.
+pub struct LazyPlan {
+    /// The plan without its clips (`clips` is empty).
+    header: Plan,
+    source: Source,
+}
+
+enum Source {
+    /// The scripts of a plan file.
+    Held(Vec<ClipScript>),
+    /// Each stratum's draws, in plan order; `starts[k]` is the plan index of stratum `k`'s first clip.
+    Drawn {
+        strata: Vec<StratumDraws>,
+        starts: Vec<usize>,
+    },
+}
+
+/// What a stratum allocates across its clips; each clip's script compiles from these alone.
+struct StratumDraws {
+    town: TownRef,
+    weather: WeatherRef,
+    basics: Vec<ClipBasics>,
+    allocs: Vec<PedAlloc>,
+    /// Driving profile of each vehicle of the stratum, in clip order.
+    profiles: Vec<DrivingProfileKind>,
+}
+
+impl LazyPlan {
+    /// The spec's plan, each clip compiled when asked for. Makes every stratum's draws (quick: no geometry);
+    /// a clip that cannot be planned, or whose town is missing from `towns`, is reported by
+    /// [`LazyPlan::script`].
+    pub fn compile(spec: &Spec, spec_hash: &str, spec_dir: &str, towns: &BTreeMap<String, TownContext>) -> LazyPlan {
+        let mut starts = Vec::new();
+        let mut next = 0;
+        let strata: Vec<StratumDraws> = strata(spec)
             .iter()
-            .map(|(name, t)| (name.clone(), t.fingerprint.clone()))
-            .collect(),
-        clips,
-    })
+            .map(|stratum| {
+                starts.push(next);
+                next += stratum.clip_ids.len();
+                draw_stratum(spec, stratum)
+            })
+            .collect();
+        LazyPlan {
+            header: Plan {
+                format_version: PLAN_FORMAT_VERSION,
+                pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
+                dataset: spec.dataset.name.clone(),
+                seed: spec.dataset.seed,
+                spec_hash: spec_hash.to_owned(),
+                target_crossing_ratio: spec.crossing.target_ratio,
+                sim: SimParams::from_spec(spec),
+                spec: spec.clone(),
+                spec_dir: spec_dir.to_owned(),
+                towns: towns
+                    .iter()
+                    .map(|(name, t)| (name.clone(), t.fingerprint.clone()))
+                    .collect(),
+                clips: Vec::new(),
+            },
+            source: Source::Drawn { strata, starts },
+        }
+    }
+
+    /// A plan that holds its scripts (a plan file, already checked).
+    pub fn from_plan(mut plan: Plan) -> LazyPlan {
+        let clips = std::mem::take(&mut plan.clips);
+        LazyPlan {
+            header: plan,
+            source: Source::Held(clips),
+        }
+    }
+
+    /// The plan without its clips (`clips` is empty).
+    pub fn header(&self) -> &Plan {
+        &self.header
+    }
+
+    /// The header, as a plan to put the clips in.
+    pub fn into_header(self) -> Plan {
+        self.header
+    }
+
+    /// The number of clips.
+    pub fn len(&self) -> usize {
+        match &self.source {
+            Source::Held(clips) => clips.len(),
+            Source::Drawn { strata, starts } => {
+                starts.last().copied().unwrap_or(0) + strata.last().map_or(0, |s| s.basics.len())
+            }
+        }
+    }
+
+    /// Whether the plan has no clip.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The stratum and the index in it of plan index `i` (`i < len`).
+    fn locate(starts: &[usize], i: usize) -> (usize, usize) {
+        let k = starts.partition_point(|&s| s <= i).saturating_sub(1);
+        (k, i - starts.get(k).copied().unwrap_or(0))
+    }
+
+    /// The id of clip `i` (plan order), if there is one.
+    pub fn clip_id(&self, i: usize) -> Option<std::borrow::Cow<'_, str>> {
+        match &self.source {
+            Source::Held(clips) => clips.get(i).map(|c| c.clip_id.as_str().into()),
+            Source::Drawn { strata, starts } => {
+                let (k, j) = Self::locate(starts, i);
+                let d = strata.get(k)?;
+                (j < d.basics.len()).then(|| clip_id(&d.town, &d.weather, j).into())
+            }
+        }
+    }
+
+    /// The plan index of the clip `id`.
+    pub fn position(&self, id: &str) -> Option<usize> {
+        (0..self.len()).find(|&i| self.clip_id(i).as_deref() == Some(id))
+    }
+
+    /// The script of clip `i` (plan order): borrowed from a plan file, or compiled from its stratum's draws.
+    pub fn script<'a>(
+        &'a self,
+        i: usize,
+        towns: &BTreeMap<String, TownContext>,
+    ) -> Result<std::borrow::Cow<'a, ClipScript>, PlanProblem> {
+        let no_clip = || PlanProblem {
+            clip_id: format!("#{i}"),
+            reason: NO_SUCH_CLIP.to_owned(),
+        };
+        let (strata, starts) = match &self.source {
+            Source::Held(clips) => return clips.get(i).map(std::borrow::Cow::Borrowed).ok_or_else(no_clip),
+            Source::Drawn { strata, starts } => (strata, starts),
+        };
+        let (k, j) = Self::locate(starts, i);
+        let d = strata.get(k).ok_or_else(no_clip)?;
+        let b = d.basics.get(j).ok_or_else(no_clip)?;
+        let Some(town) = towns.get(d.town.name()) else {
+            return Err(PlanProblem {
+                clip_id: "*".to_owned(),
+                reason: format!("town `{}` was not loaded", d.town.name()),
+            });
+        };
+        let spec = &self.header.spec;
+        let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
+        let id = clip_id(&d.town, &d.weather, j);
+        plan_clip(
+            spec,
+            (&d.town, &d.weather),
+            town,
+            (id.clone(), b),
+            &d.allocs[b.first_pedestrian..b.first_pedestrian + b.pedestrians],
+            b.first_pedestrian,
+            &d.profiles[b.first_vehicle..b.first_vehicle + b.vehicles],
+            &archetype_names,
+        )
+        .map(std::borrow::Cow::Owned)
+        .map_err(|reason| PlanProblem { clip_id: id, reason })
+    }
 }
 
 /// Per-clip draws that the stratum's quotas depend on.
 struct ClipBasics {
-    clip_id: String,
     seed: u64,
     frame_count: u32,
     pedestrians: usize,
     vehicles: usize,
+    /// Stratum-wide index of the clip's first pedestrian (in the stratum's allocations).
+    first_pedestrian: usize,
+    /// Stratum-wide index of the clip's first vehicle (in the stratum's driving profiles).
+    first_vehicle: usize,
 }
 
-/// Per-pedestrian allocations made at the stratum level.
+/// Per-pedestrian allocations made at the stratum level (16 bytes: a plan holds one per pedestrian).
 #[derive(Clone)]
 struct PedAlloc {
-    archetype: usize,
+    /// Index in the spec's archetype mix.
+    archetype: u32,
     speed_profile: SpeedProfile,
     source: CrosserSource,
     behaviour: Behaviour,
     /// Stratum-wide index of the group's leader.
-    group: Option<usize>,
+    group: Option<u32>,
 }
 
 /// The share of pedestrians layer 1 allocates as crossers so that, with the baseline and the measured share of
@@ -210,9 +363,11 @@ pub fn allocated_crosser_ratio(spec: &Spec) -> f64 {
     r.clamp(0.0, l1.max_crosser_ratio)
 }
 
-fn plan_stratum(spec: &Spec, stratum: &Stratum, town: &TownContext) -> Result<Vec<ClipScript>, Vec<PlanProblem>> {
+/// The draws of a stratum: each clip's basics, then the stratum's pedestrian allocations and driving profiles.
+fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
     let seed = spec.dataset.seed;
     let d = &spec.dataset;
+    let (mut first_pedestrian, mut first_vehicle) = (0, 0);
     let basics: Vec<ClipBasics> = stratum
         .clip_ids
         .iter()
@@ -223,55 +378,36 @@ fn plan_stratum(spec: &Spec, stratum: &Stratum, town: &TownContext) -> Result<Ve
             let frame_count = ((duration_s * f64::from(d.fps)).round() as u32).max(1);
             let p = &spec.pedestrians.per_clip;
             let v = &spec.traffic.vehicles_per_clip;
-            ClipBasics {
-                clip_id: id.clone(),
+            let basics = ClipBasics {
                 seed: clip_seed,
                 frame_count,
                 pedestrians: rng.random_range(p.min()..=p.max()) as usize,
                 vehicles: rng.random_range(v.min()..=v.max()) as usize,
-            }
+                first_pedestrian,
+                first_vehicle,
+            };
+            first_pedestrian += basics.pedestrians;
+            first_vehicle += basics.vehicles;
+            basics
         })
         .collect();
 
     let allocs = allocate_pedestrians(spec, stratum, &basics);
-    let total_vehicles: usize = basics.iter().map(|b| b.vehicles).sum();
     let m = &spec.traffic.profile_mix;
     let mut stratum_rng = seeds::rng_for(
         seed,
         &format!("stratum/{}/{}/vehicles", stratum.town.name(), stratum.weather.name()),
     );
-    let profiles = quota::allocate(total_vehicles, &[m.aggressive, m.normal, m.cautious], &mut stratum_rng);
-
-    let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
-    let mut scripts = Vec::new();
-    let mut problems = Vec::new();
-    let (mut ped_cursor, mut veh_cursor) = (0, 0);
-    for b in &basics {
-        let peds = &allocs[ped_cursor..ped_cursor + b.pedestrians];
-        let vehs = &profiles[veh_cursor..veh_cursor + b.vehicles];
-        ped_cursor += b.pedestrians;
-        veh_cursor += b.vehicles;
-        match plan_clip(
-            spec,
-            stratum,
-            town,
-            b,
-            peds,
-            ped_cursor - b.pedestrians,
-            vehs,
-            &archetype_names,
-        ) {
-            Ok(script) => scripts.push(script),
-            Err(reason) => problems.push(PlanProblem {
-                clip_id: b.clip_id.clone(),
-                reason,
-            }),
-        }
-    }
-    if problems.is_empty() {
-        Ok(scripts)
-    } else {
-        Err(problems)
+    let profiles = quota::allocate(first_vehicle, &[m.aggressive, m.normal, m.cautious], &mut stratum_rng)
+        .into_iter()
+        .map(|k| DrivingProfileKind::ALL[k])
+        .collect();
+    StratumDraws {
+        town: stratum.town.clone(),
+        weather: stratum.weather.clone(),
+        basics,
+        allocs,
+        profiles,
     }
 }
 
@@ -315,7 +451,7 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
 
     let mut out: Vec<PedAlloc> = (0..n)
         .map(|i| PedAlloc {
-            archetype: archetypes[i],
+            archetype: u32::try_from(archetypes[i]).unwrap_or(u32::MAX),
             speed_profile: SpeedProfile::ALL[speed[i]],
             source: CrosserSource::None,
             behaviour: Behaviour::None,
@@ -416,7 +552,7 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
             out[i].source = CrosserSource::Allocated;
             out[i].behaviour = behaviour;
             if unit.len() > 1 {
-                out[i].group = Some(unit[0]);
+                out[i].group = Some(u32::try_from(unit[0]).unwrap_or(u32::MAX));
             }
         }
     }
@@ -441,12 +577,12 @@ const MAX_URBAN_SPEED_MPS: f64 = 14.0;
 #[allow(clippy::too_many_arguments)]
 fn plan_clip(
     spec: &Spec,
-    stratum: &Stratum,
+    (town_ref, weather): (&TownRef, &WeatherRef),
     town: &TownContext,
-    basics: &ClipBasics,
+    (clip_id, basics): (String, &ClipBasics),
     peds: &[PedAlloc],
     first_ped: usize,
-    vehicle_profiles: &[usize],
+    vehicle_profiles: &[DrivingProfileKind],
     archetype_names: &[&String],
 ) -> Result<ClipScript, String> {
     let mut rng = seeds::clip_rng(basics.seed, "plan");
@@ -519,15 +655,15 @@ fn plan_clip(
     };
 
     Ok(ClipScript {
-        clip_id: basics.clip_id.clone(),
+        clip_id,
         seed: basics.seed,
-        town: stratum.town.name().to_owned(),
-        weather: stratum.weather.name().to_owned(),
-        weather_params: stratum.weather.params(),
+        town: town_ref.name().to_owned(),
+        weather: weather.name().to_owned(),
+        weather_params: weather.params(),
         split: spec
             .dataset
             .splits
-            .get(stratum.town.name())
+            .get(town_ref.name())
             .copied()
             .unwrap_or(spec.dataset.default_split),
         fps,
@@ -635,14 +771,14 @@ fn plan_pedestrians(
     let mut scripts: Vec<PedestrianScript> = Vec::with_capacity(peds.len());
     let mut crosser_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
     // Group ids are numbered by leader, in pedestrian order.
-    let mut leaders: Vec<usize> = peds.iter().filter_map(|a| a.group).collect();
+    let mut leaders: Vec<u32> = peds.iter().filter_map(|a| a.group).collect();
     leaders.sort_unstable();
     leaders.dedup();
 
     for (i, alloc) in peds.iter().enumerate() {
         let id = i as u32;
         let name = archetype_names
-            .get(alloc.archetype)
+            .get(alloc.archetype as usize)
             .map_or("casual_person", |s| s.as_str());
         let a = p.archetypes.get(name).cloned().unwrap_or_default();
         let base_speed_mps = draw(rng, a.speed_mps);
@@ -659,7 +795,7 @@ fn plan_pedestrians(
         };
         let group = alloc.group.map(|leader| GroupRef {
             group_id: leaders.iter().position(|&l| l == leader).unwrap_or(0) as u32,
-            leader: (leader - first_ped) as u32,
+            leader: (leader as usize - first_ped) as u32,
         });
         let role = if alloc.source == CrosserSource::None {
             Role::NonCrosser
@@ -1022,7 +1158,7 @@ fn plan_vehicles(
     town: &TownContext,
     ego_route: &Route,
     peds: &[PedestrianScript],
-    profiles: &[usize],
+    profiles: &[DrivingProfileKind],
     needed_m: f64,
     rng: &mut ChaCha20Rng,
 ) -> Result<Vec<VehicleScript>, String> {
@@ -1043,8 +1179,7 @@ fn plan_vehicles(
         .collect();
     let mut out: Vec<VehicleScript> = Vec::with_capacity(profiles.len());
     let mut taken: Vec<DVec2> = vec![ego_start];
-    for (i, &profile_index) in profiles.iter().enumerate() {
-        let kind = DrivingProfileKind::ALL[profile_index];
+    for (i, &kind) in profiles.iter().enumerate() {
         let p = match kind {
             DrivingProfileKind::Aggressive => &spec.traffic.profiles.aggressive,
             DrivingProfileKind::Normal => &spec.traffic.profiles.normal,

@@ -133,6 +133,17 @@ pub enum Split {
     Test,
 }
 
+impl Split {
+    /// The split's name, as the spec and the tables spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Val => "val",
+            Split::Test => "test",
+        }
+    }
+}
+
 /// The keyword `all`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]

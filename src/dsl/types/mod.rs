@@ -120,6 +120,12 @@ mod tests {
                 serde_json::Value::from(preset.name())
             );
         }
+        for split in [Split::Train, Split::Val, Split::Test] {
+            assert_eq!(
+                serde_json::to_value(split).unwrap(),
+                serde_json::Value::from(split.name())
+            );
+        }
     }
 
     #[test]

@@ -5,7 +5,7 @@
 //! one run write into one `--out` on shared storage. The engines schedule; pedsynth only splits the plan.
 
 use crate::error::{Error, code};
-use crate::planner::Plan;
+use crate::planner::PreparedPlan;
 
 /// Options of `pedsynth slurm`.
 #[derive(Clone, Debug, Default)]
@@ -75,7 +75,7 @@ pub fn time_limit(cpu_s: f64, cpus: u32) -> String {
     format!("{}-{:02}:{:02}:{:02}", s / 86_400, s / 3600 % 24, s / 60 % 60, s % 60)
 }
 
-fn check_count(what: &str, n: usize, plan: &Plan) -> Result<(), Error> {
+fn check_count(what: &str, n: usize, plan: &PreparedPlan) -> Result<(), Error> {
     if n == 0 || n > plan.clips.len() {
         return Err(Error::new(
             code::SHARD_INVALID,
@@ -92,13 +92,13 @@ fn check_count(what: &str, n: usize, plan: &Plan) -> Result<(), Error> {
 
 /// The submit script of `pedsynth slurm`: `bash` it on a login node; it submits the array and the merge job
 /// (`--dependency=afterok`) and prints their ids.
-pub fn slurm_script(plan: &Plan, o: &SlurmOptions) -> Result<String, Error> {
+pub fn slurm_script(plan: &PreparedPlan, o: &SlurmOptions) -> Result<String, Error> {
     check_count("--array", o.array, plan)?;
     let longest_cpu_s = crate::exec::generate::shard_cpu_s(plan, o.array)
         .into_iter()
         .fold(0.0, f64::max);
     let time = o.time.clone().unwrap_or_else(|| time_limit(longest_cpu_s, o.cpus));
-    let job = format!("pedsynth-{}", job_name(&plan.dataset, 40));
+    let job = format!("pedsynth-{}", job_name(&plan.header().dataset, 40));
     let sets: String = o.overrides.iter().map(|s| format!(" --set {}", sh_quote(s))).collect();
     let mut sbatch = format!("--cpus-per-task={} --time={}", o.cpus, sh_quote(&time));
     if let Some(mem) = &o.mem {
@@ -140,7 +140,7 @@ EOF
 merge_job=${{merge_job%%;*}}
 echo "submitted array job $array_job ({n} tasks) and merge job $merge_job; logs in "{logs}
 "#,
-        dataset = plan.dataset,
+        dataset = plan.header().dataset,
         n = o.array,
         est = longest_cpu_s,
         merge_time = sh_quote(&time_limit(clips as f64 * 2.0, 1)),
@@ -172,7 +172,7 @@ fn yaml_str(text: &str) -> String {
 /// The manifest of `pedsynth k8s`: a ConfigMap with the resolved spec (unless it is on the volume) and an
 /// Indexed Job whose pods each generate the shard of their `JOB_COMPLETION_INDEX` into `/data/<out>`; the last
 /// pod to finish writes the manifest and the card. `spec_yaml` is the resolved spec.
-pub fn k8s_manifest(plan: &Plan, spec_yaml: &str, o: &K8sOptions) -> Result<String, Error> {
+pub fn k8s_manifest(plan: &PreparedPlan, spec_yaml: &str, o: &K8sOptions) -> Result<String, Error> {
     check_count("--completions", o.completions, plan)?;
     for (flag, path) in [("--out", Some(&o.out)), ("--spec-on-volume", o.spec_on_volume.as_ref())] {
         if let Some(path) = path
@@ -186,6 +186,7 @@ pub fn k8s_manifest(plan: &Plan, spec_yaml: &str, o: &K8sOptions) -> Result<Stri
     }
     if o.spec_on_volume.is_none()
         && let Some(town) = plan
+            .header()
             .spec
             .dataset
             .towns
@@ -202,7 +203,7 @@ pub fn k8s_manifest(plan: &Plan, spec_yaml: &str, o: &K8sOptions) -> Result<Stri
         .help("copy the spec and its maps onto the volume and pass --spec-on-volume PATH"));
     }
     let name = o.name.clone().map_or_else(
-        || format!("pedsynth-{}", job_name(&plan.dataset, 40)),
+        || format!("pedsynth-{}", job_name(&plan.header().dataset, 40)),
         |n| job_name(&n, 50),
     );
     let parallelism = o.parallelism.unwrap_or(o.completions).clamp(1, o.completions);
@@ -219,7 +220,7 @@ pub fn k8s_manifest(plan: &Plan, spec_yaml: &str, o: &K8sOptions) -> Result<Stri
          # generates the cost-balanced shard of its JOB_COMPLETION_INDEX into /data/{out} on the claim `{pvc}`\n\
          # (ReadWriteMany), and the last pod to finish writes the manifest and the card. Written by pedsynth\n\
          # {version} (`pedsynth k8s`); apply with `kubectl apply -f`. Longest shard estimate: {est:.0} CPU-s.\n",
-        dataset = plan.dataset,
+        dataset = plan.header().dataset,
         clips = plan.clips.len(),
         n = o.completions,
         out = o.out,

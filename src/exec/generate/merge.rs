@@ -12,7 +12,7 @@ use crate::error::{Error, code};
 use crate::exec::write::manifest::Manifest;
 use crate::exec::write::tables::TABLES;
 use crate::exec::write::{DatasetWriter, Layout};
-use crate::planner::Plan;
+use crate::planner::PreparedPlan;
 
 /// What a merge did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -31,7 +31,7 @@ pub struct MergeReport {
 
 /// Merges the finished clips of `shards` (dataset directories of the same spec and plan) into `out`, then
 /// writes the manifest and, when every clip is there, the card.
-pub fn merge(plan: &Plan, out: &Path, shards: &[PathBuf]) -> Result<MergeReport, Error> {
+pub fn merge(plan: &PreparedPlan, out: &Path, shards: &[PathBuf]) -> Result<MergeReport, Error> {
     let writer = DatasetWriter::open(out, plan, false)?;
     let sources: Vec<Layout> = shards.iter().map(Layout::new).collect();
     for source in &sources {

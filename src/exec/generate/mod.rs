@@ -16,7 +16,7 @@ use crate::error::{Error, code};
 use crate::exec::observe::rig::Rig;
 use crate::exec::write::DatasetWriter;
 use crate::exec::{ClipCounts, run_clip};
-use crate::planner::{ClipScript, Plan, TownContext};
+use crate::planner::{PreparedPlan, TownContext};
 use progress::Progress;
 
 /// Options of `pedsynth generate`.
@@ -39,7 +39,7 @@ pub struct GenerateOptions {
 /// The clips of shard `index` of `count`: clips sorted by estimated CPU cost (largest first, then by id) go one
 /// by one to the shard with the least cost so far (the lowest index on a tie). Deterministic: every shard of
 /// a run computes the same assignment from the plan alone.
-pub fn shard_clips(plan: &Plan, index: usize, count: usize) -> BTreeSet<String> {
+pub fn shard_clips(plan: &PreparedPlan, index: usize, count: usize) -> BTreeSet<String> {
     let (assignment, _) = assign_shards(plan, count);
     assignment
         .into_iter()
@@ -49,21 +49,22 @@ pub fn shard_clips(plan: &Plan, index: usize, count: usize) -> BTreeSet<String> 
 }
 
 /// The estimated CPU seconds of each of `count` shards ([`shard_clips`]'s assignment).
-pub fn shard_cpu_s(plan: &Plan, count: usize) -> Vec<f64> {
+pub fn shard_cpu_s(plan: &PreparedPlan, count: usize) -> Vec<f64> {
     assign_shards(plan, count).1
 }
 
 /// Each clip's shard and each shard's estimated CPU seconds.
-fn assign_shards(plan: &Plan, count: usize) -> (Vec<(&str, usize)>, Vec<f64>) {
+fn assign_shards(plan: &PreparedPlan, count: usize) -> (Vec<(&str, usize)>, Vec<f64>) {
     use crate::planner::stats::{CAMERA_CPU_S_PER_PIXEL, GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S, LIDAR_CPU_S_PER_RAY};
-    let s = &plan.spec.sensors;
+    let spec = &plan.header().spec;
+    let s = &spec.sensors;
     let pixels = if s.cameras_enabled() {
         f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px)
     } else {
         0.0
     };
     let rays = if s.lidar.enabled {
-        f64::from(s.lidar.points_per_second) / f64::from(plan.spec.dataset.fps.max(1))
+        f64::from(s.lidar.points_per_second) / f64::from(spec.dataset.fps.max(1))
     } else {
         0.0
     };
@@ -72,7 +73,7 @@ fn assign_shards(plan: &Plan, count: usize) -> (Vec<(&str, usize)>, Vec<f64>) {
         .iter()
         .map(|c| {
             let frames = f64::from(c.frame_count);
-            let cost = frames * c.pedestrians.len() as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
+            let cost = frames * f64::from(c.pedestrians) / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
                 + frames * pixels * CAMERA_CPU_S_PER_PIXEL
                 + frames * rays * LIDAR_CPU_S_PER_RAY
                 + frames * 1e-6;
@@ -107,9 +108,33 @@ pub struct GenerateReport {
     pub samples: u64,
 }
 
-/// Generates the dataset of `plan` into `options.out`.
+impl GenerateReport {
+    /// Counts one generated clip.
+    fn add(&mut self, c: &ClipCounts) {
+        self.absorb(&GenerateReport {
+            generated: 1,
+            skipped: 0,
+            frames: c.frames,
+            pedestrian_frames: c.pedestrian_frames,
+            samples: c.samples,
+        });
+    }
+
+    /// Adds the counts of another part of the run.
+    fn absorb(&mut self, other: &GenerateReport) {
+        self.generated += other.generated;
+        self.skipped += other.skipped;
+        self.frames += other.frames;
+        self.pedestrian_frames += other.pedestrian_frames;
+        self.samples += other.samples;
+    }
+}
+
+/// Generates the dataset of `plan` into `options.out`. Each worker compiles the script of the clip it takes
+/// ([`PreparedPlan::script`]) and drops it when the clip is written, so memory grows with `--jobs`, not with
+/// the number of clips.
 pub fn generate(
-    plan: &Plan,
+    plan: &PreparedPlan,
     towns: &BTreeMap<String, TownContext>,
     options: &GenerateOptions,
 ) -> Result<GenerateReport, Error> {
@@ -134,18 +159,17 @@ pub fn generate(
     }
     let writer = DatasetWriter::open(&options.out, plan, options.shard.is_some())?;
     let shard = options.shard.map(|(i, n)| shard_clips(plan, i, n));
-    let selected: Vec<&ClipScript> = plan
-        .clips
-        .iter()
-        .filter(|c| options.only.as_ref().is_none_or(|id| &c.clip_id == id))
-        .filter(|c| shard.as_ref().is_none_or(|s| s.contains(&c.clip_id)))
+    let selected: Vec<usize> = (0..plan.clips.len())
+        .filter(|&i| options.only.as_ref().is_none_or(|id| &plan.clips[i].clip_id == id))
+        .filter(|&i| shard.as_ref().is_none_or(|s| s.contains(&plan.clips[i].clip_id)))
         .collect();
-    let todo: Vec<&ClipScript> = selected
+    let todo: Vec<usize> = selected
         .iter()
         .copied()
-        .filter(|c| !writer.is_clip_done(&c.clip_id))
+        .filter(|&i| !writer.is_clip_done(&plan.clips[i].clip_id))
         .collect();
-    let rig = Rig::from_spec(&plan.spec.sensors);
+    let header = plan.header();
+    let rig = Rig::from_spec(&header.spec.sensors);
     let progress = if options.progress_json {
         Progress::json(todo.len())
     } else {
@@ -155,32 +179,43 @@ pub fn generate(
         .num_threads(options.jobs.unwrap_or(0))
         .build()
         .map_err(|e| Error::new(code::IO_THREADS, format!("cannot start worker threads: {e}")))?;
-    let results: Vec<Result<ClipCounts, Error>> = pool.install(|| {
+    // Counts summed and failures kept as the clips finish (nothing per clip is held); failures in plan order.
+    let (mut report, mut failures): (GenerateReport, Vec<(usize, Error)>) = pool.install(|| {
         todo.par_iter()
-            .map(|script| {
-                let counts = run_clip(plan, script, &towns[&script.town], &rig, &writer)?;
-                progress.clip_done(&script.clip_id, counts.frames);
-                Ok(counts)
+            .map(|&i| {
+                let result = plan
+                    .script(i, towns)
+                    .map_err(|p| Error::new(code::PLAN_INFEASIBLE, format!("the plan changed while generating: {p}")))
+                    .and_then(|script| {
+                        let counts = run_clip(header, &script, &towns[&script.town], &rig, &writer)?;
+                        progress.clip_done(&script.clip_id, counts.frames);
+                        Ok(counts)
+                    });
+                (i, result)
             })
-            .collect()
+            .fold(
+                || (GenerateReport::default(), Vec::new()),
+                |(mut report, mut failures), (i, result)| {
+                    match result {
+                        Ok(c) => report.add(&c),
+                        Err(e) => failures.push((i, e)),
+                    }
+                    (report, failures)
+                },
+            )
+            .reduce(
+                || (GenerateReport::default(), Vec::new()),
+                |(mut a, mut fa), (b, fb)| {
+                    a.absorb(&b);
+                    fa.extend(fb);
+                    (a, fa)
+                },
+            )
     });
     progress.finish();
-    let mut report = GenerateReport {
-        skipped: selected.len() - todo.len(),
-        ..GenerateReport::default()
-    };
-    let mut failures = Vec::new();
-    for r in results {
-        match r {
-            Ok(c) => {
-                report.generated += 1;
-                report.frames += c.frames;
-                report.pedestrian_frames += c.pedestrian_frames;
-                report.samples += c.samples;
-            }
-            Err(e) => failures.push(e),
-        }
-    }
+    report.skipped = selected.len() - todo.len();
+    failures.sort_by_key(|(i, _)| *i);
+    let mut failures: Vec<Error> = failures.into_iter().map(|(_, e)| e).collect();
     // Shards of one run finish in any order: the manifest (derived from the files on disk) and the card are
     // written under the manifest lock, so the last one to finish writes the complete ones.
     let _guard = writer.manifest_lock()?;
@@ -198,33 +233,36 @@ pub fn generate(
 
 /// Writes the manifest (derived from the files on disk) and, when every clip is finished and `card` holds,
 /// the dataset card (README.md, after the manifest). The caller holds the manifest lock. Returns whether every
-/// clip is finished.
+/// clip is finished. Both files are streamed: what is held does not grow with the number of clips beyond a
+/// few words per clip.
 pub(crate) fn finish_dataset(
-    plan: &Plan,
+    plan: &PreparedPlan,
     writer: &DatasetWriter,
     out: &std::path::Path,
     card: bool,
 ) -> Result<bool, Error> {
-    let manifest = writer.finish()?;
-    let complete = manifest.clips.iter().all(|c| c.status == "done");
+    let complete = writer.finish(plan)?;
     if card && complete {
         let stats = crate::exec::read::stats::compute(out)?;
-        let splits = plan
+        let layout = writer.layout();
+        let clips: Vec<(&str, &str)> = plan
             .clips
             .iter()
-            .map(|c| (c.clip_id.clone(), crate::exec::write::tables::split_name(c.split)))
+            .map(|c| (c.clip_id.as_str(), c.split.name()))
             .collect();
-        let layout = writer.layout();
-        let mut rows = BTreeMap::new();
-        for clip in &plan.clips {
+        // Rows of each table in each split.
+        let mut rows: BTreeMap<(&str, &str), u64> = BTreeMap::new();
+        for &(id, split) in &clips {
             for table in crate::exec::write::tables::TABLES {
-                let n = crate::exec::read::tables::row_count(&layout.table(table, &clip.clip_id))?;
-                rows.insert((table.to_owned(), clip.clip_id.clone()), n);
+                *rows.entry((table, split)).or_default() +=
+                    crate::exec::read::tables::row_count(&layout.table(table, id))?;
             }
         }
-        let card = crate::exec::write::card::render(&plan.spec, &manifest, &splits, &rows, &stats);
         let path = out.join(crate::exec::write::card::CARD_FILE);
-        crate::fsutil::write_atomically(&path, card.as_bytes()).map_err(|e| Error::write(&path, e))?;
+        let mut file = crate::fsutil::AtomicFile::create(&path).map_err(|e| Error::write(&path, e))?;
+        crate::exec::write::card::write(&plan.header().spec, writer.manifest(), &clips, &rows, &stats, &mut file)
+            .map_err(|e| Error::write(&path, e))?;
+        file.commit_synced().map_err(|e| Error::write(&path, e))?;
     }
     Ok(complete)
 }

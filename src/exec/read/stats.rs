@@ -93,10 +93,15 @@ pub struct DatasetStats {
 pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     let layout = Layout::new(dir);
     let mut s = DatasetStats::default();
-    let manifest: Option<serde_json::Value> = std::fs::read_to_string(layout.manifest())
+    // Only the target from the manifest, read as a stream (its clip list grows with the dataset).
+    #[derive(serde::Deserialize)]
+    struct Target {
+        target_crossing_ratio: Option<f64>,
+    }
+    s.target_crossing_ratio = std::fs::File::open(layout.manifest())
         .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
-    s.target_crossing_ratio = manifest.as_ref().and_then(|m| m["target_crossing_ratio"].as_f64());
+        .and_then(|f| serde_json::from_reader::<_, Target>(std::io::BufReader::new(f)).ok())
+        .and_then(|m| m.target_crossing_ratio);
     let mut towns = std::collections::BTreeSet::new();
     let mut weathers = std::collections::BTreeSet::new();
     let mut duration_s = 0.0;

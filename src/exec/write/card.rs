@@ -60,25 +60,78 @@ fn table_summary(table: &str) -> &'static str {
     }
 }
 
-/// The card of a finished dataset. `clips` maps each clip id to its split (`train`, `val`, `test`); `rows`
-/// gives the rows of each (table, clip id) file. A split whose files of a table hold no row is left out of that
-/// table's config (`datasets` cannot load a split without data), and a table without any row gets no config.
-pub fn render(
+/// The card of a finished dataset, as text ([`write`]).
+pub fn render<C>(
     spec: &Spec,
-    manifest: &Manifest,
-    clips: &BTreeMap<String, String>,
-    rows: &BTreeMap<(String, String), u64>,
+    manifest: &Manifest<C>,
+    clips: &[(&str, &str)],
+    rows: &BTreeMap<(&str, &str), u64>,
     stats: &DatasetStats,
 ) -> String {
-    let rows_of = |table: &str, ids: &[&str]| -> u64 {
-        ids.iter()
-            .map(|id| rows.get(&(table.to_owned(), (*id).to_owned())).copied().unwrap_or(0))
-            .sum()
-    };
-    let mut by_split: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
-    for (clip, split) in clips {
-        by_split.entry(hf_split(split)).or_default().push(clip);
+    let mut bytes = Vec::new();
+    // Writing into memory does not fail.
+    let _ = write(spec, manifest, clips, rows, stats, &mut bytes);
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+/// Writes the card of a finished dataset to `out`, streamed (its file lists grow with the clips). `clips`
+/// gives each clip id and its split (`train`, `val`, `test`) in plan order; `rows` the rows of each (table,
+/// split). A split whose files of a table hold no row is left out of that table's config (`datasets` cannot
+/// load a split without data), and a table without any row gets no config.
+pub fn write<C>(
+    spec: &Spec,
+    manifest: &Manifest<C>,
+    clips: &[(&str, &str)],
+    rows: &BTreeMap<(&str, &str), u64>,
+    stats: &DatasetStats,
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    let mut x = Text { out, error: None };
+    write_text(spec, manifest, clips, rows, stats, &mut x);
+    x.error.map_or(Ok(()), Err)
+}
+
+/// `fmt::Write` into an `io::Write`, keeping the first IO error (the card's text is written with `write!`).
+struct Text<'a> {
+    out: &'a mut dyn std::io::Write,
+    error: Option<std::io::Error>,
+}
+
+impl Text<'_> {
+    fn push_str(&mut self, s: &str) {
+        let _ = std::fmt::Write::write_str(self, s);
     }
+}
+
+impl std::fmt::Write for Text<'_> {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        if self.error.is_some() {
+            return Err(std::fmt::Error);
+        }
+        self.out.write_all(s.as_bytes()).map_err(|e| {
+            self.error = Some(e);
+            std::fmt::Error
+        })
+    }
+}
+
+fn write_text<C>(
+    spec: &Spec,
+    manifest: &Manifest<C>,
+    clips: &[(&str, &str)],
+    rows: &BTreeMap<(&str, &str), u64>,
+    stats: &DatasetStats,
+    x: &mut Text<'_>,
+) {
+    let mut by_split: BTreeMap<&str, (&str, Vec<&str>)> = BTreeMap::new();
+    for &(clip, split) in clips {
+        by_split
+            .entry(hf_split(split))
+            .or_insert((split, Vec::new()))
+            .1
+            .push(clip);
+    }
+    let rows_of = |table: &str, split: &str| rows.get(&(table, split)).copied().unwrap_or(0);
     // Splits in the conventional order.
     let order = |s: &str| match s {
         "train" => 0,
@@ -86,10 +139,9 @@ pub fn render(
         "test" => 2,
         _ => 3,
     };
-    let mut splits: Vec<(&str, Vec<&str>)> = by_split.into_iter().collect();
+    let mut splits: Vec<(&str, (&str, Vec<&str>))> = by_split.into_iter().collect();
     splits.sort_by_key(|(s, _)| (order(s), s.to_string()));
 
-    let mut x = String::new();
     let _ = write!(
         x,
         "---\nlicense: {}\npretty_name: {}\ntags:\n- synthetic\n- pedestrian-crossing\n- pedestrian-intention\n- autonomous-driving\n- pedsynth\ntask_categories:\n- video-classification\n- object-detection\n- keypoint-detection\nsize_categories:\n- {}\nconfigs:\n",
@@ -99,7 +151,10 @@ pub fn render(
     );
     let mut empty = Vec::new();
     for table in TABLES {
-        let filled: Vec<&(&str, Vec<&str>)> = splits.iter().filter(|(_, ids)| rows_of(table, ids) > 0).collect();
+        let filled: Vec<&(&str, (&str, Vec<&str>))> = splits
+            .iter()
+            .filter(|(_, (ours, _))| rows_of(table, ours) > 0)
+            .collect();
         if filled.is_empty() {
             empty.push(table);
             continue;
@@ -109,7 +164,7 @@ pub fn render(
             x.push_str("  default: true\n");
         }
         x.push_str("  data_files:\n");
-        for (split, ids) in filled {
+        for (split, (_, ids)) in filled {
             let _ = writeln!(x, "  - split: {split}\n    path:");
             for id in ids {
                 let _ = writeln!(x, "    - {}", quoted(&format!("tables/{table}/{id}.parquet")));
@@ -194,5 +249,4 @@ pub fn render(
         "\n## Licence\n\n`{}` (the spec's `dataset.license`). The data is synthetic: no real person is depicted.\n",
         spec.dataset.license
     );
-    x
 }

@@ -7,7 +7,6 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, code};
-use crate::planner::Plan;
 
 /// Marker and version of the dataset format (`manifest.json`'s `pedsynth_dataset`).
 pub const DATASET_FORMAT: u32 = 1;
@@ -23,9 +22,10 @@ pub struct ManifestClip {
     pub files: BTreeMap<String, String>,
 }
 
-/// `manifest.json`.
+/// `manifest.json`. `C` is the clip list: held (`Vec`, what is read), none (`()`, a writer's header), or
+/// [`crate::stream_json::Streamed`] (written clip by clip, in constant memory).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Manifest {
+pub struct Manifest<C = Vec<ManifestClip>> {
     /// Dataset format version; its presence marks a pedsynth dataset.
     pub pedsynth_dataset: u32,
     /// pedsynth version that wrote the dataset.
@@ -45,10 +45,10 @@ pub struct Manifest {
     /// Sensors and what was written for each.
     pub sensors: BTreeMap<String, String>,
     /// Every planned clip.
-    pub clips: Vec<ManifestClip>,
+    pub clips: C,
 }
 
-impl Manifest {
+impl<C: Serialize> Manifest<C> {
     /// The manifest's JSON text (pretty, with a final newline).
     pub fn to_json(&self) -> Result<String, Error> {
         let mut text = crate::error::to_json(self, true)?;
@@ -56,75 +56,34 @@ impl Manifest {
         Ok(text)
     }
 
+    /// Writes the manifest's JSON text (as [`Manifest::to_json`]) to `out`.
+    pub fn write_json(&self, out: impl std::io::Write) -> Result<(), serde_json::Error> {
+        let mut out = out;
+        serde_json::to_writer_pretty(&mut out, self)?;
+        out.write_all(b"\n").map_err(serde_json::Error::io)
+    }
+
+    /// The same manifest with the clip list `clips`.
+    pub fn with_clips<D>(&self, clips: D) -> Manifest<D> {
+        Manifest {
+            pedsynth_dataset: self.pedsynth_dataset,
+            pedsynth_version: self.pedsynth_version.clone(),
+            schema_version: self.schema_version,
+            dataset: self.dataset.clone(),
+            spec_hash: self.spec_hash.clone(),
+            plan_hash: self.plan_hash.clone(),
+            target_crossing_ratio: self.target_crossing_ratio,
+            tables: self.tables.clone(),
+            sensors: self.sensors.clone(),
+            clips,
+        }
+    }
+}
+
+impl Manifest {
     /// Parses a manifest; `what` names it in the error.
     pub fn parse(text: &str, what: &str) -> Result<Manifest, Error> {
         serde_json::from_str(text)
             .map_err(|e| Error::new(code::DATASET_INVALID, format!("{what} is not a pedsynth manifest: {e}")))
-    }
-}
-
-/// blake3 of a plan's canonical JSON, without `spec_dir`: where the spec file lies (and how its path was
-/// spelled) does not change the dataset, so the same spec run from another directory, or its
-/// `spec.resolved.yaml`, resumes the same dataset and writes the same manifest.
-pub fn plan_hash(plan: &Plan) -> Result<String, Error> {
-    // The plan's fields by reference, `spec_dir` blanked: the JSON of the plan without cloning it (a
-    // 6,000-clip plan is tens of megabytes), streamed into the hasher instead of held as a string. The test
-    // below holds it equal to the JSON of a clone with an empty `spec_dir`, field for field.
-    #[derive(Serialize)]
-    struct Hashed<'a> {
-        format_version: u32,
-        pedsynth_version: &'a str,
-        dataset: &'a str,
-        seed: u64,
-        spec_hash: &'a str,
-        target_crossing_ratio: f64,
-        sim: &'a crate::planner::SimParams,
-        spec: &'a crate::dsl::Spec,
-        spec_dir: &'a str,
-        towns: &'a BTreeMap<String, String>,
-        clips: &'a [crate::planner::ClipScript],
-    }
-    let hashed = Hashed {
-        format_version: plan.format_version,
-        pedsynth_version: &plan.pedsynth_version,
-        dataset: &plan.dataset,
-        seed: plan.seed,
-        spec_hash: &plan.spec_hash,
-        target_crossing_ratio: plan.target_crossing_ratio,
-        sim: &plan.sim,
-        spec: &plan.spec,
-        spec_dir: "",
-        towns: &plan.towns,
-        clips: &plan.clips,
-    };
-    let mut hasher = blake3::Hasher::new();
-    serde_json::to_writer(&mut hasher, &hashed)
-        .map_err(|e| Error::new(code::INTERNAL_SERIALIZE, format!("cannot serialise the plan: {e}")))?;
-    Ok(hasher.finalize().to_hex().to_string())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn plan_hash_is_the_hash_of_the_plans_json_without_its_spec_dir() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-        let (_, plan) = crate::commands::compile_plan(&path, &Default::default(), None).expect("quickstart");
-        let mut blank = plan.clone();
-        blank.spec_dir = String::new();
-        let json = serde_json::to_string(&blank).expect("json");
-        let expected = blake3::hash(json.as_bytes()).to_hex().to_string();
-        // Equal when every field of `Plan` is in `plan_hash`'s mirror, in order.
-        assert_eq!(plan_hash(&plan).expect("hash"), expected);
-        let mut moved = plan.clone();
-        moved.spec_dir = "../elsewhere".into();
-        assert_eq!(
-            plan_hash(&moved).expect("hash"),
-            expected,
-            "where the spec lies does not matter"
-        );
-        moved.seed += 1;
-        assert_ne!(plan_hash(&moved).expect("hash"), expected);
     }
 }

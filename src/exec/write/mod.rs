@@ -27,9 +27,9 @@ use crate::error::{Error, code};
 use crate::exec::observe::Observations;
 use crate::exec::trace::ClipTrace;
 use crate::fsutil::write_atomically;
-use crate::planner::{ClipScript, Plan};
+use crate::planner::{ClipScript, Plan, PreparedPlan};
 pub use layout::Layout;
-pub use manifest::{DATASET_FORMAT, Manifest, ManifestClip, plan_hash};
+pub use manifest::{DATASET_FORMAT, Manifest, ManifestClip};
 use tables::{FileMeta, TABLES};
 
 /// An output directory opened for the dataset of one plan.
@@ -38,8 +38,8 @@ pub struct DatasetWriter {
     /// The directory's lock ([`LOCK_FILE`]), held while the writer lives.
     _lock: std::fs::File,
     layout: Layout,
-    /// The manifest as it was at opening (every clip pending, or the resumed dataset's manifest).
-    manifest: Manifest,
+    /// The manifest without its clips (their list is written from the plan's summaries, clip by clip).
+    manifest: Manifest<()>,
     meta: FileMeta,
 }
 
@@ -51,10 +51,10 @@ impl DatasetWriter {
     /// A whole run holds an exclusive lock on [`LOCK_FILE`]; a shard (`shared`) holds a shared one, so shards
     /// of one run write side by side while a whole run and a shard exclude each other. Temporaries are removed
     /// only when nothing else holds the lock (a running shard's are in use).
-    pub fn open(out: &Path, plan: &Plan, shared: bool) -> Result<DatasetWriter, Error> {
+    pub fn open(out: &Path, plan: &PreparedPlan, shared: bool) -> Result<DatasetWriter, Error> {
         let layout = Layout::new(out);
-        let plan_hash = plan_hash(plan)?;
-        check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
+        let header = plan.header();
+        check_out_dir(&layout, &header.spec_hash, &plan.plan_hash)?;
         std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
         // The manifest lock is taken first and held through the start: it makes a shard wait while the first
         // one cleans up and writes the initial manifest (holding the directory lock exclusively for that
@@ -64,46 +64,38 @@ impl DatasetWriter {
         let (lock, alone) = lock_out_dir(&layout, shared)?;
         // Checked again under the locks: another run, or another shard of this one, may have started the
         // dataset in between.
-        let existing = check_out_dir(&layout, &plan.spec_hash, &plan_hash)?;
-        let spec_yaml = crate::dsl::to_yaml(&plan.spec)?;
+        let existing = check_out_dir(&layout, &header.spec_hash, &plan.plan_hash)?;
+        let spec_yaml = crate::dsl::to_yaml(&header.spec)?;
         let spec_path = layout.spec_resolved();
         write_atomically(&spec_path, spec_yaml.as_bytes()).map_err(|e| Error::write(&spec_path, e))?;
         let manifest = Manifest {
             pedsynth_dataset: DATASET_FORMAT,
             pedsynth_version: env!("CARGO_PKG_VERSION").to_owned(),
             schema_version: tables::SCHEMA_VERSION,
-            dataset: plan.dataset.clone(),
-            spec_hash: plan.spec_hash.clone(),
-            plan_hash,
-            target_crossing_ratio: plan.target_crossing_ratio,
+            dataset: header.dataset.clone(),
+            spec_hash: header.spec_hash.clone(),
+            plan_hash: plan.plan_hash.clone(),
+            target_crossing_ratio: header.target_crossing_ratio,
             tables: TABLES.iter().map(|t| t.to_string()).collect(),
-            sensors: sensor_status(plan),
-            clips: plan
-                .clips
-                .iter()
-                .map(|c| ManifestClip {
-                    clip_id: c.clip_id.clone(),
-                    status: "pending".into(),
-                    files: BTreeMap::new(),
-                })
-                .collect(),
+            sensors: sensor_status(header),
+            clips: (),
         };
         let writer = DatasetWriter {
             _lock: lock,
             layout,
             manifest,
             meta: FileMeta {
-                spec_hash: plan.spec_hash.clone(),
+                spec_hash: header.spec_hash.clone(),
             },
         };
         if alone {
-            writer.remove_temporaries()?;
+            writer.remove_temporaries(plan)?;
         }
         if shared && alone {
             share_lock(&writer._lock, &writer.layout)?;
         }
         if !existing {
-            writer.write_manifest(&writer.manifest)?;
+            writer.write_manifest(plan, |_| Ok(None))?;
         }
         drop(manifest_guard);
         Ok(writer)
@@ -118,6 +110,11 @@ impl DatasetWriter {
     /// The spec and plan hashes of the dataset being written.
     pub fn manifest_hashes(&self) -> (&str, &str) {
         (&self.manifest.spec_hash, &self.manifest.plan_hash)
+    }
+
+    /// The dataset's manifest without its clips.
+    pub fn manifest(&self) -> &Manifest<()> {
+        &self.manifest
     }
 
     /// The dataset's layout.
@@ -198,16 +195,18 @@ impl DatasetWriter {
     }
 
     /// Writes the final manifest: every finished clip `done` with its files' hashes, the others `pending`.
-    pub fn finish(&self) -> Result<Manifest, Error> {
-        let mut manifest = self.manifest.clone();
-        for clip in &mut manifest.clips {
-            if self.is_clip_done(&clip.clip_id) {
-                clip.status = "done".into();
-                clip.files = self.file_hashes(&clip.clip_id)?;
+    /// Returns whether every clip is finished.
+    pub fn finish(&self, plan: &PreparedPlan) -> Result<bool, Error> {
+        let complete = std::cell::Cell::new(true);
+        self.write_manifest(plan, |clip_id| {
+            if self.is_clip_done(clip_id) {
+                self.file_hashes(clip_id).map(Some)
+            } else {
+                complete.set(false);
+                Ok(None)
             }
-        }
-        self.write_manifest(&manifest)?;
-        Ok(manifest)
+        })?;
+        Ok(complete.get())
     }
 
     fn file_hashes(&self, clip_id: &str) -> Result<BTreeMap<String, String>, Error> {
@@ -221,27 +220,47 @@ impl DatasetWriter {
             .collect()
     }
 
-    fn write_manifest(&self, manifest: &Manifest) -> Result<(), Error> {
+    /// Writes the manifest of `plan`'s clips, streamed clip by clip into the file (never held whole): a clip
+    /// is `done` with the table hashes `files` gives for it, or `pending` where it gives none.
+    fn write_manifest(
+        &self,
+        plan: &PreparedPlan,
+        files: impl Fn(&str) -> Result<Option<BTreeMap<String, String>>, Error>,
+    ) -> Result<(), Error> {
         let path = self.layout.manifest();
-        write_atomically(&path, manifest.to_json()?.as_bytes()).map_err(|e| Error::write(&path, e))
+        let clips = plan.clips.iter().map(|c| {
+            files(&c.clip_id).map(|files| ManifestClip {
+                clip_id: c.clip_id.clone(),
+                status: if files.is_some() { "done" } else { "pending" }.into(),
+                files: files.unwrap_or_default(),
+            })
+        });
+        let manifest = self
+            .manifest
+            .with_clips(crate::stream_json::Streamed::new(clips, plan.clips.len()));
+        let mut file = crate::fsutil::AtomicFile::create(&path).map_err(|e| Error::write(&path, e))?;
+        if let Err(e) = manifest.write_json(&mut file) {
+            // A clip's table that could not be read is that error; anything else is the file's.
+            return Err(manifest.clips.take_error().unwrap_or_else(|| match e.io_error_kind() {
+                Some(kind) => Error::write(&path, std::io::Error::new(kind, e.to_string())),
+                None => Error::new(code::INTERNAL_SERIALIZE, format!("cannot serialise the manifest: {e}")),
+            }));
+        }
+        file.commit_synced().map_err(|e| Error::write(&path, e))?;
+        Ok(())
     }
 
     /// Removes the temporary files an interrupted run left in the dataset's own directories (the root,
     /// `tables/<table>/`, `sensors/<stream>/` and every clip's `sensors/<stream>/<clip_id>/`), so that a
     /// resumed dataset holds exactly the files of an uninterrupted run.
-    fn remove_temporaries(&self) -> Result<(), Error> {
+    fn remove_temporaries(&self, plan: &PreparedPlan) -> Result<(), Error> {
         let mut dirs: Vec<std::path::PathBuf> = std::iter::once(self.layout.root().to_path_buf())
             .chain(TABLES.iter().map(|t| self.layout.table_dir(t)))
             .collect();
         for stream in sensors::STREAMS {
             let stream_dir = self.layout.root().join(layout::SENSORS_DIR).join(stream);
             dirs.push(stream_dir);
-            dirs.extend(
-                self.manifest
-                    .clips
-                    .iter()
-                    .map(|c| self.layout.sensor_dir(stream, &c.clip_id)),
-            );
+            dirs.extend(plan.clips.iter().map(|c| self.layout.sensor_dir(stream, &c.clip_id)));
         }
         for dir in dirs {
             let Ok(entries) = std::fs::read_dir(&dir) else { continue };

@@ -61,11 +61,6 @@ fn lane_name(l: LaneType) -> &'static str {
     }
 }
 
-/// The name of a split as the tables write it (`train`, `val`, `test`).
-pub fn split_name(split: crate::dsl::types::Split) -> String {
-    snake(&split)
-}
-
 fn snake<T: serde::Serialize>(value: &T) -> String {
     serde_json::to_value(value)
         .ok()
