@@ -713,3 +713,75 @@ fn static_scenes_give_no_dvs_events_and_motion_gives_some() {
     esim.step(&img.rgb, 33_333_333, 2, &mut ev);
     assert!(ev.is_empty());
 }
+
+#[test]
+fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_covers() {
+    // A pedestrian moved 3 m behind a lamp pole, on the camera's line of sight through the pole: the
+    // annotation flags the joints the pole covers as occluded (v = 1), and the rendered frame shows the pole
+    // there; the joints it flags visible are on the pedestrian's pixels.
+    let mut c = clip(
+        &spec("quickstart.yaml"),
+        &["sensors.rgb.width_px=640", "sensors.rgb.height_px=360"],
+    );
+    let net = &c.towns[&c.script.town].network;
+    let mut checked = 0;
+    for frame in (0..c.trace.frame_count as usize).step_by(15) {
+        let ego = c.trace.ego[frame];
+        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+        let eye = cam.centre.truncate();
+        let posts = scene::clip_lamp_posts(&c.trace, net);
+        let Some(post) = posts.iter().find(|p| {
+            let pole = cam.project(p.foot.extend(p.base_z_m + 1.0));
+            let d = p.foot.distance(eye);
+            (6.0..20.0).contains(&d) && pole.depth_m > 0.0 && cam.in_image(pole.px)
+        }) else {
+            continue;
+        };
+        let behind = eye + (post.foot - eye) * (1.0 + 3.0 / post.foot.distance(eye));
+        let saved = c.trace.pedestrians[0][frame];
+        c.trace.pedestrians[0][frame].pos = behind.extend(post.base_z_m);
+        // The pole must still stand (no pedestrian of the clip walks through it).
+        if !scene::clip_lamp_posts(&c.trace, net).contains(post) {
+            c.trace.pedestrians[0][frame] = saved;
+            continue;
+        }
+        let ann = observe::observe(&c.script, &c.trace, &c.plan.spec, &c.rig, net).annotations;
+        let Some(row) = ann.rows.iter().find(|r| r.frame as usize == frame && r.pedestrian == 0) else {
+            c.trace.pedestrians[0][frame] = saved;
+            continue;
+        };
+        let img = observe::render_frame(&c.script, &c.trace, &c.rig, net, frame as u32);
+        let (w, id) = (img.width, pedestrian_instance(0));
+        let at = |k: usize| {
+            let (x, y) = (row.keypoints[3 * k] as usize, row.keypoints[3 * k + 1] as usize);
+            (x < w && y < img.height).then(|| y * w + x)
+        };
+        let hidden: Vec<usize> = (0..17).filter(|&k| row.keypoints[3 * k + 2] == 1.0).collect();
+        assert!(
+            row.occlusion > 0.0 && !hidden.is_empty(),
+            "frame {frame}: the pole hides nothing: {row:?}"
+        );
+        let on_pole = hidden
+            .iter()
+            .filter(|&&k| at(k).is_some_and(|i| img.semantic[i] == tag::POLE))
+            .count();
+        assert!(
+            on_pole * 2 >= hidden.len(),
+            "frame {frame}: {on_pole} of {} occluded keypoints on the pole's pixels",
+            hidden.len()
+        );
+        for k in (0..17).filter(|&k| row.keypoints[3 * k + 2] == 2.0) {
+            let i = at(k).expect("a visible keypoint is in the image");
+            let near_body = [0usize, 1, w - 1, w + 1, w, w.wrapping_neg(), 1usize.wrapping_neg()]
+                .iter()
+                .any(|&o| img.instance.get(i.wrapping_add(o)) == Some(&id));
+            assert!(near_body, "frame {frame}: visible keypoint {k} not on the pedestrian");
+        }
+        checked += 1;
+        c.trace.pedestrians[0][frame] = saved;
+    }
+    assert!(
+        checked >= 3,
+        "only {checked} frames with a pole in front of a pedestrian"
+    );
+}

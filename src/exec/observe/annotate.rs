@@ -1,5 +1,5 @@
 //! Annotation of a simulated clip: the visibility gate, tight 2D boxes of the projected body, COCO-17
-//! keypoints with visibility flags, occlusion by vehicles, buildings and other pedestrians, per-frame crossing
+//! keypoints with visibility flags, occlusion by vehicles, buildings, street lamps and other pedestrians, per-frame crossing
 //! labels with temporal smoothing, sequence labels, time-to-event and intention onset.
 //!
 //! Crossing label (the paper's definition): C = 1 in a frame when the pedestrian is in a crossing-type state
@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M};
 use super::rig::{Camera, CameraPose};
+use super::scene;
 use crate::dsl::types::{Annotations, BoxSize};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::{ClipTrace, Event, PedFrame, PedState};
@@ -133,6 +134,8 @@ enum Occluder {
         height_m: f64,
         owner: u32,
     },
+    /// A street lamp's pole (the square, axis-aligned box the renderer draws): its centre and half extents.
+    Pole { centre: DVec3, half_m: DVec3 },
 }
 
 /// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
@@ -152,7 +155,22 @@ fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
             height_m,
             ..
         } => crate::world::segment_hits_cylinder(from, d, t_max, ground, radius_m, height_m),
+        Occluder::Pole { centre, half_m } => crate::world::segment_hits_box(from, d, t_max, centre, (0.0, 1.0), half_m),
     }
+}
+
+/// The lamp poles of the clip's scene, as the renderer draws them ([`scene::clip_lamp_posts`]; the arm and the
+/// light are above any line of sight to a pedestrian).
+fn lamp_poles(trace: &ClipTrace, town: &RoadNetwork) -> Vec<Occluder> {
+    let half = f64::from(scene::LAMP_POLE_HALF_WIDTH_M);
+    let height_m = f64::from(scene::LAMP_HEIGHT_M + scene::LAMP_POLE_ABOVE_LIGHT_M);
+    scene::clip_lamp_posts(trace, town)
+        .into_iter()
+        .map(|post| Occluder::Pole {
+            centre: post.foot.extend(post.base_z_m + height_m * 0.5),
+            half_m: DVec3::new(half, half, height_m * 0.5),
+        })
+        .collect()
 }
 
 /// Whether the line of sight from the camera to `target` is blocked by one of `occluders` (already stripped of
@@ -171,6 +189,7 @@ fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f64) -> bool
     let (centre, radius_m) = match *occ {
         Occluder::Vehicle { centre, .. } => (centre.truncate(), VEHICLE_LENGTH_M.hypot(VEHICLE_WIDTH_M) * 0.5),
         Occluder::Person { ground, radius_m, .. } => (ground.truncate(), radius_m),
+        Occluder::Pole { centre, half_m } => (centre.truncate(), half_m.truncate().length()),
     };
     let r = radius_m + reach_m + 1e-6;
     crate::world::segment_projection(camera, target, centre).1 <= r * r
@@ -295,13 +314,15 @@ pub fn annotate(
         }
     }
 
-    let mut occluders: Vec<Occluder> = Vec::with_capacity(trace.vehicles.len() + 2 * n_peds);
+    let poles = lamp_poles(trace, town);
+    let mut occluders: Vec<Occluder> = Vec::with_capacity(poles.len() + trace.vehicles.len() + 2 * n_peds);
     let mut near: Vec<Occluder> = Vec::with_capacity(occluders.capacity());
     let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
     for frame in 0..trace.frame_count as usize {
         let Some(ego) = trace.ego.get(frame) else { break };
         let cam = camera.at(ego.pos, ego.yaw_rad);
         occluders.clear();
+        occluders.extend_from_slice(&poles);
         for v in &trace.vehicles {
             if let Some(f) = v.get(frame) {
                 occluders.push(Occluder::Vehicle {

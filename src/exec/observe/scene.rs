@@ -520,12 +520,94 @@ fn lane_marks(town: &RoadNetwork) -> Vec<[Mark; 2]> {
         .collect()
 }
 
+/// The plan-view box of a clip's scene: the ego's path and [`SCENE_MARGIN_M`] around it.
+pub fn scene_bounds(trace: &ClipTrace) -> (DVec2, DVec2) {
+    let (lo, hi) =
+        crate::world::bounding_box(trace.ego.iter().map(|e| e.pos.truncate())).unwrap_or((DVec2::ZERO, DVec2::ZERO));
+    (lo - DVec2::splat(SCENE_MARGIN_M), hi + DVec2::splat(SCENE_MARGIN_M))
+}
+
+/// Where a street lamp stands: the foot of its pole, the sidewalk's height there and the direction of its arm
+/// (toward the road).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LampPost {
+    /// Foot of the pole, world plan view, metres.
+    pub foot: DVec2,
+    /// Height of the ground at the foot, metres.
+    pub base_z_m: f64,
+    /// Unit direction of the arm, toward the road.
+    pub to_road: DVec2,
+}
+
+/// Half the width of a (square) lamp pole, metres.
+pub const LAMP_POLE_HALF_WIDTH_M: f32 = 0.07;
+/// How far the pole rises above the light, metres.
+pub const LAMP_POLE_ABOVE_LIGHT_M: f32 = 0.2;
+
+/// The street lamps of `town` whose foot satisfies `near`: one every [`LAMP_SPACING_M`] along each sidewalk
+/// outside junctions, at the curb (a pure function of the town, so the renderer draws and the annotations
+/// test occlusion against the same poles).
+pub fn street_lamp_posts(town: &RoadNetwork, near: impl Fn(DVec2) -> bool) -> Vec<LampPost> {
+    let mut posts = Vec::new();
+    for lane in &town.lanes {
+        if lane.lane_type != LaneType::Sidewalk || lane.in_junction {
+            continue;
+        }
+        let mut next_m = LAMP_SPACING_M * 0.5;
+        let mut along = 0.0;
+        for piece in &town.pieces[lane.pieces.start as usize..lane.pieces.end as usize] {
+            let [c0, c1] = piece.centre();
+            let len = c0.distance(c1);
+            while along + len >= next_m && len > 1e-6 {
+                let t = (next_m - along) / len;
+                let inner = piece.corners[0].lerp(piece.corners[1], t);
+                let centre = c0.lerp(c1, t);
+                let to_road = (inner - centre).normalize_or_zero();
+                let width = f64::from(piece.width_m[0]);
+                let foot = inner - to_road * (0.35f64).min(0.4 * width);
+                next_m += LAMP_SPACING_M;
+                if !near(foot) || width < 1.0 {
+                    continue;
+                }
+                posts.push(LampPost {
+                    foot,
+                    base_z_m: f64::from(piece.z_m),
+                    to_road,
+                });
+            }
+            along += len;
+        }
+    }
+    posts
+}
+
+/// Clearance between a lamp pole and the path of any pedestrian of the clip (the body's radius, a child
+/// walking beside it, the pole), metres.
+const LAMP_CLEARANCE_M: f64 = 1.0;
+
+/// The street lamps of a clip's scene: [`street_lamp_posts`] within [`scene_bounds`], leaving out any that a
+/// pedestrian of the clip would walk through (the simulation does not steer around poles, and a pole inside a
+/// body makes neither a sensible image nor a sensible occlusion label). The renderer draws these and the
+/// annotations test occlusion against these.
+pub fn clip_lamp_posts(trace: &ClipTrace, town: &RoadNetwork) -> Vec<LampPost> {
+    let (lo, hi) = scene_bounds(trace);
+    let near = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
+    let mut posts = street_lamp_posts(town, near);
+    let clear2 = LAMP_CLEARANCE_M * LAMP_CLEARANCE_M;
+    posts.retain(|post| {
+        trace
+            .pedestrians
+            .iter()
+            .flatten()
+            .all(|f| f.pos.truncate().distance_squared(post.foot) > clear2)
+    });
+    posts
+}
+
 impl StaticScene {
     /// Builds the static scene of a clip: the town within [`SCENE_MARGIN_M`] of the ego's path.
     pub fn build(script: &ClipScript, trace: &ClipTrace, town: &RoadNetwork) -> StaticScene {
-        let ego: Vec<DVec2> = trace.ego.iter().map(|e| e.pos.truncate()).collect();
-        let (lo, hi) = crate::world::bounding_box(ego.iter().copied()).unwrap_or((DVec2::ZERO, DVec2::ZERO));
-        let (lo, hi) = (lo - DVec2::splat(SCENE_MARGIN_M), hi + DVec2::splat(SCENE_MARGIN_M));
+        let (lo, hi) = scene_bounds(trace);
         let z0 = trace.ego.first().map_or(0.0, |e| e.pos.z);
         let origin = DVec3::new(((lo.x + hi.x) * 0.5).round(), ((lo.y + hi.y) * 0.5).round(), z0.round());
         let near = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
@@ -737,56 +819,40 @@ impl StaticScene {
         let mut lamps = Vec::new();
         let metal = flat(Material::Metal, tag::POLE, linear([70, 74, 78]), Vec3::Z, 0);
         let head = flat(Material::LampHead, tag::POLE, linear([230, 220, 190]), -Vec3::Z, 0);
-        for lane in &town.lanes {
-            if lane.lane_type != LaneType::Sidewalk || lane.in_junction {
-                continue;
-            }
-            let mut next_m = LAMP_SPACING_M * 0.5;
-            let mut along = 0.0;
-            for piece in &town.pieces[lane.pieces.start as usize..lane.pieces.end as usize] {
-                let [c0, c1] = piece.centre();
-                let len = c0.distance(c1);
-                while along + len >= next_m && len > 1e-6 {
-                    let t = (next_m - along) / len;
-                    let inner = piece.corners[0].lerp(piece.corners[1], t);
-                    let centre = c0.lerp(c1, t);
-                    let to_road = (inner - centre).normalize_or_zero();
-                    let width = f64::from(piece.width_m[0]);
-                    let foot = inner - to_road * (0.35f64).min(0.4 * width);
-                    next_m += LAMP_SPACING_M;
-                    if !near(foot) || width < 1.0 {
-                        continue;
-                    }
-                    let base = (f64::from(piece.z_m) - origin.z) as f32;
-                    let f = (foot - origin.truncate()).as_vec2();
-                    let dir = to_road.as_vec2();
-                    let top = base + LAMP_HEIGHT_M;
-                    b.mesh
-                        .upright_box(f, 0.0, Vec2::splat(0.07), [base, top + 0.2], metal, metal);
-                    let arm_end = f + dir * 1.4;
-                    b.mesh.upright_box(
-                        (f + arm_end) * 0.5,
-                        dir.y.atan2(dir.x),
-                        Vec2::new(0.7, 0.05),
-                        [top + 0.1, top + 0.2],
-                        metal,
-                        metal,
-                    );
-                    b.mesh.upright_box(
-                        arm_end,
-                        dir.y.atan2(dir.x),
-                        Vec2::new(0.3, 0.15),
-                        [top - 0.05, top + 0.1],
-                        head,
-                        metal,
-                    );
-                    lamps.push(Lamp {
-                        pos: Vec3::new(arm_end.x, arm_end.y, top - 0.15),
-                    });
-                    close_cluster(&b, &mut clusters, &mut cluster_start);
-                }
-                along += len;
-            }
+        for post in clip_lamp_posts(trace, town) {
+            let base = (post.base_z_m - origin.z) as f32;
+            let f = (post.foot - origin.truncate()).as_vec2();
+            let dir = post.to_road.as_vec2();
+            let top = base + LAMP_HEIGHT_M;
+            b.mesh.upright_box(
+                f,
+                0.0,
+                Vec2::splat(LAMP_POLE_HALF_WIDTH_M),
+                [base, top + LAMP_POLE_ABOVE_LIGHT_M],
+                metal,
+                metal,
+            );
+            let arm_end = f + dir * 1.4;
+            b.mesh.upright_box(
+                (f + arm_end) * 0.5,
+                dir.y.atan2(dir.x),
+                Vec2::new(0.7, 0.05),
+                [top + 0.1, top + 0.2],
+                metal,
+                metal,
+            );
+            b.mesh.upright_box(
+                arm_end,
+                dir.y.atan2(dir.x),
+                Vec2::new(0.3, 0.15),
+                [top - 0.05, top + 0.1],
+                head,
+                metal,
+            );
+            lamps.push(Lamp {
+                pos: Vec3::new(arm_end.x, arm_end.y, top - 0.15),
+            });
+            close_cluster(&b, &mut clusters, &mut cluster_start);
         }
         close_cluster(&b, &mut clusters, &mut cluster_start);
 
