@@ -102,6 +102,22 @@ struct MaskReport {
     partly_hidden: usize,
 }
 
+/// Whether `test` holds for a pixel within one pixel of the image point (`x`, `y`) (the label sample of pixel
+/// (px, py) lies at (px + 0.25, py + 0.25)); `test` gets the pixel's index.
+fn near_pixel(img: &CameraImages, x: f32, y: f32, test: impl Fn(usize) -> bool) -> bool {
+    let (cx, cy) = ((x - 0.25).round() as i64, (y - 0.25).round() as i64);
+    (-1..=1).any(|dy| {
+        (-1..=1).any(|dx| {
+            let (px, py) = (cx + dx, cy + dy);
+            px >= 0
+                && py >= 0
+                && (px as usize) < img.width
+                && (py as usize) < img.height
+                && test(py as usize * img.width + px as usize)
+        })
+    })
+}
+
 /// Compares every unoccluded annotated pedestrian of one frame with its instance pixels; records a pedestrian
 /// whose pixels leave its box or whose pixels' box differs from it.
 fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut MaskReport) {
@@ -174,17 +190,7 @@ fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut MaskReport
         for k in (0..17).filter(|k| r.keypoints[3 * k + 2] == 2.0) {
             let (x, y) = (r.keypoints[3 * k], r.keypoints[3 * k + 1]);
             report.keypoints += 1;
-            let on = (-1i32..=1).any(|dy| {
-                (-1i32..=1).any(|dx| {
-                    let (px, py) = ((x - 0.25).round() as i32 + dx, (y - 0.25).round() as i32 + dy);
-                    px >= 0
-                        && py >= 0
-                        && (px as usize) < w
-                        && (py as usize) < img.height
-                        && img.instance[py as usize * w + px as usize] == id
-                })
-            });
-            report.keypoints_on_body += usize::from(on);
+            report.keypoints_on_body += usize::from(near_pixel(img, x, y, |i| img.instance[i] == id));
         }
     }
 }
@@ -751,11 +757,8 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
             continue;
         };
         let img = observe::render_frame(&c.script, &c.trace, &c.rig, net, frame as u32);
-        let (w, id) = (img.width, pedestrian_instance(0));
-        let at = |k: usize| {
-            let (x, y) = (row.keypoints[3 * k] as usize, row.keypoints[3 * k + 1] as usize);
-            (x < w && y < img.height).then(|| y * w + x)
-        };
+        let id = pedestrian_instance(0);
+        let keypoint = |k: usize| (row.keypoints[3 * k], row.keypoints[3 * k + 1]);
         let hidden: Vec<usize> = (0..17).filter(|&k| row.keypoints[3 * k + 2] == 1.0).collect();
         assert!(
             row.occlusion > 0.0 && !hidden.is_empty(),
@@ -763,7 +766,10 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
         );
         let on_pole = hidden
             .iter()
-            .filter(|&&k| at(k).is_some_and(|i| img.semantic[i] == tag::POLE))
+            .filter(|&&k| {
+                let (x, y) = keypoint(k);
+                near_pixel(&img, x, y, |i| img.semantic[i] == tag::POLE)
+            })
             .count();
         assert!(
             on_pole * 2 >= hidden.len(),
@@ -771,11 +777,11 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
             hidden.len()
         );
         for k in (0..17).filter(|&k| row.keypoints[3 * k + 2] == 2.0) {
-            let i = at(k).expect("a visible keypoint is in the image");
-            let near_body = [0usize, 1, w - 1, w + 1, w, w.wrapping_neg(), 1usize.wrapping_neg()]
-                .iter()
-                .any(|&o| img.instance.get(i.wrapping_add(o)) == Some(&id));
-            assert!(near_body, "frame {frame}: visible keypoint {k} not on the pedestrian");
+            let (x, y) = keypoint(k);
+            assert!(
+                near_pixel(&img, x, y, |i| img.instance[i] == id),
+                "frame {frame}: visible keypoint {k} not on the pedestrian"
+            );
         }
         checked += 1;
         c.trace.pedestrians[0][frame] = saved;

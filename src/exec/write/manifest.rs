@@ -49,14 +49,7 @@ pub struct Manifest<C = Vec<ManifestClip>> {
 }
 
 impl<C: Serialize> Manifest<C> {
-    /// The manifest's JSON text (pretty, with a final newline).
-    pub fn to_json(&self) -> Result<String, Error> {
-        let mut text = crate::error::to_json(self, true)?;
-        text.push('\n');
-        Ok(text)
-    }
-
-    /// Writes the manifest's JSON text (as [`Manifest::to_json`]) to `out`.
+    /// Writes the manifest's JSON text (pretty, with a final newline) to `out`.
     pub fn write_json(&self, out: impl std::io::Write) -> Result<(), serde_json::Error> {
         let mut out = out;
         serde_json::to_writer_pretty(&mut out, self)?;
