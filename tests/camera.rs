@@ -686,6 +686,94 @@ fn sensor_files_are_identical_across_jobs_and_resumption_and_indexed() {
     std::fs::remove_dir_all(&tmp).ok();
 }
 
+/// `output.rgb_encoding: h264`: one MP4 per clip with a sample per frame, byte-identical across `--jobs` and
+/// a resumed run, indexed, decoding to the frames a PNG run of the same spec writes (PSNR), and odd image
+/// sizes refused by the spec check.
+#[test]
+fn h264_videos_hold_every_frame_deterministically_and_decode_to_the_png_frames() {
+    let tmp = std::env::temp_dir().join(format!("pedsynth-camera-h264-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    let rgb_only = [
+        "sensors.rgb.width_px=160",
+        "sensors.rgb.height_px=90",
+        "dataset.clip_duration_s=[3, 4]",
+        "sensors.depth.enabled=false",
+        "sensors.semantic.enabled=false",
+        "sensors.instance.enabled=false",
+        "sensors.dvs.enabled=false",
+        "sensors.lidar.enabled=false",
+    ];
+    let h264: Vec<&str> = rgb_only.iter().copied().chain(["output.rgb_encoding=h264"]).collect();
+    let a = common::generate_with_jobs_1_and_2(&spec("quickstart.yaml"), &h264, &tmp);
+    let png_dir = tmp.join("png");
+    generate(&rgb_only, &png_dir, 2);
+    let png = common::all_files(&png_dir);
+    let manifest: serde_json::Value = serde_json::from_slice(&a["manifest.json"]).expect("manifest");
+    assert!(manifest["sensors"]["rgb"].as_str().is_some_and(|s| s.contains(".mp4")));
+    let sensor_files: Vec<&String> = a.keys().filter(|k| k.starts_with("sensors/")).collect();
+    let clips = manifest["clips"].as_array().expect("clips");
+    assert_eq!(sensor_files.len(), clips.len(), "one file per clip: {sensor_files:?}");
+    let mut frames_checked = 0;
+    for clip in clips {
+        let id = clip["clip_id"].as_str().expect("id");
+        let mp4 = tmp.join(format!("one/sensors/rgb/{id}.mp4"));
+        let png_frames: Vec<&String> = png
+            .keys()
+            .filter(|k| k.starts_with(&format!("sensors/rgb/{id}/")))
+            .collect();
+        assert!(png_frames.len() > 60, "{id}: {} PNG frames", png_frames.len());
+        let wanted = (0..png_frames.len() as u32).collect();
+        let video = pedsynth::exec::write::video::read_frames(&mp4, &wanted).expect("decode");
+        assert_eq!(
+            video.sample_count as usize,
+            png_frames.len(),
+            "{id}: a sample per frame"
+        );
+        assert_eq!((video.width, video.height), (160, 90));
+        for (frame, rgb) in &video.frames {
+            let want = &png[&format!("sensors/rgb/{id}/{frame:06}.png")];
+            let mut reader = png::Decoder::new(std::io::Cursor::new(want.as_slice()))
+                .read_info()
+                .expect("png");
+            let mut buf = vec![0; reader.output_buffer_size().expect("size")];
+            reader.next_frame(&mut buf).expect("frame");
+            let mse = buf
+                .iter()
+                .zip(rgb)
+                .map(|(a, b)| (f64::from(*a) - f64::from(*b)).powi(2))
+                .sum::<f64>()
+                / buf.len() as f64;
+            let psnr = 10.0 * (255.0f64 * 255.0 / mse.max(1e-9)).log10();
+            assert!(psnr >= 30.0, "{id} frame {frame}: PSNR {psnr:.1} dB against the PNG");
+            frames_checked += 1;
+        }
+    }
+    assert!(frames_checked > 120);
+
+    // A clip interrupted while its video was being written: no completion marker, a temporary video left.
+    let one = tmp.join("one");
+    let clip0 = clips[0]["clip_id"].as_str().expect("id");
+    std::fs::remove_file(one.join(format!("tables/clips/{clip0}.parquet"))).expect("rm");
+    std::fs::remove_file(one.join(format!("sensors/rgb/{clip0}.mp4"))).expect("rm");
+    std::fs::write(one.join(format!("sensors/rgb/.{clip0}.mp4.tmp-99999")), b"half").expect("tmp");
+    generate(&h264, &one, 2);
+    assert!(
+        common::all_files(&one) == a,
+        "a resumed run differs from an uninterrupted one"
+    );
+
+    // 4:2:0 needs even sizes: an odd width is refused before anything is written, with the value located.
+    let odd: Vec<&str> = h264.iter().copied().chain(["sensors.rgb.width_px=161"]).collect();
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &odd, &tmp.join("odd"), Some(1));
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("must be even") && stderr.contains("sensors.rgb.width_px"),
+        "{stderr}"
+    );
+    assert!(!tmp.join("odd/manifest.json").exists());
+    std::fs::remove_dir_all(&tmp).ok();
+}
+
 #[test]
 fn static_scenes_give_no_dvs_events_and_motion_gives_some() {
     let c = clip(

@@ -110,8 +110,9 @@ impl Walker {
                     let dir = std::env::temp_dir().join(format!("pedsynth-keys-{}", std::process::id()));
                     let layout = pedsynth::exec::write::Layout::new(&dir);
                     let sensors = &plan.spec.sensors;
-                    let mut files = ClipSensorWriter::new(&layout, &script.clip_id, sensors, &plan.spec.output, &meta)
-                        .expect("sensor writer");
+                    let mut files =
+                        ClipSensorWriter::new(&layout, &script.clip_id, script.fps, sensors, &plan.spec.output, &meta)
+                            .expect("sensor writer");
                     let stat = StaticScene::build(script, &trace, net);
                     let _ = observe::render_cameras(&stat, script, &trace, sensors, &rig, |f| {
                         let last = f.frame >= 4;
@@ -265,6 +266,7 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         // Beyond 50 m the default 8 px width already rejects everyone: the height shows with a lower width.
         // The JPEG quality shows in JPEG files only.
         "output.jpeg_quality" => vec![("output.rgb_encoding", json!("jpeg"))],
+        "output.h264_qp" => vec![("output.rgb_encoding", json!("h264"))],
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }
@@ -328,7 +330,7 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
                 "body" => &["adult", "child", "adult_with_child"],
                 "pose_format" => &["coco17", "openpose18"],
                 "compression" => &["zstd", "snappy", "none"],
-                "rgb_encoding" => &["png", "jpeg"],
+                "rgb_encoding" => &["png", "jpeg", "h264"],
                 "depth_encoding" => &["mm_u16", "carla_rgb24"],
                 "format" => &["parquet", "carla_bin"],
                 "dvs_encoding" => &["parquet"],

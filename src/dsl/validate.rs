@@ -36,6 +36,16 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
         100.0,
         "a JPEG quality",
     );
+    v.num(
+        "output.h264_qp",
+        f64::from(spec.output.h264_qp),
+        0.0,
+        51.0,
+        "an H.264 quantiser (0 best, 51 smallest)",
+    );
+    if spec.output.rgb_encoding == RgbEncoding::H264 && spec.sensors.rgb.enabled {
+        v.h264_size(&spec.sensors.rgb);
+    }
     if !allow_large {
         v.limits(spec);
     }
@@ -160,6 +170,41 @@ impl Validator<'_> {
             )
             .at(self.span(path), format!("out of range (0, {}]", fmt_num(hi)))
             .help(format!("`{path}` is {what}"));
+            self.problems.push(problem);
+        }
+    }
+
+    /// H.264 video (4:2:0, OpenH264): an even width and height, at most 3840 × 2160 (or 2160 × 3840).
+    fn h264_size(&mut self, rgb: &Rgb) {
+        for (path, value) in [
+            ("sensors.rgb.width_px", rgb.width_px),
+            ("sensors.rgb.height_px", rgb.height_px),
+        ] {
+            if value % 2 != 0 {
+                let problem = Problem::new(
+                    code::OUT_OF_RANGE,
+                    format!("`{path}` must be even for `output.rgb_encoding: h264`, found {value}"),
+                )
+                .at(self.span(path), "odd")
+                .help(format!(
+                    "H.264 stores colour at half resolution (4:2:0): use {} or {}, or another rgb_encoding",
+                    value - 1,
+                    value + 1
+                ));
+                self.problems.push(problem);
+            }
+        }
+        let (long, short) = (rgb.width_px.max(rgb.height_px), rgb.width_px.min(rgb.height_px));
+        if long > 3840 || short > 2160 {
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!(
+                    "an H.264 video can be at most 3840 × 2160, found {} × {}",
+                    rgb.width_px, rgb.height_px
+                ),
+            )
+            .at(self.span("sensors.rgb.width_px"), "too large for H.264")
+            .help("OpenH264 encodes up to level 5.2: use png or jpeg for larger images");
             self.problems.push(problem);
         }
     }

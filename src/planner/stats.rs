@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::script::{Behaviour, CrosserSource, Plan, Role};
-use crate::dsl::types::Spec;
+use crate::dsl::types::{RgbEncoding, Spec};
 
 // Table-size constants measured on `specs/pedsynth_pp.yaml` (600 clips: 1,701,362 pedestrian-frames, 581,588
 // annotated samples; `du -sb out/tables/*`), zstd level 3.
@@ -31,6 +31,11 @@ pub const EVENT_BYTES_PER_PEDESTRIAN: f64 = 570.0;
 /// (BENCHMARKS.md, "Cameras": 364, 35, 18 and 12 kB per frame): RGB PNG (fast compression), depth (u16 PNG),
 /// semantic (indexed PNG), instance (u16 PNG).
 pub const RGB_PNG_BYTES_PER_PIXEL: f64 = 0.395;
+/// RGB as JPEG (`jpeg_quality` 90) and as H.264 (`h264_qp` 20), measured the same way (BENCHMARKS.md,
+/// "Cameras"); other qualities scale these roughly.
+pub const RGB_JPEG_BYTES_PER_PIXEL: f64 = 0.144;
+/// See [`RGB_JPEG_BYTES_PER_PIXEL`].
+pub const RGB_H264_BYTES_PER_PIXEL: f64 = 0.016;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
 pub const DEPTH_PNG_BYTES_PER_PIXEL: f64 = 0.038;
 /// See [`RGB_PNG_BYTES_PER_PIXEL`].
@@ -358,8 +363,13 @@ fn estimate_bytes(stats: &PlanStats, spec: &Spec, vehicle_frames: u64) -> SizeEs
     );
     let s = &spec.sensors;
     let pixels = f64::from(s.rgb.width_px) * f64::from(s.rgb.height_px);
+    let rgb_bytes_per_pixel = match spec.output.rgb_encoding {
+        RgbEncoding::Png => RGB_PNG_BYTES_PER_PIXEL,
+        RgbEncoding::Jpeg => RGB_JPEG_BYTES_PER_PIXEL,
+        RgbEncoding::H264 => RGB_H264_BYTES_PER_PIXEL,
+    };
     for (stream, on, bytes_per_pixel) in [
-        ("rgb", s.rgb.enabled, RGB_PNG_BYTES_PER_PIXEL),
+        ("rgb", s.rgb.enabled, rgb_bytes_per_pixel),
         ("depth", s.depth.enabled, DEPTH_PNG_BYTES_PER_PIXEL),
         ("semantic", s.semantic.enabled, SEMANTIC_PNG_BYTES_PER_PIXEL),
         ("instance", s.instance.enabled, INSTANCE_PNG_BYTES_PER_PIXEL),

@@ -128,6 +128,8 @@ pub struct Output {
     pub rgb_encoding: RgbEncoding,
     /// JPEG quality (1–100) when `rgb_encoding` is `jpeg`.
     pub jpeg_quality: u8,
+    /// H.264 quantiser (0–51, lower is better; constant for every frame) when `rgb_encoding` is `h264`.
+    pub h264_qp: u8,
     /// Encoding of depth images.
     pub depth_encoding: DepthEncoding,
     /// Encoding of DVS events.
@@ -141,6 +143,7 @@ impl Default for Output {
             zstd_level: 3,
             rgb_encoding: RgbEncoding::Png,
             jpeg_quality: 90,
+            h264_qp: 20,
             depth_encoding: DepthEncoding::MillimetresU16,
             dvs_encoding: DvsEncoding::Parquet,
         }
@@ -167,6 +170,9 @@ pub enum RgbEncoding {
     Png,
     /// One JPEG per frame (`jpeg_quality`, 4:2:0 chroma subsampling).
     Jpeg,
+    /// One H.264 video per clip in MP4 (`sensors/rgb/<clip_id>.mp4`, sample i = frame i; constant quantiser
+    /// `h264_qp`, 4:2:0 BT.601, an IDR frame every second). Needs an even width and height.
+    H264,
 }
 
 /// Depth image encodings (both lossless).

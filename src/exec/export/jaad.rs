@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::dataset::{Clip, ClipInfo, Dataset, EgoFrame};
 use super::pie::{Labels, Place, inside, occlusion_class, place_at, wrap_pi, xml_escape};
-use super::{LinkMode, link_frames, write_file};
+use super::{LinkMode, RgbFiles, link_frames, write_file};
 use crate::world::RoadNetwork;
 
 /// Where a clip went.
@@ -283,6 +283,7 @@ pub struct JaadReport {
     pub videos: usize,
     pub pedestrian_tracks: usize,
     pub images: usize,
+    pub videos_linked: usize,
     pub images_note: String,
 }
 
@@ -296,7 +297,7 @@ pub fn export(
     let videos = assign_videos(&ds.clips);
     let rgb = &ds.spec.sensors.rgb;
     let towns = super::towns(ds, warn);
-    let (png_images, images_note) = super::images_note(ds, link);
+    let (rgb_files, images_note) = super::images_note(ds, link);
     let mut report = JaadReport {
         videos: videos.len(),
         images_note,
@@ -309,8 +310,13 @@ pub fn export(
         let net = towns.get(&clip.town).map(|t| &t.network);
         report.pedestrian_tracks += write_video(out, clip, v, (rgb.width_px, rgb.height_px), net)?;
         splits.entry(v.split.as_str()).or_default().push(v.video.as_str());
-        if png_images {
-            report.images += link_frames(ds, clip, &out.join("images").join(&v.video), 5, link)?;
+        match rgb_files {
+            RgbFiles::Png => report.images += link_frames(ds, clip, &out.join("images").join(&v.video), 5, link)?,
+            RgbFiles::Mp4 => {
+                let to = out.join("JAAD_clips").join(format!("{}.mp4", v.video));
+                report.videos_linked += usize::from(super::link_video(ds, clip, &to, link)?);
+            }
+            RgbFiles::None => {}
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }

@@ -101,22 +101,60 @@ pub(crate) fn progress(clips: usize) -> crate::exec::generate::progress::Progres
     crate::exec::generate::progress::Progress::new(clips, !std::io::stderr().is_terminal())
 }
 
-/// Whether the dataset's RGB frames can be linked (PNG), and the line that says what happens to images.
-pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (bool, String) {
+/// What a dataset's RGB stream offers an export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum RgbFiles {
+    /// PNG frames: linked as the loaders' `images/`.
+    Png,
+    /// One H.264 MP4 per clip: linked as the datasets' own videos (`JAAD_clips/`, `PIE_clips/`), from which
+    /// their loaders' `extract_and_save_images()` extract the frames.
+    Mp4,
+    /// Nothing the loaders read (no RGB stream, or JPEG).
+    None,
+}
+
+/// What the dataset's RGB stream offers, and the line that says what happens to images.
+pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (RgbFiles, String) {
     let rgb = ds.manifest.sensors.get("rgb").map(String::as_str).unwrap_or("disabled");
     if rgb.starts_with("rendered") && rgb.ends_with(".png") {
-        (true, format!("images linked ({link}) from sensors/rgb"))
+        (RgbFiles::Png, format!("images linked ({link}) from sensors/rgb"))
+    } else if rgb.starts_with("rendered: sensors/rgb/<clip_id>.mp4") {
+        (
+            RgbFiles::Mp4,
+            format!(
+                "videos linked ({link}) from sensors/rgb (H.264 MP4): the loader's extract_and_save_images() \
+                 writes images/ from them"
+            ),
+        )
     } else if rgb.starts_with("rendered") {
         (
-            false,
-            "images absent: the RGB stream is not PNG (the loaders read .png); annotations only".to_owned(),
+            RgbFiles::None,
+            "images absent: the RGB stream is JPEG (the loaders read .png or .mp4); annotations only".to_owned(),
         )
     } else {
         (
-            false,
+            RgbFiles::None,
             "images absent: the dataset has no RGB stream; annotations only".to_owned(),
         )
     }
+}
+
+/// Links a clip's H.264 video to `to`; returns whether it was there.
+pub(crate) fn link_video(
+    ds: &dataset::Dataset,
+    clip: &dataset::Clip,
+    to: &Path,
+    link: LinkMode,
+) -> Result<bool, Error> {
+    let from = ds.layout.sensor_clip("rgb", &clip.clip_id, "mp4");
+    if !from.exists() {
+        return Ok(false);
+    }
+    if let Some(dir) = to.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::write(dir, e))?;
+    }
+    link_file(&from, to, link)?;
+    Ok(true)
 }
 
 /// Links a clip's RGB frames into `dir` as `<frame>.png` with `digits` digits; returns how many.
@@ -168,25 +206,28 @@ pub fn export(
         Format::Pie => {
             let r = pie::export(&ds, out, link, warn)?;
             format!(
-                "{}: PIE layout of {} clips: {} videos, {} pedestrian tracks, {} vehicle tracks, {} images\n{}\n",
+                "{}: PIE layout of {} clips: {} videos, {} pedestrian tracks, {} vehicle tracks, {} images, {} \
+                 MP4 videos\n{}\n",
                 out.display(),
                 ds.clips.len(),
                 r.videos,
                 r.pedestrian_tracks,
                 r.vehicle_tracks,
                 r.images,
+                r.videos_linked,
                 r.images_note
             )
         }
         Format::Jaad => {
             let r = jaad::export(&ds, out, link, warn)?;
             format!(
-                "{}: JAAD layout of {} clips: {} videos, {} pedestrian tracks, {} images\n{}\n",
+                "{}: JAAD layout of {} clips: {} videos, {} pedestrian tracks, {} images, {} MP4 videos\n{}\n",
                 out.display(),
                 ds.clips.len(),
                 r.videos,
                 r.pedestrian_tracks,
                 r.images,
+                r.videos_linked,
                 r.images_note
             )
         }

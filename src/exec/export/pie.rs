@@ -13,7 +13,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use super::dataset::{Clip, ClipInfo, Dataset, Pedestrian};
-use super::{LinkMode, link_frames, write_file};
+use super::{LinkMode, RgbFiles, link_frames, write_file};
 use crate::error::{Error, code};
 use crate::exec::observe::rig::Camera;
 use crate::world::{LaneType, RoadNetwork, TravelDirection};
@@ -481,6 +481,7 @@ pub struct PieReport {
     pub pedestrian_tracks: usize,
     pub vehicle_tracks: usize,
     pub images: usize,
+    pub videos_linked: usize,
     pub images_note: String,
 }
 
@@ -501,7 +502,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
         videos: videos.len(),
         ..PieReport::default()
     };
-    let (png_images, note) = super::images_note(ds, link);
+    let (rgb_files, note) = super::images_note(ds, link);
     report.images_note = note;
     let progress = super::progress(ds.clips.len());
     for (info, v) in ds.clips.iter().zip(&videos) {
@@ -510,8 +511,15 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
         let (peds, vehicles) = write_video(out, clip, v, &camera, net)?;
         report.pedestrian_tracks += peds;
         report.vehicle_tracks += vehicles;
-        if png_images {
-            report.images += link_frames(ds, clip, &out.join("images").join(&v.set).join(&v.video), 5, link)?;
+        match rgb_files {
+            RgbFiles::Png => {
+                report.images += link_frames(ds, clip, &out.join("images").join(&v.set).join(&v.video), 5, link)?;
+            }
+            RgbFiles::Mp4 => {
+                let to = out.join("PIE_clips").join(&v.set).join(format!("{}.mp4", v.video));
+                report.videos_linked += usize::from(super::link_video(ds, clip, &to, link)?);
+            }
+            RgbFiles::None => {}
         }
         progress.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }

@@ -132,7 +132,13 @@ pub struct SeedReport {
 
 /// Writes the seed's layout of `ds` into `out`.
 pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<SeedReport, Error> {
-    let (png_images, images_note) = super::images_note(ds, link);
+    let (rgb_files, mut images_note) = super::images_note(ds, link);
+    if rgb_files == super::RgbFiles::Mp4 {
+        images_note = "images absent: the RGB stream is H.264 video and the seed's layout holds PNG frames; \
+                       annotations only"
+            .to_owned();
+    }
+    let png_images = rgb_files == super::RgbFiles::Png;
     let mut report = SeedReport {
         clips: ds.clips.len(),
         images_note,

@@ -3,7 +3,7 @@
 //! crossing, green: not crossing), pedestrian ids and behaviour states, and the COCO-17 skeleton. Frames are
 //! shown at half resolution. Depth is shown near-bright/far-dark on a log scale, instance ids in hashed
 //! colours, semantic tags in CARLA's palette, and DVS events of a frame as red (brighter) and blue (darker)
-//! dots. The LiDAR is shown from above with the 3D boxes ([`super::lidar_view`]).
+//! dots (over the RGB frames, read from PNG files or decoded from the clip's H.264 MP4). The LiDAR is shown from above with the 3D boxes ([`super::lidar_view`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -15,6 +15,7 @@ use crate::error::{Error, code};
 use crate::exec::observe::scene::tag;
 use crate::exec::write::Layout;
 use crate::exec::write::sensors::png_bytes;
+use crate::exec::write::video::{DecodedFrames, read_frames};
 use crate::fsutil::write_atomically;
 use crate::mix::splitmix64;
 
@@ -169,12 +170,27 @@ fn frame_canvas(
     options: &PreviewOptions,
     frame: u32,
     events: &[(u32, u16, u16, bool)],
+    video: Option<&DecodedFrames>,
 ) -> Result<Canvas, Error> {
     let path = layout.sensor_frame(options.stream.dir(), &options.clip, frame, "png");
-    let (w, h, data, colour, depth) = if options.stream == Stream::Dvs && !path.is_file() {
+    let from_video = video.and_then(|v| v.frames.get(&frame).map(|rgb| (v, rgb)));
+    let (w, h, data, colour, depth) = if let Some((v, rgb)) = from_video {
+        (
+            v.width,
+            v.height,
+            rgb.clone(),
+            png::ColorType::Rgb,
+            png::BitDepth::Eight,
+        )
+    } else if video.is_some() {
         return Err(Error::new(
             code::DATASET_INVALID,
-            "the DVS preview draws events over the RGB frames, which this dataset does not have as PNG",
+            format!("the clip's video has no frame {frame}"),
+        ));
+    } else if options.stream == Stream::Dvs && !path.is_file() {
+        return Err(Error::new(
+            code::DATASET_INVALID,
+            "the DVS preview draws events over the RGB frames, which this dataset does not have as PNG or MP4",
         ));
     } else {
         decode_png(&path).map_err(|e| {
@@ -368,6 +384,14 @@ pub fn preview(dir: &Path, options: &PreviewOptions) -> Result<String, Error> {
     } else {
         None
     };
+    // RGB as H.264 video: the picked frames decoded once.
+    let mp4 = layout.sensor_clip("rgb", &options.clip, "mp4");
+    let video = if matches!(options.stream, Stream::Rgb | Stream::Dvs) && mp4.is_file() {
+        let wanted = if gif { &gif_picks } else { &sheet_picks };
+        Some(read_frames(&mp4, &wanted.iter().copied().collect())?)
+    } else {
+        None
+    };
     let empty = Vec::new();
     let render = |f: u32| -> Result<Canvas, Error> {
         let mut c = if let Some(l) = &lidar {
@@ -378,7 +402,7 @@ pub fn preview(dir: &Path, options: &PreviewOptions) -> Result<String, Error> {
                 px: l.view(f),
             }
         } else {
-            let mut c = frame_canvas(&layout, options, f, &events)?;
+            let mut c = frame_canvas(&layout, options, f, &events, video.as_ref())?;
             draw_labels(&mut c, labels.get(&f).unwrap_or(&empty));
             c
         };

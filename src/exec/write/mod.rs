@@ -19,6 +19,7 @@ pub mod lidar;
 pub mod manifest;
 pub mod sensors;
 pub mod tables;
+pub mod video;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -173,6 +174,7 @@ impl DatasetWriter {
         sensors::ClipSensorWriter::new(
             &self.layout,
             &script.clip_id,
+            script.fps,
             &plan.spec.sensors,
             &plan.spec.output,
             &self.meta,
@@ -284,6 +286,10 @@ fn sensor_status(plan: &Plan) -> BTreeMap<String, String> {
         crate::dsl::types::RgbEncoding::Jpeg => format!(
             "rendered: sensors/rgb/<clip_id>/<frame:06>.jpg (quality {})",
             o.jpeg_quality
+        ),
+        crate::dsl::types::RgbEncoding::H264 => format!(
+            "rendered: sensors/rgb/<clip_id>.mp4 (H.264, QP {}, sample i = frame i)",
+            o.h264_qp
         ),
     };
     let depth = match o.depth_encoding {

@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! sensors/rgb/<clip_id>/<frame:06>.png|jpg     sRGB 8-bit (PNG fast compression, or JPEG)
+//! sensors/rgb/<clip_id>.mp4                    or H.264 video, sample i = frame i (see super::video)
 //! sensors/depth/<clip_id>/<frame:06>.png       u16 millimetres (grey 16-bit), or CARLA's 24-bit RGB
 //! sensors/semantic/<clip_id>/<frame:06>.png    CARLA tag ids as an indexed PNG whose palette is CARLA's
 //! sensors/instance/<clip_id>/<frame:06>.png    u16 instance ids (grey 16-bit; see scene::CHILD_INSTANCE_BASE)
@@ -74,6 +75,8 @@ pub struct ClipSensorWriter<'a> {
     output: &'a Output,
     rows: Vec<IndexRow>,
     dvs: Option<ArrowWriter<Vec<u8>>>,
+    video: Option<super::video::ClipVideo>,
+    fps: u32,
     scratch: Vec<u8>,
 }
 
@@ -161,10 +164,11 @@ pub fn depth_mm(depth_m: f32) -> u16 {
 }
 
 impl<'a> ClipSensorWriter<'a> {
-    /// A writer for one clip; `meta` goes into its Parquet file's metadata.
+    /// A writer for one clip of `fps` frames per second; `meta` goes into its Parquet file's metadata.
     pub fn new(
         layout: &'a Layout,
         clip_id: &'a str,
+        fps: u32,
         sensors: &'a Sensors,
         output: &'a Output,
         meta: &FileMeta,
@@ -185,25 +189,42 @@ impl<'a> ClipSensorWriter<'a> {
             output,
             rows: Vec::new(),
             dvs,
+            video: None,
+            fps,
             scratch: Vec::new(),
         })
     }
 
-    fn put(&mut self, stream: &'static str, frame: Option<(u32, i64)>, ext: &str, bytes: &[u8]) -> Result<(), Error> {
-        let path = match frame {
+    fn path(&self, stream: &'static str, frame: Option<(u32, i64)>, ext: &str) -> std::path::PathBuf {
+        match frame {
             Some((f, _)) => self.layout.sensor_frame(stream, self.clip_id, f, ext),
             None => self.layout.sensor_clip(stream, self.clip_id, ext),
-        };
+        }
+    }
+
+    fn put(&mut self, stream: &'static str, frame: Option<(u32, i64)>, ext: &str, bytes: &[u8]) -> Result<(), Error> {
+        let path = self.path(stream, frame, ext);
         write_atomically_unsynced(&path, bytes).map_err(|e| Error::write(&path, e))?;
+        self.index(stream, frame, &path, bytes.len() as u64, &Sha256::digest(bytes));
+        Ok(())
+    }
+
+    fn index(
+        &mut self,
+        stream: &'static str,
+        frame: Option<(u32, i64)>,
+        path: &std::path::Path,
+        bytes: u64,
+        sha: &[u8],
+    ) {
         self.rows.push(IndexRow {
             frame: frame.map(|f| f.0),
             timestamp_ns: frame.map(|f| f.1),
             stream,
-            path: self.layout.relative(&path),
-            bytes: bytes.len() as u64,
-            sha256: hex(&Sha256::digest(bytes)),
+            path: self.layout.relative(path),
+            bytes,
+            sha256: hex(sha),
         });
-        Ok(())
     }
 
     /// Encodes and writes the enabled streams of one frame.
@@ -222,6 +243,21 @@ impl<'a> ClipSensorWriter<'a> {
                             Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}"))
                         })?;
                     self.put("rgb", at, "jpg", &out)?;
+                }
+                RgbEncoding::H264 => {
+                    if self.video.is_none() {
+                        let path = self.path("rgb", None, "mp4");
+                        self.video = Some(super::video::ClipVideo::create(
+                            &path,
+                            w,
+                            h,
+                            self.fps,
+                            self.output.h264_qp,
+                        )?);
+                    }
+                    if let Some(video) = self.video.as_mut() {
+                        video.push(&img.rgb)?;
+                    }
                 }
             }
         }
@@ -273,8 +309,14 @@ impl<'a> ClipSensorWriter<'a> {
         Ok(())
     }
 
-    /// Writes the per-clip files (DVS events) and returns the index rows, sorted by (frame, stream).
+    /// Writes the per-clip files (DVS events, the H.264 video) and returns the index rows, sorted by (frame,
+    /// stream).
     pub fn finish(mut self) -> Result<Vec<IndexRow>, Error> {
+        if let Some(video) = self.video.take() {
+            let path = self.path("rgb", None, "mp4");
+            let (bytes, sha) = video.finish()?;
+            self.index("rgb", None, &path, bytes, &sha);
+        }
         if let Some(dvs) = self.dvs.take() {
             let bytes = dvs
                 .into_inner()
