@@ -737,13 +737,7 @@ fn h264_videos_hold_every_frame_deterministically_and_decode_to_the_png_frames()
                 .expect("png");
             let mut buf = vec![0; reader.output_buffer_size().expect("size")];
             reader.next_frame(&mut buf).expect("frame");
-            let mse = buf
-                .iter()
-                .zip(rgb)
-                .map(|(a, b)| (f64::from(*a) - f64::from(*b)).powi(2))
-                .sum::<f64>()
-                / buf.len() as f64;
-            let psnr = 10.0 * (255.0f64 * 255.0 / mse.max(1e-9)).log10();
+            let psnr = psnr(&buf, rgb);
             assert!(psnr >= 30.0, "{id} frame {frame}: PSNR {psnr:.1} dB against the PNG");
             frames_checked += 1;
         }

@@ -460,9 +460,8 @@ mod tests {
                 .iter()
                 .zip(rgb)
                 .map(|(a, b)| (f64::from(*a) - f64::from(*b)).powi(2))
-                .sum::<f64>()
-                / src.len() as f64;
-            let psnr = 10.0 * (255.0f64 * 255.0 / mse.max(1e-9)).log10();
+                .sum::<f64>();
+            let psnr = 10.0 * (255.0f64 * 255.0 * src.len() as f64 / mse.max(1e-9)).log10();
             assert!(psnr > 35.0, "frame {k}: PSNR {psnr:.1} dB");
         }
         // An unfinished video leaves nothing.
