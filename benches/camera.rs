@@ -33,14 +33,18 @@ fn render_rgb_frame(bencher: divan::Bencher, weather: &str) {
     let (pos, yaw) = ego_at(&s.trace, t);
     let pose = s.rig.camera.at(pos, yaw);
     let mut img = CameraImages::default();
+    // One core: the renderer resolves bands of rows on the current rayon pool.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     bencher.bench_local(|| {
-        renderer.render(
-            &s.scene,
-            &frame,
-            &pose,
-            streak_seed(s.script.seed, s.frame, 0),
-            &mut img,
-        );
+        pool.install(|| {
+            renderer.render(
+                &s.scene,
+                &frame,
+                &pose,
+                streak_seed(s.script.seed, s.frame, 0),
+                &mut img,
+            )
+        });
     });
 }
 

@@ -52,19 +52,30 @@ pub fn run_clip(
     let mut sensor_rows = Vec::new();
     if sensors.cameras_enabled() || sensors.lidar.enabled {
         let stat = observe::scene::StaticScene::build(script, &trace, &town.network);
-        if sensors.cameras_enabled() {
-            let mut files = out.clip_sensors(plan, script)?;
-            observe::render_cameras(&stat, script, &trace, sensors, rig, |frame| {
-                images += 1;
-                files.frame(frame)
-            })?;
-            sensor_rows.extend(files.finish()?);
-        }
-        if sensors.lidar.enabled {
-            let mut files = out.clip_lidar(plan, script)?;
-            observe::scan_lidar(&stat, script, &trace, &sensors.lidar, rig, |tick| files.tick(tick))?;
-            sensor_rows.extend(files.finish()?);
-        }
+        // Cameras and LiDAR write disjoint files: side by side on the rayon pool (an idle worker takes one).
+        let (cameras, lidar) = rayon::join(
+            || -> Result<Vec<write::sensors::IndexRow>, Error> {
+                if !sensors.cameras_enabled() {
+                    return Ok(Vec::new());
+                }
+                let mut files = out.clip_sensors(plan, script)?;
+                observe::render_cameras(&stat, script, &trace, sensors, rig, |frame| {
+                    images += 1;
+                    files.frame(frame)
+                })?;
+                files.finish()
+            },
+            || -> Result<Vec<write::sensors::IndexRow>, Error> {
+                if !sensors.lidar.enabled {
+                    return Ok(Vec::new());
+                }
+                let mut files = out.clip_lidar(plan, script)?;
+                observe::scan_lidar(&stat, script, &trace, &sensors.lidar, rig, |tick| files.tick(tick))?;
+                files.finish()
+            },
+        );
+        sensor_rows.extend(cameras?);
+        sensor_rows.extend(lidar?);
         write::sensors::sort_index(&mut sensor_rows);
     }
     out.write_clip(plan, script, &trace, &observations, rig, &sensor_rows)?;

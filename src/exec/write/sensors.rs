@@ -26,6 +26,7 @@ use arrow_array::{
 };
 use arrow_schema::{DataType, Field, Schema, SchemaRef};
 use parquet::arrow::ArrowWriter;
+use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::Layout;
@@ -77,7 +78,6 @@ pub struct ClipSensorWriter<'a> {
     dvs: Option<ArrowWriter<Vec<u8>>>,
     video: Option<super::video::ClipVideo>,
     fps: u32,
-    scratch: Vec<u8>,
 }
 
 impl std::fmt::Debug for ClipSensorWriter<'_> {
@@ -163,6 +163,70 @@ pub fn depth_mm(depth_m: f32) -> u16 {
     (f64::from(depth_m) * 1000.0).round().clamp(0.0, 65535.0) as u16
 }
 
+/// 16-bit samples as the big-endian bytes a 16-bit PNG holds.
+fn be_bytes(samples: impl Iterator<Item = u16>, len: usize) -> Vec<u8> {
+    let mut raw = vec![0u8; len * 2];
+    for (out, v) in raw.chunks_exact_mut(2).zip(samples) {
+        out.copy_from_slice(&v.to_be_bytes());
+    }
+    raw
+}
+
+/// A stream written as one image file per frame.
+#[derive(Clone, Copy, Debug)]
+enum Still {
+    Rgb,
+    Depth,
+    Semantic,
+    Instance,
+}
+
+impl Still {
+    /// Stream name and file extension.
+    fn file(self) -> (&'static str, &'static str) {
+        match self {
+            Still::Rgb => ("rgb", "png"),
+            Still::Depth => ("depth", "png"),
+            Still::Semantic => ("semantic", "png"),
+            Still::Instance => ("instance", "png"),
+        }
+    }
+
+    /// The file's bytes for a frame.
+    fn encode(self, img: &CameraImages, output: &Output) -> Result<Vec<u8>, Error> {
+        let (w, h) = (img.width, img.height);
+        match self {
+            Still::Rgb => match output.rgb_encoding {
+                RgbEncoding::Jpeg => {
+                    let mut out = Vec::new();
+                    jpeg_encoder::Encoder::new(&mut out, output.jpeg_quality.clamp(1, 100))
+                        .encode(&img.rgb, w as u16, h as u16, jpeg_encoder::ColorType::Rgb)
+                        .map_err(|e| {
+                            Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}"))
+                        })?;
+                    Ok(out)
+                }
+                RgbEncoding::Png | RgbEncoding::H264 => rgb_png(img),
+            },
+            Still::Depth => match output.depth_encoding {
+                DepthEncoding::MillimetresU16 => {
+                    let raw = be_bytes(img.depth_m.iter().map(|d| depth_mm(*d)), img.depth_m.len());
+                    png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &raw, None)
+                }
+                DepthEncoding::CarlaRgb24 => {
+                    let raw: Vec<u8> = img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)).collect();
+                    png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &raw, None)
+                }
+            },
+            Still::Semantic => semantic_png(img),
+            Still::Instance => {
+                let raw = be_bytes(img.instance.iter().copied(), img.instance.len());
+                png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &raw, None)
+            }
+        }
+    }
+}
+
 impl<'a> ClipSensorWriter<'a> {
     /// A writer for one clip of `fps` frames per second; `meta` goes into its Parquet file's metadata.
     pub fn new(
@@ -191,7 +255,6 @@ impl<'a> ClipSensorWriter<'a> {
             dvs,
             video: None,
             fps,
-            scratch: Vec::new(),
         })
     }
 
@@ -227,78 +290,49 @@ impl<'a> ClipSensorWriter<'a> {
         });
     }
 
-    /// Encodes and writes the enabled streams of one frame.
+    /// Encodes and writes the enabled streams of one frame. The images of a frame are encoded in parallel on
+    /// the current rayon pool (and beside the clip's video), then written and indexed in a fixed order.
     pub fn frame(&mut self, f: SensorFrame) -> Result<(), Error> {
         let img: &CameraImages = f.images;
-        let (w, h) = (img.width, img.height);
         let at = Some((f.frame, f.timestamp_ns));
-        if self.sensors.rgb.enabled {
-            match self.output.rgb_encoding {
-                RgbEncoding::Png => self.put("rgb", at, "png", &rgb_png(img)?)?,
-                RgbEncoding::Jpeg => {
-                    let mut out = Vec::new();
-                    jpeg_encoder::Encoder::new(&mut out, self.output.jpeg_quality.clamp(1, 100))
-                        .encode(&img.rgb, w as u16, h as u16, jpeg_encoder::ColorType::Rgb)
-                        .map_err(|e| {
-                            Error::new(code::INTERNAL_SERIALIZE, format!("cannot encode a JPEG image: {e}"))
-                        })?;
-                    self.put("rgb", at, "jpg", &out)?;
-                }
-                RgbEncoding::H264 => {
-                    if self.video.is_none() {
-                        let path = self.path("rgb", None, "mp4");
-                        self.video = Some(super::video::ClipVideo::create(
-                            &path,
-                            w,
-                            h,
-                            self.fps,
-                            self.output.h264_qp,
-                        )?);
-                    }
-                    if let Some(video) = self.video.as_mut() {
-                        video.push(&img.rgb)?;
-                    }
-                }
-            }
+        let (sensors, output) = (self.sensors, self.output);
+        let mut stills: Vec<Still> = Vec::with_capacity(4);
+        if sensors.rgb.enabled && output.rgb_encoding != RgbEncoding::H264 {
+            stills.push(Still::Rgb);
         }
-        if self.sensors.depth.enabled {
-            self.scratch.clear();
-            let bytes = match self.output.depth_encoding {
-                DepthEncoding::MillimetresU16 => {
-                    self.scratch
-                        .extend(img.depth_m.iter().flat_map(|d| depth_mm(*d).to_be_bytes()));
-                    png_bytes(
-                        w,
-                        h,
-                        png::ColorType::Grayscale,
-                        png::BitDepth::Sixteen,
-                        &self.scratch,
-                        None,
-                    )?
-                }
-                DepthEncoding::CarlaRgb24 => {
-                    self.scratch
-                        .extend(img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)));
-                    png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &self.scratch, None)?
-                }
-            };
-            self.put("depth", at, "png", &bytes)?;
+        if sensors.depth.enabled {
+            stills.push(Still::Depth);
         }
-        if self.sensors.semantic.enabled {
-            self.put("semantic", at, "png", &semantic_png(img)?)?;
+        if sensors.semantic.enabled {
+            stills.push(Still::Semantic);
         }
-        if self.sensors.instance.enabled {
-            self.scratch.clear();
-            self.scratch.extend(img.instance.iter().flat_map(|i| i.to_be_bytes()));
-            let bytes = png_bytes(
-                w,
-                h,
-                png::ColorType::Grayscale,
-                png::BitDepth::Sixteen,
-                &self.scratch,
-                None,
-            )?;
-            self.put("instance", at, "png", &bytes)?;
+        if sensors.instance.enabled {
+            stills.push(Still::Instance);
+        }
+        if sensors.rgb.enabled && output.rgb_encoding == RgbEncoding::H264 && self.video.is_none() {
+            let path = self.path("rgb", None, "mp4");
+            self.video = Some(super::video::ClipVideo::create(
+                &path,
+                img.width,
+                img.height,
+                self.fps,
+                output.h264_qp,
+            )?);
+        }
+        let video = self.video.as_mut();
+        let (pushed, encoded) = rayon::join(
+            || video.map_or(Ok(()), |v| v.push(&img.rgb)),
+            || {
+                stills
+                    .par_iter()
+                    .map(|&still| still.encode(img, output).map(|bytes| (still, bytes)))
+                    .collect::<Result<Vec<_>, Error>>()
+            },
+        );
+        pushed?;
+        for (still, bytes) in encoded? {
+            let (stream, ext) = still.file();
+            self.put(stream, at, ext, &bytes)?;
         }
         if let Some(dvs) = self.dvs.as_mut()
             && !f.events.is_empty()

@@ -18,6 +18,7 @@
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
+use rayon::prelude::*;
 
 use crate::dsl::types::Dvs;
 
@@ -77,9 +78,16 @@ impl Esim {
     /// Feeds the image taken at `now_ns` (RGB, 3 bytes per pixel) and appends its events to `events`, sorted by
     /// time; `noise_seed` seeds the threshold noise of this image.
     pub fn step(&mut self, rgb: &[u8], now_ns: i64, noise_seed: u64, events: &mut Vec<Event>) {
-        for (l, px) in self.current.iter_mut().zip(rgb.chunks_exact(3)) {
-            *l = log_intensity(&self.params, [px[0], px[1], px[2]]);
-        }
+        // Per pixel, so rows in parallel on the rayon pool give the same values.
+        let (params, w) = (&self.params, self.width.max(1));
+        self.current
+            .par_chunks_mut(w * 16)
+            .zip(rgb.par_chunks(w * 16 * 3))
+            .for_each(|(ls, pxs)| {
+                for (l, px) in ls.iter_mut().zip(pxs.chunks_exact(3)) {
+                    *l = log_intensity(params, [px[0], px[1], px[2]]);
+                }
+            });
         self.step_values(now_ns, noise_seed, events);
     }
 

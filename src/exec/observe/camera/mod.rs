@@ -20,6 +20,7 @@ pub mod shade;
 use glam::{DAffine3, DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use super::rig::{Camera, CameraPose};
 use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
@@ -57,6 +58,18 @@ pub struct CameraImages {
     pub instance: Vec<u16>,
 }
 
+/// Rows of the images resolved as one task.
+const BAND_ROWS: usize = 16;
+
+/// Rows `y0..` of the images (as many as the slices hold).
+struct Band<'a> {
+    y0: usize,
+    rgb: &'a mut [u8],
+    depth_m: &'a mut [f32],
+    semantic: &'a mut [u8],
+    instance: &'a mut [u16],
+}
+
 /// The orthographic sun camera of the shadow map.
 #[derive(Clone, Copy, Debug)]
 struct SunView {
@@ -90,7 +103,7 @@ pub struct Renderer {
     lights: ActiveLights,
     /// Scratch of [`nearest`]: (squared distance, index), reused from frame to frame.
     nearby: Vec<(f32, u32)>,
-    lut: Vec<u8>,
+    lut: Box<[u8; LUT_LEN]>,
 }
 
 /// The (up to) `n` items nearest to `from` within `radius_m`, nearest first (ties by index), into `out`.
@@ -111,20 +124,18 @@ fn nearest<T>(items: &[T], pos: impl Fn(&T) -> Vec3, from: Vec3, radius_m: f32, 
 const LUT_LEN: usize = 4096;
 const LUT_MAX: f32 = 8.0;
 
-fn build_lut() -> Vec<u8> {
-    (0..LUT_LEN)
-        .map(|i| {
-            let s = i as f32 / (LUT_LEN - 1) as f32;
-            let x = s * s * LUT_MAX;
-            let mapped = 1.0 - (-1.1 * x).exp();
-            let srgb = if mapped <= 0.003_130_8 {
-                12.92 * mapped
-            } else {
-                1.055 * mapped.powf(1.0 / 2.4) - 0.055
-            };
-            (srgb * 255.0 + 0.5).clamp(0.0, 255.0) as u8
-        })
-        .collect()
+fn build_lut() -> Box<[u8; LUT_LEN]> {
+    Box::new(std::array::from_fn(|i| {
+        let s = i as f32 / (LUT_LEN - 1) as f32;
+        let x = s * s * LUT_MAX;
+        let mapped = 1.0 - (-1.1 * x).exp();
+        let srgb = if mapped <= 0.003_130_8 {
+            12.92 * mapped
+        } else {
+            1.055 * mapped.powf(1.0 / 2.4) - 0.055
+        };
+        (srgb * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+    }))
 }
 
 impl Renderer {
@@ -271,7 +282,7 @@ impl Renderer {
         let Some(sun) = &self.sun else { return 1.0 };
         let q = sun.project(p + normal * 0.05);
         let (x, y) = (q.x as f32 - 0.5, q.y as f32 - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (shade::floor_f32(x), shade::floor_f32(y));
         if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
             return 1.0;
         }
@@ -308,9 +319,34 @@ impl Renderer {
             .extend(self.nearby.iter().map(|&(_, i)| frame.head_lamps[i as usize]));
     }
 
+    /// Resolves the visibility buffer into the images, in bands of rows on the current rayon pool (each pixel
+    /// is a pure function of the buffers, so the bytes do not depend on how the bands are spread).
     fn resolve(&self, scene: &StaticScene, frame: &FrameScene, pose: &CameraPose, cam: Vec3, out: &mut CameraImages) {
+        let w = self.camera.width_px as usize;
+        let rows = BAND_ROWS;
+        out.rgb
+            .par_chunks_mut(w * 3 * rows)
+            .zip(out.depth_m.par_chunks_mut(w * rows))
+            .zip(out.semantic.par_chunks_mut(w * rows))
+            .zip(out.instance.par_chunks_mut(w * rows))
+            .enumerate()
+            .for_each(|(band, (((rgb, depth_m), semantic), instance))| {
+                let band = Band {
+                    y0: band * rows,
+                    rgb,
+                    depth_m,
+                    semantic,
+                    instance,
+                };
+                self.resolve_band(scene, frame, pose, cam, band);
+            });
+    }
+
+    fn resolve_band(&self, scene: &StaticScene, frame: &FrameScene, pose: &CameraPose, cam: Vec3, out: Band) {
         let c = &self.camera;
-        let (w, h) = (c.width_px as usize, c.height_px as usize);
+        let w = c.width_px as usize;
+        let y0 = out.y0;
+        let h = out.depth_m.len() / w;
         let (f, cx, cy) = (c.focal_px as f32, c.width_px as f32 * 0.5, c.height_px as f32 * 0.5);
         let (right, down, fwd) = (pose.right.as_vec3(), pose.down.as_vec3(), pose.forward.as_vec3());
         let ctx = ShadeContext {
@@ -342,14 +378,15 @@ impl Renderer {
             };
             shade::fog(&self.light, shade::surface(&ctx, prim, p, view, shadow), dist)
         };
-        for y in 0..h {
+        for row in 0..h {
+            let y = y0 + row;
             for x in 0..w {
                 let s0 = (y * SS) * sw + x * SS;
                 let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
                 let prims = ids.map(|i| self.vis.prim[i]);
                 let keys = ids.map(|i| self.vis.key[i]);
                 // Labels: the first sample.
-                let o = y * w + x;
+                let o = row * w + x;
                 let (u0, v0) = (x as f32 + 0.5 * inv_ss, y as f32 + 0.5 * inv_ss);
                 if prims[0] == EMPTY {
                     out.depth_m[o] = SKY_DEPTH_M;
@@ -385,7 +422,8 @@ impl Renderer {
                 let px = &mut out.rgb[o * 3..o * 3 + 3];
                 for (ch, value) in px.iter_mut().zip(colour.to_array()) {
                     let s = (value.max(0.0) * (1.0 / LUT_MAX)).min(1.0).sqrt();
-                    *ch = self.lut[(s * (LUT_LEN - 1) as f32) as usize];
+                    // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
+                    *ch = self.lut[(s * (LUT_LEN - 1) as f32) as i32 as usize & (LUT_LEN - 1)];
                 }
             }
         }
@@ -410,7 +448,8 @@ impl Renderer {
                 if y < 0.0 || y >= h || x < 0.0 || x >= w - 1.0 {
                     continue;
                 }
-                let (xi, fx) = (x.floor() as usize, x - x.floor());
+                let xf = shade::floor_f32(x);
+                let (xi, fx) = (xf as usize, x - xf);
                 let row = y as usize * out.width;
                 for (dx, cov) in [(0usize, 1.0 - fx), (1, fx)] {
                     let o = (row + xi + dx) * 3;

@@ -8,7 +8,7 @@
 //! edges, so triangles that share an edge leave no gap; the depth test then picks one. Setup is in `f64`
 //! (large coordinates after near-plane clipping), the per-sample loop in `f32`, allocation-free.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 
 /// A visibility buffer.
 #[derive(Clone, Debug)]
@@ -105,13 +105,47 @@ impl Raster {
             let kxf = kx as f32;
             let keys = &mut self.key[base + x0..=base + x1 as usize];
             let prims = &mut self.prim[base + x0..=base + x1 as usize];
-            for (i, (key, p)) in keys.iter_mut().zip(prims.iter_mut()).enumerate() {
-                let k = k_row + kxf * (x0 + i) as f32;
-                if k > *key {
-                    *key = k;
-                    *p = prim;
-                }
-            }
+            depth_test_span(keys, prims, k_row, kxf, x0 as f32, prim);
+        }
+    }
+}
+
+/// The depth test along a span of samples whose keys are `k_row + kx · (x0 + i)`: where the key is
+/// greater, it and `prim` replace the buffer's. Four samples at a time with SIMD selects (glam's `Vec4`;
+/// primitive ids travel as the bit patterns of `f32` lanes, which moves and bitwise selects keep exactly).
+#[inline]
+fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0: f32, prim: u32) {
+    let n = keys.len().min(prims.len());
+    let (keys, prims) = (&mut keys[..n], &mut prims[..n]);
+    let whole = n / 4 * 4;
+    let lane = Vec4::new(0.0, 1.0, 2.0, 3.0);
+    let prim_bits = Vec4::splat(f32::from_bits(prim));
+    for (start, (kk, pp)) in keys[..whole]
+        .chunks_exact_mut(4)
+        .zip(prims[..whole].chunks_exact_mut(4))
+        .enumerate()
+        .map(|(c, chunk)| (c * 4, chunk))
+    {
+        let k = Vec4::splat(k_row) + Vec4::splat(kx) * (Vec4::splat(x0 + start as f32) + lane);
+        let old_k = Vec4::from_slice(kk);
+        let nearer = k.cmpgt(old_k);
+        Vec4::select(nearer, k, old_k).write_to_slice(kk);
+        let old_p = Vec4::new(
+            f32::from_bits(pp[0]),
+            f32::from_bits(pp[1]),
+            f32::from_bits(pp[2]),
+            f32::from_bits(pp[3]),
+        );
+        let new_p = Vec4::select(nearer, prim_bits, old_p).to_array();
+        for (p, v) in pp.iter_mut().zip(new_p) {
+            *p = v.to_bits();
+        }
+    }
+    for i in whole..n {
+        let k = k_row + kx * (x0 + i as f32);
+        if k > keys[i] {
+            keys[i] = k;
+            prims[i] = prim;
         }
     }
 }
@@ -200,6 +234,32 @@ mod tests {
             3,
         );
         assert!((r.key[3] - 3.5).abs() < 1e-5, "{}", r.key[3]);
+    }
+
+    #[test]
+    fn the_simd_depth_test_equals_the_scalar_one() {
+        // Spans of every length 0..=13 over keys with ties, NaN-pattern ids (EMPTY) and sloped keys.
+        for n in 0..=13usize {
+            for (k_row, kx) in [(0.5f32, 0.0f32), (0.2, 0.05), (0.9, -0.07), (0.45, 1.0e-3)] {
+                let keys: Vec<f32> = (0..n).map(|i| [0.0, 0.5, 0.3, 0.7, 0.45][i % 5]).collect();
+                let prims: Vec<u32> = (0..n).map(|i| if i % 3 == 0 { EMPTY } else { i as u32 * 7 }).collect();
+                let (mut k1, mut p1) = (keys.clone(), prims.clone());
+                depth_test_span(&mut k1, &mut p1, k_row, kx, 3.0, 42);
+                let (mut k2, mut p2) = (keys.clone(), prims.clone());
+                for i in 0..n {
+                    let k = k_row + kx * (3.0 + i as f32);
+                    if k > k2[i] {
+                        k2[i] = k;
+                        p2[i] = 42;
+                    }
+                }
+                assert_eq!(p1, p2, "n {n} k_row {k_row} kx {kx}");
+                assert_eq!(
+                    k1.iter().map(|k| k.to_bits()).collect::<Vec<_>>(),
+                    k2.iter().map(|k| k.to_bits()).collect::<Vec<_>>()
+                );
+            }
+        }
     }
 
     #[test]

@@ -9,6 +9,26 @@ use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use crate::exec::observe::scene::{FrameScene, Material, Prim, StaticScene, road_paint, tag};
 use crate::mix::splitmix64;
 
+/// `x.floor()` without the call into libm that `f32::floor` compiles to on x86-64 without SSE4.1 (a hot
+/// spot of texture lookups); the same value for every finite `x` and NaN (only `−0.0` becomes `+0.0`).
+#[inline(always)]
+pub fn floor_f32(x: f32) -> f32 {
+    // Every float of magnitude 2^23 or more is an integer already.
+    if x.abs() < 8_388_608.0 {
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    } else {
+        x
+    }
+}
+
+/// `x.floor()` as an integer, for `|x| < 2^31` (texture coordinates; NaN gives 0).
+#[inline(always)]
+pub fn floor_i32(x: f32) -> i32 {
+    let t = x as i32;
+    t - i32::from(t as f32 > x)
+}
+
 /// A seeded tileable value-noise table, sampled bilinearly (values in [−1, 1]).
 #[derive(Clone, Debug)]
 pub struct Noise {
@@ -27,12 +47,12 @@ impl Noise {
     }
 
     /// Bilinear sample at `p` (one cell per unit).
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, p: Vec2) -> f32 {
-        let (fx, fy) = (p.x.floor(), p.y.floor());
-        let (tx, ty) = (p.x - fx, p.y - fy);
+        let (ix, iy) = (floor_i32(p.x), floor_i32(p.y));
+        let (tx, ty) = (p.x - ix as f32, p.y - iy as f32);
         let m = NOISE_SIZE - 1;
-        let (x0, y0) = ((fx as i64 as usize) & m, (fy as i64 as usize) & m);
+        let (x0, y0) = ((ix as usize) & m, (iy as usize) & m);
         let (x1, y1) = ((x0 + 1) & m, (y0 + 1) & m);
         let v = |x: usize, y: usize| self.values[y * NOISE_SIZE + x];
         let a = v(x0, y0) + (v(x1, y0) - v(x0, y0)) * tx;
@@ -98,8 +118,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
             ground = true;
             if prim.tag == tag::SIDEWALK {
                 let g = xy / 0.6;
-                let f = g - g.floor();
-                let tile = 0.88 + 0.2 * nz.cell(g.x.floor() as i32, g.y.floor() as i32, 7);
+                let cell = Vec2::new(floor_f32(g.x), floor_f32(g.y));
+                let f = g - cell;
+                let tile = 0.88 + 0.2 * nz.cell(cell.x as i32, cell.y as i32, 7);
                 albedo *= if f.x < 0.05 || f.y < 0.05 { 0.62 } else { tile };
             }
             albedo *= 1.0 + 0.08 * nz.sample(xy * 3.7);
@@ -118,9 +139,10 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
             let along_dir = Vec2::new(-normal.y, normal.x);
             let a = xy.dot(along_dir) / 2.8;
             let z = p.z / 3.2;
-            let (fa, fz) = (a - a.floor(), z - z.floor());
+            let (cell_a, cell_z) = (floor_f32(a), floor_f32(z));
+            let (fa, fz) = (a - cell_a, z - cell_z);
             if fa > 0.22 && fa < 0.78 && fz > 0.3 && fz < 0.82 && p.z > 1.2 {
-                let lit = nz.cell(a.floor() as i32, z.floor() as i32, prim.aux) < 0.22;
+                let lit = nz.cell(cell_a as i32, cell_z as i32, prim.aux) < 0.22;
                 albedo = Vec3::new(0.03, 0.035, 0.045);
                 gloss = 0.35;
                 if lit {
@@ -231,4 +253,43 @@ pub fn semantic(scene: &StaticScene, prim: &Prim, p: Vec3) -> u8 {
         return t;
     }
     prim.tag
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn fast_floors_equal_the_standard_floor(x in -3.0e9f32..3.0e9f32, small in -1.0e4f32..1.0e4f32) {
+            for v in [x, small, small.trunc(), small.trunc() - 0.5] {
+                prop_assert_eq!(floor_f32(v), v.floor(), "{}", v);
+                if v.abs() < 2.0e9 {
+                    prop_assert_eq!(floor_i32(v) as f32, v.floor(), "{}", v);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fast_floor_edge_cases() {
+        for v in [
+            0.0f32,
+            1.0,
+            -1.0,
+            -0.5,
+            0.5,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            1.0e30,
+            -1.0e30,
+        ] {
+            assert_eq!(floor_f32(v), v.floor(), "{v}");
+        }
+        assert!(floor_f32(f32::NAN).is_nan());
+        assert_eq!(floor_f32(f32::INFINITY), f32::INFINITY);
+        assert_eq!(floor_f32(f32::NEG_INFINITY), f32::NEG_INFINITY);
+    }
 }
