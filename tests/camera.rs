@@ -744,6 +744,47 @@ fn h264_videos_hold_every_frame_deterministically_and_decode_to_the_png_frames()
     }
     assert!(frames_checked > 120);
 
+    // `output.rgb_encoding: jpeg`: one `.jpg` per frame where the PNG run has a `.png`, each a baseline JPEG of
+    // the frame's size, and the index names them.
+    let jpeg: Vec<&str> = rgb_only.iter().copied().chain(["output.rgb_encoding=jpeg"]).collect();
+    let jpeg_dir = tmp.join("jpeg");
+    generate(&jpeg, &jpeg_dir, 2);
+    let jpg = common::all_files(&jpeg_dir);
+    let png_names: Vec<String> = png.keys().filter(|k| k.starts_with("sensors/rgb/")).cloned().collect();
+    let jpg_names: Vec<String> = jpg.keys().filter(|k| k.starts_with("sensors/rgb/")).cloned().collect();
+    let want: Vec<String> = png_names.iter().map(|k| k.replace(".png", ".jpg")).collect();
+    assert!(
+        jpg_names == want,
+        "{} RGB files, {} expected; first: {:?} vs {:?}",
+        jpg_names.len(),
+        want.len(),
+        jpg_names.first(),
+        want.first()
+    );
+    for name in &jpg_names {
+        let bytes = &jpg[name];
+        assert!(
+            bytes.starts_with(&[0xff, 0xd8, 0xff]) && bytes.ends_with(&[0xff, 0xd9]),
+            "{name}: not a JPEG"
+        );
+        let sof = bytes
+            .windows(2)
+            .position(|w| w == [0xff, 0xc0])
+            .expect("baseline SOF0 marker");
+        let size = |at: usize| u16::from_be_bytes([bytes[at], bytes[at + 1]]);
+        assert_eq!((size(sof + 7), size(sof + 5)), (160, 90), "{name}: width, height");
+    }
+    let verify = std::process::Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+        .arg("verify")
+        .arg(&jpeg_dir)
+        .output()
+        .expect("run verify");
+    assert!(
+        verify.status.success(),
+        "verify: {}",
+        String::from_utf8_lossy(&verify.stderr)
+    );
+
     // A clip interrupted while its video was being written: no completion marker, a temporary video left.
     let one = tmp.join("one");
     let clip0 = clips[0]["clip_id"].as_str().expect("id");

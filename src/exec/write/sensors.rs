@@ -183,8 +183,9 @@ enum Still {
 
 impl Still {
     /// Stream name and file extension.
-    fn file(self) -> (&'static str, &'static str) {
+    fn file(self, output: &Output) -> (&'static str, &'static str) {
         match self {
+            Still::Rgb if output.rgb_encoding == RgbEncoding::Jpeg => ("rgb", "jpg"),
             Still::Rgb => ("rgb", "png"),
             Still::Depth => ("depth", "png"),
             Still::Semantic => ("semantic", "png"),
@@ -331,7 +332,7 @@ impl<'a> ClipSensorWriter<'a> {
         );
         pushed?;
         for (still, bytes) in encoded? {
-            let (stream, ext) = still.file();
+            let (stream, ext) = still.file(output);
             self.put(stream, at, ext, &bytes)?;
         }
         if let Some(dvs) = self.dvs.as_mut()
