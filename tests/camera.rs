@@ -671,17 +671,13 @@ fn sensor_files_are_identical_across_jobs_and_resumption_and_indexed() {
     // Interrupt a clip half-way through writing: its completion marker and one of its images are gone and a
     // temporary file is left; the resumed run renders the clip again and ends byte-identical.
     let clip0 = manifest["clips"][0]["clip_id"].as_str().expect("id").to_owned();
-    std::fs::remove_file(one.join(format!("tables/clips/{clip0}.parquet"))).expect("rm");
-    std::fs::remove_file(one.join(format!("sensors/rgb/{clip0}/000003.png"))).expect("rm");
-    std::fs::write(
-        one.join(format!("sensors/depth/{clip0}/.000004.png.tmp-99999")),
-        b"half",
-    )
-    .expect("tmp");
-    generate(&small, &one, 2);
-    assert!(
-        common::all_files(&one) == a,
-        "a resumed run differs from an uninterrupted one"
+    common::assert_resume_rewrites_clip(
+        &one,
+        &clip0,
+        &[format!("sensors/rgb/{clip0}/000003.png")],
+        &format!("sensors/depth/{clip0}/.000004.png.tmp-99999"),
+        &a,
+        || generate(&small, &one, 2),
     );
     std::fs::remove_dir_all(&tmp).ok();
 }
@@ -788,13 +784,13 @@ fn h264_videos_hold_every_frame_deterministically_and_decode_to_the_png_frames()
     // A clip interrupted while its video was being written: no completion marker, a temporary video left.
     let one = tmp.join("one");
     let clip0 = clips[0]["clip_id"].as_str().expect("id");
-    std::fs::remove_file(one.join(format!("tables/clips/{clip0}.parquet"))).expect("rm");
-    std::fs::remove_file(one.join(format!("sensors/rgb/{clip0}.mp4"))).expect("rm");
-    std::fs::write(one.join(format!("sensors/rgb/.{clip0}.mp4.tmp-99999")), b"half").expect("tmp");
-    generate(&h264, &one, 2);
-    assert!(
-        common::all_files(&one) == a,
-        "a resumed run differs from an uninterrupted one"
+    common::assert_resume_rewrites_clip(
+        &one,
+        clip0,
+        &[format!("sensors/rgb/{clip0}.mp4")],
+        &format!("sensors/rgb/.{clip0}.mp4.tmp-99999"),
+        &a,
+        || generate(&h264, &one, 2),
     );
 
     // 4:2:0 needs even sizes: an odd width is refused before anything is written, with the value located.

@@ -561,13 +561,13 @@ fn written_points_lie_in_their_pedestrians_boxes_and_files_are_reproducible() {
     // Interrupted half-way: the clip's completion marker and its LiDAR file are gone and a temporary file is
     // left; the resumed run writes the clip again, byte-identical.
     let clip0 = manifest["clips"][0]["clip_id"].as_str().expect("id").to_owned();
-    std::fs::remove_file(one.join(format!("tables/clips/{clip0}.parquet"))).expect("rm");
-    std::fs::remove_file(one.join(format!("sensors/lidar/{clip0}.parquet"))).expect("rm");
-    std::fs::write(one.join(format!("sensors/lidar/.{clip0}.parquet.tmp-99999")), b"half").expect("tmp");
-    generate(&lidar_only, &one, 2);
-    assert!(
-        common::all_files(&one) == files,
-        "a resumed run differs from an uninterrupted one"
+    common::assert_resume_rewrites_clip(
+        &one,
+        &clip0,
+        &[format!("sensors/lidar/{clip0}.parquet")],
+        &format!("sensors/lidar/.{clip0}.parquet.tmp-99999"),
+        &files,
+        || generate(&lidar_only, &one, 2),
     );
 
     // The seed's layout: one .bin per frame with the same points' x y z intensity.

@@ -329,3 +329,26 @@ impl Drop for Scratch {
         let _ = std::fs::remove_dir_all(&self.0);
     }
 }
+
+/// Leaves a clip of the dataset at `out` as a run killed while writing it would: its completion marker
+/// (`tables/clips/<clip>.parquet`) and the files `remove` (paths relative to `out`) gone, and a half-written
+/// temporary file at `leftover`. Then `resume` runs and the directory must equal `want` byte for byte.
+pub fn assert_resume_rewrites_clip(
+    out: &std::path::Path,
+    clip_id: &str,
+    remove: &[String],
+    leftover: &str,
+    want: &std::collections::BTreeMap<String, Vec<u8>>,
+    resume: impl FnOnce(),
+) {
+    std::fs::remove_file(out.join(format!("tables/clips/{clip_id}.parquet"))).expect("remove completion marker");
+    for path in remove {
+        std::fs::remove_file(out.join(path)).expect("remove file");
+    }
+    std::fs::write(out.join(leftover), b"half").expect("write leftover");
+    resume();
+    assert!(
+        all_files(out) == *want,
+        "a resumed run differs from an uninterrupted one"
+    );
+}

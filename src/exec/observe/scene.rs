@@ -901,8 +901,7 @@ pub fn road_paint(scene: &StaticScene, piece: &PieceSurface, p: Vec2) -> Option<
             let along = (piece.inner[1] - piece.inner[0]).normalize_or_zero();
             let across = along.perp();
             let k = p.dot(across);
-            return (k - crate::exec::observe::camera::shade::floor_f32(k) < 0.5)
-                .then_some((Vec3::splat(0.62), tag::ROAD_LINE));
+            return (k - k.floor() < 0.5).then_some((Vec3::splat(0.62), tag::ROAD_LINE));
         }
     }
     if piece.marks == [Mark::None, Mark::None] {

@@ -14,12 +14,7 @@ use crate::mix::splitmix64;
 #[inline(always)]
 pub fn floor_f32(x: f32) -> f32 {
     // Every float of magnitude 2^23 or more is an integer already.
-    if x.abs() < 8_388_608.0 {
-        let t = x as i32 as f32;
-        if t > x { t - 1.0 } else { t }
-    } else {
-        x
-    }
+    if x.abs() < 8_388_608.0 { floor_i32(x) as f32 } else { x }
 }
 
 /// `x.floor()` as an integer, for `|x| < 2^31` (texture coordinates; NaN gives 0).
