@@ -596,8 +596,8 @@ pub fn slurm(
     script: Option<&Path>,
     out: &mut dyn Write,
 ) -> Result<(), Error> {
-    let (plan, _) = load_input(input, options)?;
-    let text = crate::exec::generate::cluster::slurm_script(&plan, slurm)?;
+    let (plan, towns) = load_input(input, options)?;
+    let text = crate::exec::generate::cluster::slurm_script(&plan, &towns, slurm)?;
     emit_to(script, &text, true, out)
 }
 
@@ -609,9 +609,9 @@ pub fn k8s(
     manifest: Option<&Path>,
     out: &mut dyn Write,
 ) -> Result<(), Error> {
-    let (plan, _) = load_input(input, options)?;
+    let (plan, towns) = load_input(input, options)?;
     let spec_yaml = dsl::to_yaml(&plan.header().spec)?;
-    let text = crate::exec::generate::cluster::k8s_manifest(&plan, &spec_yaml, k8s)?;
+    let text = crate::exec::generate::cluster::k8s_manifest(&plan, &towns, &spec_yaml, k8s)?;
     emit_to(manifest, &text, false, out)
 }
 

@@ -23,8 +23,13 @@ fn shards_are_disjoint_complete_and_balanced_by_cost() {
     let (_, plan) = commands::compile_plan(&spec("pedsynth_pp.yaml"), &Default::default(), None)
         .unwrap_or_else(|e| panic!("{}", e.render()));
     let prepared = PreparedPlan::from_plan(plan.clone()).expect("prepared");
+    // The same spec compiled lazily (as `generate SPEC` does: scripts made when needed) shards alike.
+    let loaded = pedsynth::dsl::load_file(&spec("pedsynth_pp.yaml"), &Default::default()).expect("spec");
+    let towns = commands::load_towns(&loaded).unwrap_or_else(|e| panic!("{}", e.render()));
+    let lazy = pedsynth::planner::LazyPlan::compile(&loaded.spec, &loaded.hash().expect("hash"), "", &towns);
+    let lazy = PreparedPlan::new(lazy, &towns).expect("lazy plan");
     for n in [1, 3, 8] {
-        let shards: Vec<BTreeSet<String>> = (0..n).map(|i| shard_clips(&prepared, i, n)).collect();
+        let shards: Vec<BTreeSet<String>> = (0..n).map(|i| shard_clips(&prepared, &BTreeMap::new(), i, n)).collect();
         let all: BTreeSet<&String> = shards.iter().flatten().collect();
         assert_eq!(all.len(), plan.clips.len(), "{n} shards cover every clip");
         assert_eq!(
@@ -50,8 +55,15 @@ fn shards_are_disjoint_complete_and_balanced_by_cost() {
         );
         assert_eq!(
             shards,
-            (0..n).map(|i| shard_clips(&prepared, i, n)).collect::<Vec<_>>(),
+            (0..n)
+                .map(|i| shard_clips(&prepared, &BTreeMap::new(), i, n))
+                .collect::<Vec<_>>(),
             "deterministic"
+        );
+        assert_eq!(
+            shards,
+            (0..n).map(|i| shard_clips(&lazy, &towns, i, n)).collect::<Vec<_>>(),
+            "a plan file and its spec shard alike"
         );
     }
 }
@@ -112,7 +124,7 @@ fn shards_started_at_once_into_one_directory_equal_a_single_run() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("pedsynth::merge::incomplete"), "{stderr}");
     let (_, small_plan) = commands::compile_plan(&small(), &Default::default(), None).unwrap();
-    let missing = shard_clips(&PreparedPlan::from_plan(small_plan).unwrap(), 2, 3);
+    let missing = shard_clips(&PreparedPlan::from_plan(small_plan).unwrap(), &BTreeMap::new(), 2, 3);
     assert!(missing.iter().all(|id| stderr.contains(id.as_str())), "{stderr}");
     let manifest = std::fs::read_to_string(merged.join("manifest.json")).unwrap();
     assert_eq!(manifest.matches("\"pending\"").count(), missing.len(), "{manifest}");

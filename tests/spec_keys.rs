@@ -75,7 +75,7 @@ impl Walker {
         }))
         .expect("manifest");
         let card =
-            pedsynth::exec::write::card::render(&plan.spec, &manifest, &[], &BTreeMap::new(), &Default::default());
+            pedsynth::exec::write::card::render(&plan.spec, &manifest, &|_| {}, &BTreeMap::new(), &Default::default());
         let plan_text =
             serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio, card)).expect("json");
         let tables = with_tables.then(|| {

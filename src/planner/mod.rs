@@ -27,7 +27,7 @@ use rand_chacha::ChaCha20Rng;
 use crate::dsl::types::{ClipsPer, Spec, TownRef, WeatherRef};
 use crate::world::{LaneType, RoadNetwork};
 use crate::world::{Route, Side, SpawnPoint};
-pub use prepared::{ClipSummary, PreparedPlan, plan_hash};
+pub use prepared::{PreparedPlan, plan_hash};
 pub use script::*;
 
 /// A town ready for planning: its road network and derived spawn candidates.
@@ -71,12 +71,12 @@ impl std::fmt::Display for PlanProblem {
     }
 }
 
-/// One (town, weather) cell and its clips.
+/// One (town, weather) cell and its number of clips (clip `k`'s id is [`clip_id`]).
 #[derive(Clone, Debug)]
 struct Stratum {
     town: TownRef,
     weather: WeatherRef,
-    clip_ids: Vec<String>,
+    clips: usize,
 }
 
 /// The id of clip `k` of the stratum (`town`, `weather`): `<town>-<weather>-<NNNN>`.
@@ -89,9 +89,9 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
     let weathers = spec.dataset.weathers.resolved();
     let towns = &spec.dataset.towns;
     let count = spec.dataset.clips.count as usize;
-    let mut cells: BTreeMap<(usize, usize), Vec<String>> = BTreeMap::new();
+    let mut cells: BTreeMap<(usize, usize), usize> = BTreeMap::new();
     for (wi, weather) in weathers.iter().enumerate() {
-        for (ti, town) in towns.iter().enumerate() {
+        for ti in 0..towns.len() {
             let n = match spec.dataset.clips.per {
                 ClipsPer::TownAndWeather => count,
                 // `count` clips per weather spread round-robin over the towns, starting at a town chosen by the
@@ -107,17 +107,16 @@ fn strata(spec: &Spec) -> Vec<Stratum> {
                     }
                 }
             };
-            let ids = (0..n).map(|k| clip_id(town, weather, k)).collect();
-            cells.insert((ti, wi), ids);
+            cells.insert((ti, wi), n);
         }
     }
     cells
         .into_iter()
-        .filter(|(_, ids)| !ids.is_empty())
-        .map(|((ti, wi), clip_ids)| Stratum {
+        .filter(|&(_, n)| n > 0)
+        .map(|((ti, wi), clips)| Stratum {
             town: towns[ti].clone(),
             weather: weathers[wi].clone(),
-            clip_ids,
+            clips,
         })
         .collect()
 }
@@ -160,9 +159,9 @@ pub fn plan(
 }
 
 /// A compiled plan whose clip scripts are not held: each is compiled again when asked for, from the draws of
-/// its stratum, which cost about a tenth of the scripts' memory — so `generate` works through any number of
-/// clips in bounded memory. A plan read from a file holds its scripts instead. Either way, [`LazyPlan::script`]
-/// returns the script [`plan`] would put in the plan, bit for bit.
+/// its stratum, which are themselves made again when needed (a few strata's draws are cached) — so `generate`
+/// works through any number of clips holding nothing per clip. A plan read from a file holds its scripts
+/// instead. Either way, [`LazyPlan::script`] returns the script [`plan`] would put in the plan, bit for bit.
 pub struct LazyPlan {
     /// The plan without its clips (`clips` is empty).
     header: Plan,
@@ -172,36 +171,83 @@ pub struct LazyPlan {
 enum Source {
     /// The scripts of a plan file.
     Held(Vec<ClipScript>),
-    /// Each stratum's draws, in plan order; `starts[k]` is the plan index of stratum `k`'s first clip.
+    /// The strata in plan order; `starts[k]` is the plan index of stratum `k`'s first clip. Their draws are
+    /// made when a clip of theirs is compiled.
     Drawn {
-        strata: Vec<StratumDraws>,
+        strata: Vec<Stratum>,
         starts: Vec<usize>,
+        cache: DrawCache,
     },
+}
+
+/// The draws of the strata used last, most recent last. Draws are arithmetic on the spec and seeds, so a
+/// stratum drawn twice (two workers at once, or after eviction) gives the same draws: the cache changes the
+/// time taken, never a script.
+#[derive(Default)]
+struct DrawCache(std::sync::Mutex<Vec<(usize, std::sync::Arc<StratumDraws>)>>);
+
+/// Strata whose draws are kept: enough for every worker of a large machine to work in its own stratum
+/// (workers take clips from separate parts of the plan) while holding a bounded amount.
+const CACHED_STRATA: usize = 32;
+
+impl DrawCache {
+    /// The draws of stratum `k`, made with `draw` unless cached.
+    fn get(&self, k: usize, draw: impl FnOnce() -> StratumDraws) -> std::sync::Arc<StratumDraws> {
+        // A worker that panicked while holding the lock left a valid list behind (the list is only pushed to
+        // and rotated): the poison is ignored.
+        let lock = || self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        {
+            let mut entries = lock();
+            if let Some(at) = entries.iter().position(|(key, _)| *key == k) {
+                let entry = entries.remove(at);
+                let draws = std::sync::Arc::clone(&entry.1);
+                entries.push(entry);
+                return draws;
+            }
+        }
+        // Drawn without the lock, so that other workers are not held up.
+        let draws = std::sync::Arc::new(draw());
+        let mut entries = lock();
+        if !entries.iter().any(|(key, _)| *key == k) {
+            entries.push((k, std::sync::Arc::clone(&draws)));
+            if entries.len() > CACHED_STRATA {
+                entries.remove(0);
+            }
+        }
+        draws
+    }
 }
 
 /// What a stratum allocates across its clips; each clip's script compiles from these alone.
 struct StratumDraws {
-    town: TownRef,
-    weather: WeatherRef,
     basics: Vec<ClipBasics>,
     allocs: Vec<PedAlloc>,
     /// Driving profile of each vehicle of the stratum, in clip order.
     profiles: Vec<DrivingProfileKind>,
 }
 
+/// Which clip of the plan a plan index is, without compiling it: see [`LazyPlan::clip`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ClipRef<'a> {
+    /// Clip id.
+    pub clip_id: std::borrow::Cow<'a, str>,
+    /// Town name.
+    pub town: &'a str,
+    /// Dataset split.
+    pub split: crate::dsl::types::Split,
+}
+
 impl LazyPlan {
-    /// The spec's plan, each clip compiled when asked for. Makes every stratum's draws (quick: no geometry);
-    /// a clip that cannot be planned, or whose town is missing from `towns`, is reported by
-    /// [`LazyPlan::script`].
+    /// The spec's plan, each clip compiled when asked for (nothing is drawn yet); a clip that cannot be
+    /// planned, or whose town is missing from `towns`, is reported by [`LazyPlan::script`].
     pub fn compile(spec: &Spec, spec_hash: &str, spec_dir: &str, towns: &BTreeMap<String, TownContext>) -> LazyPlan {
-        let mut starts = Vec::new();
-        let mut next = 0;
-        let strata: Vec<StratumDraws> = strata(spec)
+        let strata = strata(spec);
+        let starts = strata
             .iter()
-            .map(|stratum| {
-                starts.push(next);
-                next += stratum.clip_ids.len();
-                draw_stratum(spec, stratum)
+            .scan(0, |next, s| {
+                let start = *next;
+                *next += s.clips;
+                Some(start)
             })
             .collect();
         LazyPlan {
@@ -221,7 +267,11 @@ impl LazyPlan {
                     .collect(),
                 clips: Vec::new(),
             },
-            source: Source::Drawn { strata, starts },
+            source: Source::Drawn {
+                strata,
+                starts,
+                cache: DrawCache::default(),
+            },
         }
     }
 
@@ -248,8 +298,8 @@ impl LazyPlan {
     pub fn len(&self) -> usize {
         match &self.source {
             Source::Held(clips) => clips.len(),
-            Source::Drawn { strata, starts } => {
-                starts.last().copied().unwrap_or(0) + strata.last().map_or(0, |s| s.basics.len())
+            Source::Drawn { strata, starts, .. } => {
+                starts.last().copied().unwrap_or(0) + strata.last().map_or(0, |s| s.clips)
             }
         }
     }
@@ -265,16 +315,29 @@ impl LazyPlan {
         (k, i - starts.get(k).copied().unwrap_or(0))
     }
 
-    /// The id of clip `i` (plan order), if there is one.
-    pub fn clip_id(&self, i: usize) -> Option<std::borrow::Cow<'_, str>> {
+    /// Which clip plan index `i` is (id, town, split), if there is one; nothing is compiled or drawn.
+    pub fn clip(&self, i: usize) -> Option<ClipRef<'_>> {
         match &self.source {
-            Source::Held(clips) => clips.get(i).map(|c| c.clip_id.as_str().into()),
-            Source::Drawn { strata, starts } => {
+            Source::Held(clips) => clips.get(i).map(|c| ClipRef {
+                clip_id: c.clip_id.as_str().into(),
+                town: &c.town,
+                split: c.split,
+            }),
+            Source::Drawn { strata, starts, .. } => {
                 let (k, j) = Self::locate(starts, i);
-                let d = strata.get(k)?;
-                (j < d.basics.len()).then(|| clip_id(&d.town, &d.weather, j).into())
+                let s = strata.get(k)?;
+                (j < s.clips).then(|| ClipRef {
+                    clip_id: clip_id(&s.town, &s.weather, j).into(),
+                    town: s.town.name(),
+                    split: split_of(&self.header.spec, &s.town),
+                })
             }
         }
+    }
+
+    /// The id of clip `i` (plan order), if there is one.
+    pub fn clip_id(&self, i: usize) -> Option<std::borrow::Cow<'_, str>> {
+        self.clip(i).map(|c| c.clip_id)
     }
 
     /// The plan index of the clip `id`.
@@ -292,25 +355,29 @@ impl LazyPlan {
             clip_id: format!("#{i}"),
             reason: NO_SUCH_CLIP.to_owned(),
         };
-        let (strata, starts) = match &self.source {
+        let (strata, starts, cache) = match &self.source {
             Source::Held(clips) => return clips.get(i).map(std::borrow::Cow::Borrowed).ok_or_else(no_clip),
-            Source::Drawn { strata, starts } => (strata, starts),
+            Source::Drawn { strata, starts, cache } => (strata, starts, cache),
         };
         let (k, j) = Self::locate(starts, i);
-        let d = strata.get(k).ok_or_else(no_clip)?;
-        let b = d.basics.get(j).ok_or_else(no_clip)?;
-        let Some(town) = towns.get(d.town.name()) else {
+        let s = strata.get(k).ok_or_else(no_clip)?;
+        if j >= s.clips {
+            return Err(no_clip());
+        }
+        let Some(town) = towns.get(s.town.name()) else {
             return Err(PlanProblem {
                 clip_id: "*".to_owned(),
-                reason: format!("town `{}` was not loaded", d.town.name()),
+                reason: format!("town `{}` was not loaded", s.town.name()),
             });
         };
         let spec = &self.header.spec;
+        let d = cache.get(k, || draw_stratum(spec, s));
+        let b = d.basics.get(j).ok_or_else(no_clip)?;
         let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
-        let id = clip_id(&d.town, &d.weather, j);
+        let id = clip_id(&s.town, &s.weather, j);
         plan_clip(
             spec,
-            (&d.town, &d.weather),
+            (&s.town, &s.weather),
             town,
             (id.clone(), b),
             &d.allocs[b.first_pedestrian..b.first_pedestrian + b.pedestrians],
@@ -321,6 +388,15 @@ impl LazyPlan {
         .map(std::borrow::Cow::Owned)
         .map_err(|reason| PlanProblem { clip_id: id, reason })
     }
+}
+
+/// The split of the clips of `town`.
+fn split_of(spec: &Spec, town: &TownRef) -> crate::dsl::types::Split {
+    spec.dataset
+        .splits
+        .get(town.name())
+        .copied()
+        .unwrap_or(spec.dataset.default_split)
 }
 
 /// Per-clip draws that the stratum's quotas depend on.
@@ -368,11 +444,9 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
     let seed = spec.dataset.seed;
     let d = &spec.dataset;
     let (mut first_pedestrian, mut first_vehicle) = (0, 0);
-    let basics: Vec<ClipBasics> = stratum
-        .clip_ids
-        .iter()
-        .map(|id| {
-            let clip_seed = seeds::seed_u64(seed, id);
+    let basics: Vec<ClipBasics> = (0..stratum.clips)
+        .map(|k| {
+            let clip_seed = seeds::seed_u64(seed, &clip_id(&stratum.town, &stratum.weather, k));
             let mut rng = seeds::clip_rng(clip_seed, "basics");
             let duration_s = rng.random_range(d.clip_duration_s.min()..=d.clip_duration_s.max());
             let frame_count = ((duration_s * f64::from(d.fps)).round() as u32).max(1);
@@ -403,8 +477,6 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
         .map(|k| DrivingProfileKind::ALL[k])
         .collect();
     StratumDraws {
-        town: stratum.town.clone(),
-        weather: stratum.weather.clone(),
         basics,
         allocs,
         profiles,
@@ -660,12 +732,7 @@ fn plan_clip(
         town: town_ref.name().to_owned(),
         weather: weather.name().to_owned(),
         weather_params: weather.params(),
-        split: spec
-            .dataset
-            .splits
-            .get(town_ref.name())
-            .copied()
-            .unwrap_or(spec.dataset.default_split),
+        split: split_of(spec, town_ref),
         fps,
         frame_count,
         ego,

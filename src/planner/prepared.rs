@@ -1,7 +1,7 @@
-//! A plan prepared for generation: its header, one small [`ClipSummary`] per clip and the plan's hash, with
-//! the clips' scripts compiled again one at a time when a worker needs them ([`LazyPlan`]). Preparing compiles
-//! every clip once (which checks that each can be planned) and streams its JSON into the plan's hash, so the
-//! memory held while a dataset is generated does not grow with the size of the scripts.
+//! A plan prepared for generation: its header and the plan's hash, with the clips' scripts compiled again one
+//! at a time when a worker needs them ([`LazyPlan`]). Preparing compiles every clip once (which checks that each
+//! can be planned) and streams its JSON into the plan's hash, so nothing held while a dataset is generated grows
+//! with the number of clips: which clip an index is ([`PreparedPlan::clip`]) is arithmetic on the spec.
 //!
 //! Pure: hashing is arithmetic on the plan's JSON, which is never held whole.
 
@@ -9,60 +9,24 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::{ClipScript, LazyPlan, Plan, PlanProblem, TownContext};
-use crate::dsl::types::Split;
+use super::{ClipRef, ClipScript, LazyPlan, Plan, PlanProblem, TownContext};
 use crate::stream_json::Streamed;
-
-/// What generation needs to know of a clip before its script is compiled: which it is, where it goes, and
-/// what it costs.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ClipSummary {
-    /// Clip id.
-    pub clip_id: String,
-    /// Town name.
-    pub town: String,
-    /// Dataset split.
-    pub split: Split,
-    /// Number of frames.
-    pub frame_count: u32,
-    /// Number of pedestrians.
-    pub pedestrians: u32,
-}
-
-impl ClipSummary {
-    /// The summary of a script.
-    pub fn of(script: &ClipScript) -> ClipSummary {
-        ClipSummary {
-            clip_id: script.clip_id.clone(),
-            town: script.town.clone(),
-            split: script.split,
-            frame_count: script.frame_count,
-            pedestrians: u32::try_from(script.pedestrians.len()).unwrap_or(u32::MAX),
-        }
-    }
-}
 
 /// A plan ready to generate: see the module documentation.
 pub struct PreparedPlan {
     /// The plan and its scripts.
     lazy: LazyPlan,
-    /// Each clip's summary, in plan order.
-    pub clips: Vec<ClipSummary>,
     /// blake3 of the plan's JSON without `spec_dir` ([`plan_hash`]).
     pub plan_hash: String,
 }
 
 impl PreparedPlan {
-    /// Prepares `lazy`: compiles each clip once, summarising it and hashing its JSON. Fails with every clip
-    /// that cannot be planned (a town that was not loaded counts once).
+    /// Prepares `lazy`: compiles each clip once, hashing its JSON. Fails with every clip that cannot be planned
+    /// (a town that was not loaded counts once).
     pub fn new(lazy: LazyPlan, towns: &BTreeMap<String, TownContext>) -> Result<PreparedPlan, Vec<PlanProblem>> {
-        let mut clips = Vec::with_capacity(lazy.len());
         let mut problems = Vec::new();
         let scripts = (0..lazy.len()).filter_map(|i| match lazy.script(i, towns) {
-            Ok(script) => {
-                clips.push(ClipSummary::of(&script));
-                Some(Ok::<_, std::convert::Infallible>(script))
-            }
+            Ok(script) => Some(Ok::<_, std::convert::Infallible>(script)),
             Err(p) => {
                 problems.push(p);
                 None
@@ -80,7 +44,7 @@ impl PreparedPlan {
                 reason: format!("cannot serialise the plan: {e}"),
             }]
         })?;
-        Ok(PreparedPlan { lazy, clips, plan_hash })
+        Ok(PreparedPlan { lazy, plan_hash })
     }
 
     /// A plan whose scripts are all held (tests, a plan file).
@@ -88,9 +52,29 @@ impl PreparedPlan {
         PreparedPlan::new(LazyPlan::from_plan(plan), &BTreeMap::new())
     }
 
-    /// The plan without its clips (`clips` is empty: see [`PreparedPlan::clips`] and [`PreparedPlan::script`]).
+    /// The plan without its clips (`clips` is empty: see [`PreparedPlan::clip`] and [`PreparedPlan::script`]).
     pub fn header(&self) -> &Plan {
         self.lazy.header()
+    }
+
+    /// The number of clips.
+    pub fn len(&self) -> usize {
+        self.lazy.len()
+    }
+
+    /// Whether the plan has no clip.
+    pub fn is_empty(&self) -> bool {
+        self.lazy.is_empty()
+    }
+
+    /// Which clip plan index `i` is (id, town, split), without compiling it.
+    pub fn clip(&self, i: usize) -> Option<ClipRef<'_>> {
+        self.lazy.clip(i)
+    }
+
+    /// Every clip in plan order ([`PreparedPlan::clip`]), made one at a time.
+    pub fn clips(&self) -> impl Iterator<Item = ClipRef<'_>> + '_ {
+        (0..self.len()).filter_map(|i| self.clip(i))
     }
 
     /// The script of clip `i` (plan order).
@@ -187,16 +171,39 @@ mod tests {
         let plan = super::super::plan(&spec, "h", "dir", &towns, None).expect("plan");
         let prepared = PreparedPlan::new(LazyPlan::compile(&spec, "h", "dir", &towns), &towns).expect("prepared");
         assert_eq!(prepared.plan_hash, plan_hash(&plan).expect("hash"));
-        assert_eq!(prepared.clips.len(), plan.clips.len());
+        assert_eq!(prepared.len(), plan.clips.len());
         assert!(prepared.header().clips.is_empty());
         for (i, script) in plan.clips.iter().enumerate() {
-            assert_eq!(prepared.clips[i], ClipSummary::of(script));
+            let clip = prepared.clip(i).expect("clip");
+            assert_eq!(
+                (&*clip.clip_id, clip.town, clip.split),
+                (script.clip_id.as_str(), script.town.as_str(), script.split)
+            );
             assert_eq!(&*prepared.script(i, &towns).expect("script"), script, "clip {i}");
         }
+        assert_eq!(prepared.clip(plan.clips.len()), None);
         let held = PreparedPlan::from_plan(plan.clone()).expect("held");
         assert_eq!(held.plan_hash, prepared.plan_hash);
-        assert_eq!(held.clips, prepared.clips);
+        assert!(held.clips().eq(prepared.clips()));
         assert_eq!(&*held.script(1, &BTreeMap::new()).expect("held script"), &plan.clips[1]);
+    }
+
+    #[test]
+    fn scripts_asked_for_in_any_order_across_more_strata_than_are_cached_equal_the_plans() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/pedsynth_pp.yaml");
+        let loaded = crate::dsl::load_file(&path, &Default::default()).expect("spec");
+        let towns = crate::commands::load_towns(&loaded).expect("towns");
+        let mut spec = loaded.spec.clone();
+        spec.dataset.clips.count = 1;
+        spec.dataset.clips.per = crate::dsl::types::ClipsPer::TownAndWeather;
+        let plan = super::super::plan(&spec, "h", "dir", &towns, None).expect("plan");
+        let n = plan.clips.len();
+        assert!(n > super::super::CACHED_STRATA, "{n} strata of one clip");
+        let lazy = LazyPlan::compile(&spec, "h", "dir", &towns);
+        // Strided twice round: every stratum is drawn, evicted and drawn again.
+        for i in (0..2 * n).map(|k| k * 7 % n) {
+            assert_eq!(&*lazy.script(i, &towns).expect("script"), &plan.clips[i], "clip {i}");
+        }
     }
 
     #[test]

@@ -4,8 +4,10 @@
 //! shard comes from the engine's environment (`SLURM_ARRAY_TASK_ID`, `JOB_COMPLETION_INDEX`), and shards of
 //! one run write into one `--out` on shared storage. The engines schedule; pedsynth only splits the plan.
 
+use std::collections::BTreeMap;
+
 use crate::error::{Error, code};
-use crate::planner::PreparedPlan;
+use crate::planner::{PreparedPlan, TownContext};
 
 /// Options of `pedsynth slurm`.
 #[derive(Clone, Debug, Default)]
@@ -76,13 +78,13 @@ pub fn time_limit(cpu_s: f64, cpus: u32) -> String {
 }
 
 fn check_count(what: &str, n: usize, plan: &PreparedPlan) -> Result<(), Error> {
-    if n == 0 || n > plan.clips.len() {
+    if n == 0 || n > plan.len() {
         return Err(Error::new(
             code::SHARD_INVALID,
             format!(
                 "{what} {n}: the plan has {} clips, so 1 to {} shards",
-                plan.clips.len(),
-                plan.clips.len()
+                plan.len(),
+                plan.len()
             ),
         )
         .help("each shard generates whole clips; more shards than clips would leave some idle"));
@@ -92,9 +94,13 @@ fn check_count(what: &str, n: usize, plan: &PreparedPlan) -> Result<(), Error> {
 
 /// The submit script of `pedsynth slurm`: `bash` it on a login node; it submits the array and the merge job
 /// (`--dependency=afterok`) and prints their ids.
-pub fn slurm_script(plan: &PreparedPlan, o: &SlurmOptions) -> Result<String, Error> {
+pub fn slurm_script(
+    plan: &PreparedPlan,
+    towns: &BTreeMap<String, TownContext>,
+    o: &SlurmOptions,
+) -> Result<String, Error> {
     check_count("--array", o.array, plan)?;
-    let longest_cpu_s = crate::exec::generate::shard_cpu_s(plan, o.array)
+    let longest_cpu_s = crate::exec::generate::shard_cpu_s(plan, towns, o.array)
         .into_iter()
         .fold(0.0, f64::max);
     let time = o.time.clone().unwrap_or_else(|| time_limit(longest_cpu_s, o.cpus));
@@ -111,7 +117,7 @@ pub fn slurm_script(plan: &PreparedPlan, o: &SlurmOptions) -> Result<String, Err
     let logs = sh_quote(&format!("{}.logs", o.out));
     let pedsynth = sh_quote(&o.pedsynth);
     let last = o.array - 1;
-    let clips = plan.clips.len();
+    let clips = plan.len();
     let version = env!("CARGO_PKG_VERSION");
     Ok(format!(
         r#"#!/usr/bin/env bash
@@ -172,7 +178,12 @@ fn yaml_str(text: &str) -> String {
 /// The manifest of `pedsynth k8s`: a ConfigMap with the resolved spec (unless it is on the volume) and an
 /// Indexed Job whose pods each generate the shard of their `JOB_COMPLETION_INDEX` into `/data/<out>`; the last
 /// pod to finish writes the manifest and the card. `spec_yaml` is the resolved spec.
-pub fn k8s_manifest(plan: &PreparedPlan, spec_yaml: &str, o: &K8sOptions) -> Result<String, Error> {
+pub fn k8s_manifest(
+    plan: &PreparedPlan,
+    towns: &BTreeMap<String, TownContext>,
+    spec_yaml: &str,
+    o: &K8sOptions,
+) -> Result<String, Error> {
     check_count("--completions", o.completions, plan)?;
     for (flag, path) in [("--out", Some(&o.out)), ("--spec-on-volume", o.spec_on_volume.as_ref())] {
         if let Some(path) = path
@@ -211,7 +222,7 @@ pub fn k8s_manifest(plan: &PreparedPlan, spec_yaml: &str, o: &K8sOptions) -> Res
         Some(p) => format!("/data/{p}"),
         None => "/spec/spec.yaml".to_owned(),
     };
-    let longest_cpu_s = crate::exec::generate::shard_cpu_s(plan, o.completions)
+    let longest_cpu_s = crate::exec::generate::shard_cpu_s(plan, towns, o.completions)
         .into_iter()
         .fold(0.0, f64::max);
     let deadline_s = (longest_cpu_s / f64::from(o.cpus.max(1)) * 3.0 + 600.0).ceil() as u64 * 2;
@@ -221,7 +232,7 @@ pub fn k8s_manifest(plan: &PreparedPlan, spec_yaml: &str, o: &K8sOptions) -> Res
          # (ReadWriteMany), and the last pod to finish writes the manifest and the card. Written by pedsynth\n\
          # {version} (`pedsynth k8s`); apply with `kubectl apply -f`. Longest shard estimate: {est:.0} CPU-s.\n",
         dataset = plan.header().dataset,
-        clips = plan.clips.len(),
+        clips = plan.len(),
         n = o.completions,
         out = o.out,
         pvc = o.pvc,

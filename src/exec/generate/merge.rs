@@ -38,14 +38,14 @@ pub fn merge(plan: &PreparedPlan, out: &Path, shards: &[PathBuf]) -> Result<Merg
         check_source(source, writer.manifest_hashes())?;
     }
     let mut report = MergeReport::default();
-    for clip in &plan.clips {
-        let id = &clip.clip_id;
+    for clip in plan.clips() {
+        let id = &*clip.clip_id;
         if writer.is_clip_done(id) {
             report.kept += 1;
             continue;
         }
         let Some(source) = sources.iter().find(|s| TABLES.iter().all(|t| s.table(t, id).is_file())) else {
-            report.missing.push(id.clone());
+            report.missing.push(id.to_owned());
             continue;
         };
         copy_clip(source, writer.layout(), id, &mut report)?;
@@ -61,7 +61,7 @@ pub fn merge(plan: &PreparedPlan, out: &Path, shards: &[PathBuf]) -> Result<Merg
                 "{}: {} of {} clips are finished in no directory given ({}{}); the manifest lists them as pending",
                 out.display(),
                 report.missing.len(),
-                plan.clips.len(),
+                plan.len(),
                 shown.join(", "),
                 if report.missing.len() > shown.len() {
                     ", ..."

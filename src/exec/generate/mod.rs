@@ -39,22 +39,30 @@ pub struct GenerateOptions {
 /// The clips of shard `index` of `count`: clips sorted by estimated CPU cost (largest first, then by id) go one
 /// by one to the shard with the least cost so far (the lowest index on a tie). Deterministic: every shard of
 /// a run computes the same assignment from the plan alone.
-pub fn shard_clips(plan: &PreparedPlan, index: usize, count: usize) -> BTreeSet<String> {
-    let (assignment, _) = assign_shards(plan, count);
-    assignment
-        .into_iter()
-        .filter(|&(_, k)| k == index)
-        .map(|(id, _)| id.to_owned())
+pub fn shard_clips(
+    plan: &PreparedPlan,
+    towns: &BTreeMap<String, TownContext>,
+    index: usize,
+    count: usize,
+) -> BTreeSet<String> {
+    let (shard_of, _) = assign_shards(plan, towns, count);
+    shard_of
+        .iter()
+        .enumerate()
+        .filter(|&(_, &k)| k as usize == index)
+        .filter_map(|(i, _)| plan.clip(i).map(|c| c.clip_id.into_owned()))
         .collect()
 }
 
 /// The estimated CPU seconds of each of `count` shards ([`shard_clips`]'s assignment).
-pub fn shard_cpu_s(plan: &PreparedPlan, count: usize) -> Vec<f64> {
-    assign_shards(plan, count).1
+pub fn shard_cpu_s(plan: &PreparedPlan, towns: &BTreeMap<String, TownContext>, count: usize) -> Vec<f64> {
+    assign_shards(plan, towns, count).1
 }
 
-/// Each clip's shard and each shard's estimated CPU seconds.
-fn assign_shards(plan: &PreparedPlan, count: usize) -> (Vec<(&str, usize)>, Vec<f64>) {
+/// The shard of each clip (plan order) and each shard's estimated CPU seconds. A clip's cost needs its script
+/// (its frames and pedestrians), so every script is compiled again; what is held is 4 bytes per clip for the
+/// assignment (16 while sorting), only when sharding.
+fn assign_shards(plan: &PreparedPlan, towns: &BTreeMap<String, TownContext>, count: usize) -> (Vec<u32>, Vec<f64>) {
     use crate::planner::stats::{CAMERA_CPU_S_PER_PIXEL, GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S, LIDAR_CPU_S_PER_RAY};
     let spec = &plan.header().spec;
     let s = &spec.sensors;
@@ -68,29 +76,36 @@ fn assign_shards(plan: &PreparedPlan, count: usize) -> (Vec<(&str, usize)>, Vec<
     } else {
         0.0
     };
-    let mut clips: Vec<(f64, &str)> = plan
-        .clips
-        .iter()
-        .map(|c| {
-            let frames = f64::from(c.frame_count);
-            let cost = frames * f64::from(c.pedestrians) / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
-                + frames * pixels * CAMERA_CPU_S_PER_PIXEL
-                + frames * rays * LIDAR_CPU_S_PER_RAY
-                + frames * 1e-6;
-            (cost, c.clip_id.as_str())
+    // A clip that cannot be compiled costs nothing here; generating it reports the problem.
+    let mut clips: Vec<(f64, u32)> = (0..plan.len())
+        .map(|i| {
+            let cost = plan.script(i, towns).map_or(0.0, |c| {
+                let frames = f64::from(c.frame_count);
+                frames * c.pedestrians.len() as f64 / GENERATION_PEDESTRIAN_FRAMES_PER_CPU_S
+                    + frames * pixels * CAMERA_CPU_S_PER_PIXEL
+                    + frames * rays * LIDAR_CPU_S_PER_RAY
+                    + frames * 1e-6
+            });
+            (cost, u32::try_from(i).unwrap_or(u32::MAX))
         })
         .collect();
-    clips.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(b.1)));
+    // Ties by clip id, which within the plan's order is a stable total order of its own (ids are unique).
+    let id = |i: u32| {
+        plan.clip(i as usize)
+            .map(|c| c.clip_id.into_owned())
+            .unwrap_or_default()
+    };
+    clips.sort_by(|a, b| b.0.total_cmp(&a.0).then_with(|| id(a.1).cmp(&id(b.1))));
     let mut load = vec![0.0f64; count.max(1)];
-    let mut assignment = Vec::with_capacity(clips.len());
-    for (cost, id) in clips {
+    let mut shard_of = vec![0u32; plan.len()];
+    for (cost, i) in clips {
         let k = (0..load.len())
             .min_by(|&a, &b| load[a].total_cmp(&load[b]).then(a.cmp(&b)))
             .unwrap_or(0);
         load[k] += cost;
-        assignment.push((id, k));
+        shard_of[i as usize] = u32::try_from(k).unwrap_or(u32::MAX);
     }
-    (assignment, load)
+    (shard_of, load)
 }
 
 /// What a run did.
@@ -139,15 +154,15 @@ pub fn generate(
     options: &GenerateOptions,
 ) -> Result<GenerateReport, Error> {
     if let Some(id) = &options.only
-        && !plan.clips.iter().any(|c| &c.clip_id == id)
+        && !plan.clips().any(|c| &*c.clip_id == id)
     {
         return Err(
             Error::new(code::PLAN_UNKNOWN_CLIP, format!("no clip `{id}` in this plan"))
                 .help("`pedsynth plan SPEC --json` lists the clip ids"),
         );
     }
-    for clip in &plan.clips {
-        if !towns.contains_key(&clip.town) {
+    for clip in plan.clips() {
+        if !towns.contains_key(clip.town) {
             return Err(Error::new(
                 code::PLAN_INVALID,
                 format!(
@@ -158,22 +173,27 @@ pub fn generate(
         }
     }
     let writer = DatasetWriter::open(&options.out, plan, options.shard.is_some())?;
-    let shard = options.shard.map(|(i, n)| shard_clips(plan, i, n));
-    let selected: Vec<usize> = (0..plan.clips.len())
-        .filter(|&i| options.only.as_ref().is_none_or(|id| &plan.clips[i].clip_id == id))
-        .filter(|&i| shard.as_ref().is_none_or(|s| s.contains(&plan.clips[i].clip_id)))
-        .collect();
-    let todo: Vec<usize> = selected
-        .iter()
-        .copied()
-        .filter(|&i| !writer.is_clip_done(&plan.clips[i].clip_id))
-        .collect();
+    // Which clips this run does, decided per plan index when needed (nothing per clip is held, except the
+    // shard assignment when sharding).
+    let shard = options
+        .shard
+        .map(|(i, n)| (u32::try_from(i).unwrap_or(u32::MAX), assign_shards(plan, towns, n).0));
+    let selected = |i: usize| {
+        options
+            .only
+            .as_ref()
+            .is_none_or(|id| plan.clip(i).is_some_and(|c| &*c.clip_id == id))
+            && shard.as_ref().is_none_or(|(k, shard_of)| shard_of.get(i) == Some(k))
+    };
+    let todo = |i: usize| selected(i) && plan.clip(i).is_some_and(|c| !writer.is_clip_done(&c.clip_id));
+    let selected_count = (0..plan.len()).filter(|&i| selected(i)).count();
+    let todo_count = (0..plan.len()).filter(|&i| todo(i)).count();
     let header = plan.header();
     let rig = Rig::from_spec(&header.spec.sensors);
     let progress = if options.progress_json {
-        Progress::json(todo.len())
+        Progress::json(todo_count)
     } else {
-        Progress::new(todo.len(), options.quiet)
+        Progress::new(todo_count, options.quiet)
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.jobs.unwrap_or(0))
@@ -181,8 +201,10 @@ pub fn generate(
         .map_err(|e| Error::new(code::IO_THREADS, format!("cannot start worker threads: {e}")))?;
     // Counts summed and failures kept as the clips finish (nothing per clip is held); failures in plan order.
     let (mut report, mut failures): (GenerateReport, Vec<(usize, Error)>) = pool.install(|| {
-        todo.par_iter()
-            .map(|&i| {
+        (0..plan.len())
+            .into_par_iter()
+            .filter(|&i| todo(i))
+            .map(|i| {
                 let result = plan
                     .script(i, towns)
                     .map_err(|p| Error::new(code::PLAN_INFEASIBLE, format!("the plan changed while generating: {p}")))
@@ -213,7 +235,8 @@ pub fn generate(
             )
     });
     progress.finish();
-    report.skipped = selected.len() - todo.len();
+    // Clips found finished when the run started (shards of one run never share a clip, so none finished since).
+    report.skipped = selected_count - todo_count;
     failures.sort_by_key(|(i, _)| *i);
     let mut failures: Vec<Error> = failures.into_iter().map(|(_, e)| e).collect();
     // Shards of one run finish in any order: the manifest (derived from the files on disk) and the card are
@@ -245,19 +268,19 @@ pub(crate) fn finish_dataset(
     if card && complete {
         let stats = crate::exec::read::stats::compute(out)?;
         let layout = writer.layout();
-        let clips: Vec<(&str, &str)> = plan
-            .clips
-            .iter()
-            .map(|c| (c.clip_id.as_str(), c.split.name()))
-            .collect();
         // Rows of each table in each split.
         let mut rows: BTreeMap<(&str, &str), u64> = BTreeMap::new();
-        for &(id, split) in &clips {
+        for clip in plan.clips() {
             for table in crate::exec::write::tables::TABLES {
-                *rows.entry((table, split)).or_default() +=
-                    crate::exec::read::tables::row_count(&layout.table(table, id))?;
+                *rows.entry((table, clip.split.name())).or_default() +=
+                    crate::exec::read::tables::row_count(&layout.table(table, &clip.clip_id))?;
             }
         }
+        let clips = |f: &mut dyn FnMut(&str, &str)| {
+            for clip in plan.clips() {
+                f(&clip.clip_id, clip.split.name());
+            }
+        };
         let path = out.join(crate::exec::write::card::CARD_FILE);
         let mut file = crate::fsutil::AtomicFile::create(&path).map_err(|e| Error::write(&path, e))?;
         crate::exec::write::card::write(&plan.header().spec, writer.manifest(), &clips, &rows, &stats, &mut file)

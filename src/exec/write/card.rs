@@ -60,11 +60,15 @@ fn table_summary(table: &str) -> &'static str {
     }
 }
 
+/// Calls its argument with each clip's id and split (`train`, `val`, `test`), in plan order: the card walks the
+/// clips once per table and split instead of holding their list.
+pub type ClipList<'a> = &'a dyn Fn(&mut dyn FnMut(&str, &str));
+
 /// The card of a finished dataset, as text ([`write`]).
 pub fn render<C>(
     spec: &Spec,
     manifest: &Manifest<C>,
-    clips: &[(&str, &str)],
+    clips: ClipList<'_>,
     rows: &BTreeMap<(&str, &str), u64>,
     stats: &DatasetStats,
 ) -> String {
@@ -75,13 +79,13 @@ pub fn render<C>(
 }
 
 /// Writes the card of a finished dataset to `out`, streamed (its file lists grow with the clips). `clips`
-/// gives each clip id and its split (`train`, `val`, `test`) in plan order; `rows` the rows of each (table,
+/// gives each clip id and its split in plan order ([`ClipList`]); `rows` the rows of each (table,
 /// split). A split whose files of a table hold no row is left out of that table's config (`datasets` cannot
 /// load a split without data), and a table without any row gets no config.
 pub fn write<C>(
     spec: &Spec,
     manifest: &Manifest<C>,
-    clips: &[(&str, &str)],
+    clips: ClipList<'_>,
     rows: &BTreeMap<(&str, &str), u64>,
     stats: &DatasetStats,
     out: &mut dyn std::io::Write,
@@ -118,19 +122,18 @@ impl std::fmt::Write for Text<'_> {
 fn write_text<C>(
     spec: &Spec,
     manifest: &Manifest<C>,
-    clips: &[(&str, &str)],
+    clips: ClipList<'_>,
     rows: &BTreeMap<(&str, &str), u64>,
     stats: &DatasetStats,
     x: &mut Text<'_>,
 ) {
-    let mut by_split: BTreeMap<&str, (&str, Vec<&str>)> = BTreeMap::new();
-    for &(clip, split) in clips {
-        by_split
-            .entry(hf_split(split))
-            .or_insert((split, Vec::new()))
-            .1
-            .push(clip);
-    }
+    // Each Hugging Face split name and our split it stands for.
+    let mut by_split: BTreeMap<String, String> = BTreeMap::new();
+    clips(&mut |_, split| {
+        if !by_split.contains_key(hf_split(split)) {
+            by_split.insert(hf_split(split).to_owned(), split.to_owned());
+        }
+    });
     let rows_of = |table: &str, split: &str| rows.get(&(table, split)).copied().unwrap_or(0);
     // Splits in the conventional order.
     let order = |s: &str| match s {
@@ -139,7 +142,7 @@ fn write_text<C>(
         "test" => 2,
         _ => 3,
     };
-    let mut splits: Vec<(&str, (&str, Vec<&str>))> = by_split.into_iter().collect();
+    let mut splits: Vec<(String, String)> = by_split.into_iter().collect();
     splits.sort_by_key(|(s, _)| (order(s), s.to_string()));
 
     let _ = write!(
@@ -151,10 +154,7 @@ fn write_text<C>(
     );
     let mut empty = Vec::new();
     for table in TABLES {
-        let filled: Vec<&(&str, (&str, Vec<&str>))> = splits
-            .iter()
-            .filter(|(_, (ours, _))| rows_of(table, ours) > 0)
-            .collect();
+        let filled: Vec<&(String, String)> = splits.iter().filter(|(_, ours)| rows_of(table, ours) > 0).collect();
         if filled.is_empty() {
             empty.push(table);
             continue;
@@ -164,11 +164,13 @@ fn write_text<C>(
             x.push_str("  default: true\n");
         }
         x.push_str("  data_files:\n");
-        for (split, (_, ids)) in filled {
+        for (split, ours) in filled {
             let _ = writeln!(x, "  - split: {split}\n    path:");
-            for id in ids {
-                let _ = writeln!(x, "    - {}", quoted(&format!("tables/{table}/{id}.parquet")));
-            }
+            clips(&mut |id, clip_split| {
+                if clip_split == ours {
+                    let _ = writeln!(x, "    - {}", quoted(&format!("tables/{table}/{id}.parquet")));
+                }
+            });
         }
     }
     x.push_str("---\n\n");

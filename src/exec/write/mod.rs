@@ -230,16 +230,16 @@ impl DatasetWriter {
         files: impl Fn(&str) -> Result<Option<BTreeMap<String, String>>, Error>,
     ) -> Result<(), Error> {
         let path = self.layout.manifest();
-        let clips = plan.clips.iter().map(|c| {
+        let clips = plan.clips().map(|c| {
             files(&c.clip_id).map(|files| ManifestClip {
-                clip_id: c.clip_id.clone(),
+                clip_id: c.clip_id.into_owned(),
                 status: if files.is_some() { "done" } else { "pending" }.into(),
                 files: files.unwrap_or_default(),
             })
         });
         let manifest = self
             .manifest
-            .with_clips(crate::stream_json::Streamed::new(clips, plan.clips.len()));
+            .with_clips(crate::stream_json::Streamed::new(clips, plan.len()));
         let mut file = crate::fsutil::AtomicFile::create(&path).map_err(|e| Error::write(&path, e))?;
         if let Err(e) = manifest.write_json(&mut file) {
             // A clip's table that could not be read is that error; anything else is the file's.
@@ -256,14 +256,13 @@ impl DatasetWriter {
     /// `tables/<table>/`, `sensors/<stream>/` and every clip's `sensors/<stream>/<clip_id>/`), so that a
     /// resumed dataset holds exactly the files of an uninterrupted run.
     fn remove_temporaries(&self, plan: &PreparedPlan) -> Result<(), Error> {
-        let mut dirs: Vec<std::path::PathBuf> = std::iter::once(self.layout.root().to_path_buf())
+        // Made one at a time: a list of every clip's directories would grow with the clips.
+        let dirs = std::iter::once(self.layout.root().to_path_buf())
             .chain(TABLES.iter().map(|t| self.layout.table_dir(t)))
-            .collect();
-        for stream in sensors::STREAMS {
-            let stream_dir = self.layout.root().join(layout::SENSORS_DIR).join(stream);
-            dirs.push(stream_dir);
-            dirs.extend(plan.clips.iter().map(|c| self.layout.sensor_dir(stream, &c.clip_id)));
-        }
+            .chain(sensors::STREAMS.iter().flat_map(|stream| {
+                std::iter::once(self.layout.root().join(layout::SENSORS_DIR).join(stream))
+                    .chain(plan.clips().map(move |c| self.layout.sensor_dir(stream, &c.clip_id)))
+            }));
         for dir in dirs {
             let Ok(entries) = std::fs::read_dir(&dir) else { continue };
             for entry in entries.flatten() {
