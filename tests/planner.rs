@@ -90,7 +90,7 @@ fn assert_quotas(loaded: &dsl::LoadedSpec, plan: &Plan) {
             .count();
         within_one(
             baseline,
-            spec.crossing.baseline_ratio * (n - allocated) as f64,
+            planner::baseline_crosser_ratio(spec) * (n - allocated) as f64,
             &format!("{cell} baseline crossers"),
         );
         let l3 = &spec.crossing.layers.midroad_jaywalkers;
@@ -355,4 +355,38 @@ fn pedsynth_pp_plans_600_clips_at_the_target_ratio() {
         .filter(|c| c.town == "town05_like")
         .all(|c| c.split == pedsynth::dsl::types::Split::Test);
     assert!(test_split);
+}
+
+#[test]
+fn targets_below_the_baseline_lower_it_and_a_target_of_0_plans_no_crosser() {
+    for target in [0.0, 0.05] {
+        let set = vec![
+            format!("crossing.target_ratio={target}"),
+            "dataset.clips.count=4".to_owned(),
+        ];
+        let (loaded, _, plan) = compile("specs/pedsynth_pp.yaml", &set);
+        let stats = planner::stats::compute(&plan, &loaded.spec);
+        let adapted = stats.adapted_baseline.as_ref().expect("the baseline is lowered");
+        assert_eq!(adapted.spec_ratio, loaded.spec.crossing.baseline_ratio);
+        assert!(adapted.used_ratio < adapted.spec_ratio, "{adapted:?}");
+        assert_eq!(stats.crossers_by_source.get("allocated").copied().unwrap_or(0), 0);
+        // Exact quotas: the expected labelled ratio is the target up to one crosser per stratum.
+        let slack = stats.cells.len() as f64 / stats.pedestrians as f64;
+        assert!(
+            (stats.expected_crossing_ratio - target).abs() <= slack,
+            "target {target}: expected {}",
+            stats.expected_crossing_ratio
+        );
+        if target == 0.0 {
+            assert_eq!(stats.crossers, 0);
+            assert_eq!(stats.expected_crossing_ratio_sd, 0.0);
+        } else {
+            assert!(stats.expected_crossing_ratio_sd > 0.0);
+            let text = stats.to_string();
+            assert!(text.contains("note: baseline crossers planned at"), "{text}");
+        }
+    }
+    // At the default target the spec's baseline is used as written.
+    let (loaded, _, plan) = compile("specs/pedsynth_pp.yaml", &["dataset.clips.count=4".to_owned()]);
+    assert_eq!(planner::stats::compute(&plan, &loaded.spec).adapted_baseline, None);
 }

@@ -86,6 +86,7 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
 }
 
 /// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, the
+/// lowest is 0 (the planner lowers the baseline for targets below it: `planner::baseline_crosser_ratio`) and the
 /// highest is what its largest allocation yields once the measured share of planned crossers that end up
 /// labelled crossers is taken into account ([`crate::calibration::CROSSER_REALISATION`]).
 pub fn reachable_crossing_ratio(crossing: &Crossing) -> (f64, f64) {
@@ -93,7 +94,7 @@ pub fn reachable_crossing_ratio(crossing: &Crossing) -> (f64, f64) {
     if l1.enabled {
         let hi = (l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio)
             * crate::calibration::CROSSER_REALISATION;
-        (crossing.baseline_ratio, hi)
+        (0.0, hi)
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)
     }
@@ -662,8 +663,14 @@ impl Validator<'_> {
                     "with `crossing.layers.crosser_allocation` off only the baseline ({}) crosses: enable it, or set `target_ratio` to the baseline",
                     fmt_num(lo)
                 )
-            } else if c.target_ratio > hi {
+            } else if c.target_ratio > hi && l.crosser_allocation.max_crosser_ratio < 1.0 {
                 "raise `crossing.layers.crosser_allocation.max_crosser_ratio`, or lower the target".to_owned()
+            } else if c.target_ratio > hi {
+                format!(
+                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view), so with every pedestrian planned to cross the labelled ratio is about {}: lower the target",
+                    100.0 * crate::calibration::CROSSER_REALISATION,
+                    fmt_num(hi)
+                )
             } else {
                 "lower `crossing.baseline_ratio`, or raise the target".to_owned()
             };

@@ -427,16 +427,40 @@ struct PedAlloc {
 /// planned crossers that end up labelled crossers ([`crate::calibration::CROSSER_REALISATION`]), the expected
 /// labelled crossing ratio meets the target.
 pub fn allocated_crosser_ratio(spec: &Spec) -> f64 {
+    crosser_shares(spec).0
+}
+
+/// The share of the pedestrians not allocated by layer 1 that cross on their own: the spec's
+/// `baseline_ratio`, lowered when the target is below what the baseline alone would give (a rare-event set of
+/// 5 % crossers under the default 9 % baseline), so that any target down to 0 is met ([`adapted_baseline`]).
+pub fn baseline_crosser_ratio(spec: &Spec) -> f64 {
+    crosser_shares(spec).1
+}
+
+/// Whether the planner lowered the baseline for this spec's target, and to what: `Some((spec's, used))`.
+pub fn adapted_baseline(spec: &Spec) -> Option<(f64, f64)> {
+    let b = spec.crossing.baseline_ratio;
+    let used = baseline_crosser_ratio(spec);
+    (used < b).then_some((b, used))
+}
+
+/// (layer 1's allocated share, the baseline share of the rest).
+fn crosser_shares(spec: &Spec) -> (f64, f64) {
     let c = &spec.crossing;
     let l1 = &c.layers.crosser_allocation;
+    let b = c.baseline_ratio.clamp(0.0, 1.0);
     if !l1.enabled {
-        return 0.0;
+        return (0.0, b);
     }
-    // Plan enough crossers that the expected share labelled crossers in the dataset meets the target.
-    let planned = (c.target_ratio / crate::calibration::CROSSER_REALISATION).min(1.0);
-    let b = c.baseline_ratio;
+    // Plan enough crossers that the expected share labelled crossers in the dataset meets the target; allocated
+    // and baseline crossers are labelled at the same measured rate.
+    let planned = (c.target_ratio / crate::calibration::CROSSER_REALISATION).clamp(0.0, 1.0);
+    if planned <= b {
+        // The baseline alone would overshoot: it carries all the crossers, at the planned share.
+        return (0.0, planned);
+    }
     let r = if b >= 1.0 { 0.0 } else { (planned - b) / (1.0 - b) };
-    r.clamp(0.0, l1.max_crosser_ratio)
+    (r.clamp(0.0, l1.max_crosser_ratio), b)
 }
 
 /// The draws of a stratum: each clip's basics, then the stratum's pedestrian allocations and driving profiles.
@@ -516,7 +540,7 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
     let allocated = quota::largest_remainder(n, &[r, 1.0 - r])[0];
     let allocated_mask = quota::weighted_choice(allocated, &weights, &mut rng);
     let rest: Vec<usize> = (0..n).filter(|&i| !allocated_mask[i]).collect();
-    let b = c.baseline_ratio;
+    let b = baseline_crosser_ratio(spec);
     let baseline = quota::largest_remainder(rest.len(), &[b, 1.0 - b])[0];
     let rest_weights: Vec<f64> = rest.iter().map(|&i| weights[i]).collect();
     let baseline_mask = quota::weighted_choice(baseline, &rest_weights, &mut rng);

@@ -87,6 +87,15 @@ pub struct SplitStats {
     pub crossers: usize,
 }
 
+/// The baseline the planner used instead of the spec's, for a target below what the spec's baseline gives.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct AdaptedBaseline {
+    /// The spec's `crossing.baseline_ratio`.
+    pub spec_ratio: f64,
+    /// The share of pedestrians planned as baseline crossers.
+    pub used_ratio: f64,
+}
+
 /// Group statistics.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct GroupStats {
@@ -139,6 +148,13 @@ pub struct PlanStats {
     /// Expected share of pedestrians labelled crossers in the dataset (planned crossers × the measured
     /// realisation, `calibration::CROSSER_REALISATION`).
     pub expected_crossing_ratio: f64,
+    /// One standard deviation of the labelled crossing ratio around `expected_crossing_ratio`: each planned
+    /// crosser's outcome (binomial) and the realisation's spread between specs
+    /// (`calibration::CROSSER_REALISATION_SPREAD`).
+    pub expected_crossing_ratio_sd: f64,
+    /// The baseline the planner used when it lowered the spec's `baseline_ratio` to meet a low target (else
+    /// none).
+    pub adapted_baseline: Option<AdaptedBaseline>,
     /// Target crossing ratio.
     pub target_crossing_ratio: f64,
     /// Pedestrians per archetype.
@@ -206,6 +222,11 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         crossers_by_source: BTreeMap::new(),
         planned_crossing_ratio: 0.0,
         expected_crossing_ratio: 0.0,
+        expected_crossing_ratio_sd: 0.0,
+        adapted_baseline: super::adapted_baseline(spec).map(|(spec_ratio, used)| AdaptedBaseline {
+            spec_ratio,
+            used_ratio: round(used, 4),
+        }),
         target_crossing_ratio: plan.target_crossing_ratio,
         archetypes: spec.pedestrians.archetype_mix.keys().map(|k| (k.clone(), 0)).collect(),
         behaviours: Behaviour::ALL.iter().map(|b| (b.name().to_owned(), 0)).collect(),
@@ -305,8 +326,15 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         stats.planned_crossing_ratio = round(stats.crossers as f64 / stats.pedestrians as f64, 4);
         // Allocated and baseline crossers alike end up labelled at the measured realisation (the planner
         // allocates on that assumption).
-        let expected = stats.crossers as f64 * crate::calibration::CROSSER_REALISATION;
+        let (realisation, spread) = (
+            crate::calibration::CROSSER_REALISATION,
+            crate::calibration::CROSSER_REALISATION_SPREAD,
+        );
+        let crossers = stats.crossers as f64;
+        let expected = crossers * realisation;
         stats.expected_crossing_ratio = round(expected / stats.pedestrians as f64, 4);
+        let variance = crossers * realisation * (1.0 - realisation) + (crossers * spread).powi(2);
+        stats.expected_crossing_ratio_sd = round(variance.sqrt() / stats.pedestrians as f64, 4);
     }
     stats.estimated_annotated_samples = (stats.pedestrian_frames as f64 * EXPECTED_VISIBLE_SHARE).round() as u64;
     stats.estimated_bytes = estimate_bytes(&stats, spec, vehicle_frames);
@@ -473,9 +501,19 @@ impl std::fmt::Display for PlanStats {
         )?;
         writeln!(
             out,
-            "planned crossing ratio {:.3}: expected labelled crossing ratio {:.3} (target {:.3})",
-            stats.planned_crossing_ratio, stats.expected_crossing_ratio, stats.target_crossing_ratio
+            "planned crossing ratio {:.3}: expected labelled crossing ratio {:.3} ± {:.3} (1 s.d.; target {:.3})",
+            stats.planned_crossing_ratio,
+            stats.expected_crossing_ratio,
+            stats.expected_crossing_ratio_sd,
+            stats.target_crossing_ratio
         )?;
+        if let Some(b) = &stats.adapted_baseline {
+            writeln!(
+                out,
+                "note: baseline crossers planned at {:.3} of the pedestrians, not the spec's crossing.baseline_ratio {:.3}, which alone would overshoot the target",
+                b.used_ratio, b.spec_ratio
+            )?;
+        }
         writeln!(out, "vehicles              {}", stats.vehicles)?;
         writeln!(
             out,
