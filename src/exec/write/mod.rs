@@ -39,7 +39,7 @@ pub struct DatasetWriter {
     /// The directory's lock ([`LOCK_FILE`]), held while the writer lives.
     _lock: std::fs::File,
     layout: Layout,
-    /// The manifest without its clips (their list is written from the plan's summaries, clip by clip).
+    /// The manifest without its clips (their list is written from the plan, clip by clip: `PreparedPlan::clips`).
     manifest: Manifest<()>,
     meta: FileMeta,
 }
