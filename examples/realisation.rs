@@ -38,18 +38,21 @@ fn main() {
             }
         };
         let rig = Rig::from_spec(&plan.spec.sensors);
-        // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled)
-        let counts: Vec<[usize; 6]> = plan
+        // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled,
+        // allocated never annotated, pedestrians never annotated)
+        let counts: Vec<[usize; 8]> = plan
             .clips
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
                 let trace = simulate::simulate(clip, &plan.sim, net);
                 let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
-                let mut c = [0usize; 6];
+                let mut c = [0usize; 8];
                 for (i, p) in clip.pedestrians.iter().enumerate() {
                     c[0] += 1;
                     let labelled = usize::from(ann.pedestrians[i].crosser);
+                    let unseen = usize::from(ann.pedestrians[i].annotated_frames == 0);
+                    c[7] += unseen;
                     let on_road = trace.pedestrians[i]
                         .iter()
                         .any(|f| f.state.is_crossing() && f.lane_type == Some(LaneType::Driving));
@@ -58,6 +61,7 @@ fn main() {
                             c[1] += 1;
                             c[2] += labelled;
                             c[3] += usize::from(on_road);
+                            c[6] += unseen;
                         }
                         (Role::Crosser, CrosserSource::Baseline) => {
                             c[4] += 1;
@@ -69,19 +73,21 @@ fn main() {
                 c
             })
             .collect();
-        let t = counts.iter().fold([0usize; 6], |mut acc, c| {
-            for k in 0..6 {
+        let t = counts.iter().fold([0usize; 8], |mut acc, c| {
+            for k in 0..8 {
                 acc[k] += c[k];
             }
             acc
         });
         let share = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
         println!(
-            "{spec}: {} pedestrians; allocated crossers {}: on a driving lane {:.3}, labelled {:.3}; baseline crossers {}: labelled {:.3}",
+            "{spec}: {} pedestrians ({:.3} never annotated); allocated crossers {}: on a driving lane {:.3}, labelled {:.3}, never annotated {:.3}; baseline crossers {}: labelled {:.3}",
             t[0],
+            share(t[7], t[0]),
             t[1],
             share(t[3], t[1]),
             share(t[2], t[1]),
+            share(t[6], t[1]),
             t[4],
             share(t[5], t[4])
         );
