@@ -16,7 +16,9 @@ import sys
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from interop_pie import SHARED, check_sequences, check_track, fail, install_pab_get_pose, setup  # noqa: E402
+from interop_pie import (  # noqa: E402
+    SHARED, check_sequences, check_track, fail, install_pab_get_pose, report_behaviour, setup,
+)
 
 
 def main():
@@ -57,6 +59,7 @@ def main():
                 fail(f"{pid}: appearance sides {sides}")
             seen += 1
     print(f"interop_jaad: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables")
+    report_behaviour("interop_jaad")
 
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))
     data_opts = dict(config["data_opts"])

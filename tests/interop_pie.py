@@ -28,7 +28,19 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(ROOT, "..", "shared", "interfaces")
 
 COCO_TO_OP18 = [0, None, 6, 8, 10, 5, 7, 9, 12, 14, 16, 11, 13, 15, 1, 2, 3, 4]
-LOOKING = {"LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"}
+# The table's behaviour labels in the loaders' integer codes (pie_data.py / jaad_data.py `_map_text_to_scalar`):
+# PIE's `gesture`, JAAD's `hand_gesture`, `nod` and `reaction`; DATASET.md gives the same mapping.
+BEHAVIOUR_CODES = {
+    "look": lambda r: int(r["look"]),
+    "action": lambda r: {"standing": 0, "walking": 1}[r["action"]],
+    "gesture": lambda r: {"none": 0, "hand_ack": 1, "hand_yield": 2, "nod": 4}[r["gesture"]],
+    "hand_gesture": lambda r: {"none": 0, "hand_ack": 1, "hand_yield": 2, "nod": 0}[r["gesture"]],
+    "nod": lambda r: int(r["gesture"] == "nod"),
+    "reaction": lambda r: {"none": 0, "clear_path": 1, "speed_up": 2, "slow_down": 3}[r["reaction"]],
+}
+BEHAVIOUR_COLUMNS = ["look", "action", "gesture", "reaction"]
+# How many frames had each non-zero behaviour code, over every track checked (printed by the callers).
+BEHAVIOUR_SEEN = {}
 
 
 def fail(msg):
@@ -67,10 +79,21 @@ def our_pose36(kp, box):
 
 def check_track(pid, t, a):
     """A loader's pedestrian track `a` against our annotation rows `t` of it: frames, boxes, occlusion class,
-    cross and look labels."""
+    cross and every behaviour label the loader returns (look, action, gesture / hand_gesture, nod, reaction)."""
     if a["frames"] != [r["frame"] for r in t]:
         fail(f"{pid}: frames differ")
-    for r, box, occ, cross, look in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"], a["behavior"]["look"]):
+    for key, values in a["behavior"].items():
+        if key == "cross":
+            continue
+        if key not in BEHAVIOUR_CODES:
+            fail(f"{pid}: the loader returns a behaviour label `{key}` this check does not know")
+        for r, got in zip(t, values):
+            want = BEHAVIOUR_CODES[key](r)
+            if got != want:
+                fail(f"{pid} frame {r['frame']}: {key} {got} != {want} from the tables")
+            if got:
+                BEHAVIOUR_SEEN[(key, got)] = BEHAVIOUR_SEEN.get((key, got), 0) + 1
+    for r, box, occ, cross in zip(t, a["bbox"], a["occlusion"], a["behavior"]["cross"]):
         want = [r["bbox_x_min"], r["bbox_y_min"], r["bbox_x_max"], r["bbox_y_max"]]
         if max(abs(x - y) for x, y in zip(box, want)) > 0.006:
             fail(f"{pid} frame {r['frame']}: box {box} != {want}")
@@ -79,8 +102,16 @@ def check_track(pid, t, a):
             fail(f"{pid} frame {r['frame']}: occlusion {occ} for {o}")
         if cross != int(r["crossing"]):
             fail(f"{pid} frame {r['frame']}: cross {cross} != C {r['crossing']}")
-        if look != int(r["state"] in LOOKING):
-            fail(f"{pid} frame {r['frame']}: look {look} for {r['state']}")
+
+
+
+def report_behaviour(tool):
+    """Prints the behaviour codes seen; fails when no frame was `looking` or `walking` (the label check would
+    prove nothing)."""
+    print(f"{tool}: behaviour labels equal the tables; frames per non-zero code: "
+          + ", ".join(f"{k}={v}: {n}" for (k, v), n in sorted(BEHAVIOUR_SEEN.items())))
+    if not BEHAVIOUR_SEEN.get(("look", 1)) or not BEHAVIOUR_SEEN.get(("action", 1)):
+        fail("no looking or no walking frame: the behaviour check would prove nothing")
 
 
 def check_sequences(seq, tracks, peds, by_id, export, out, split, poses_too, get_pose, dataset):
@@ -150,7 +181,7 @@ def setup(name, formats):
         for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender"])
     }
     ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
-                "crossing", "state", "occlusion"] + (["keypoints"] if poses_too else [])
+                "crossing", "state", "occlusion"] + BEHAVIOUR_COLUMNS + (["keypoints"] if poses_too else [])
     tracks = {}
     for r in table(args.dataset, "annotations", ann_cols):
         tracks.setdefault((r["clip_id"], r["pedestrian"]), []).append(r)
@@ -228,6 +259,7 @@ def main():
           f"{len(video_of)} videos equal the tables; traffic objects {traffic}")
     if not traffic.get("vehicle") or not traffic.get("crosswalk"):
         fail(f"no vehicle or no crosswalk track in the whole export: {traffic}")
+    report_behaviour("interop_pie")
 
     # The benchmark's sequences (its default crossing options) and its get_pose.
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))

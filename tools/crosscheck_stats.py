@@ -71,7 +71,11 @@ def recompute(root: Path) -> dict:
     )
     frames = read_table(root, "frames", ["clip_id", "frame"])
     peds = read_table(root, "pedestrians", ["clip_id", "pedestrian", "crosser"])
-    ann = read_table(root, "annotations", ["clip_id", "frame", "pedestrian", "state", "crossing"])
+    ann = read_table(
+        root,
+        "annotations",
+        ["clip_id", "frame", "pedestrian", "state", "crossing", "look", "action", "gesture", "reaction"],
+    )
     events = read_table(root, "events", ["clip_id", "kind"])
 
     split_of = clips.select(["clip_id", "split"])
@@ -118,6 +122,15 @@ def recompute(root: Path) -> dict:
         "weathers": sorted(set(clips["weather"].to_pylist())),
         "rejected": rejected,
         "contacts": int(pc.sum(pc.cast(pc.equal(events["kind"], "contact"), pa.int64())).as_py() or 0),
+        "looking_samples": int(pc.sum(pc.cast(ann["look"], pa.int64())).as_py() or 0),
+        "walking_samples": int(pc.sum(pc.cast(pc.equal(ann["action"], "walking"), pa.int64())).as_py() or 0),
+        "gesture_samples": {k: v for k, v in counts_by(ann, "gesture").items() if k != "none"},
+        "gesturing_pedestrians": {
+            k: v
+            for k, v in counts_by(ann.group_by(["clip_id", "pedestrian", "gesture"]).aggregate([]), "gesture").items()
+            if k != "none"
+        },
+        "reaction_samples": {k: v for k, v in counts_by(ann, "reaction").items() if k != "none"},
     }
 
 
@@ -152,6 +165,8 @@ def compare(mine: dict, stats: dict) -> Checker:
     c.equal("weathers", mine["weathers"], stats.get("weathers"))
     c.equal("contacts", mine["contacts"], stats.get("contacts"))
     c.equal("rejected", mine["rejected"], stats.get("rejected"))
+    for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples"]:
+        c.equal(key, mine[key], stats.get(key))
     their_counts = stats.get("state_samples")
     if their_counts is not None:
         c.equal("states with samples", sorted(mine["state_samples"]), sorted(their_counts))

@@ -514,6 +514,16 @@ impl Validator<'_> {
                 "a speed multiplier",
             );
         }
+        let g = &p.gestures;
+        self.probability(
+            "pedestrians.gestures.acknowledge_probability",
+            g.acknowledge_probability,
+        );
+        self.probability("pedestrians.gestures.nod_share", g.nod_share);
+        self.probability(
+            "pedestrians.gestures.wave_through_probability",
+            g.wave_through_probability,
+        );
     }
 
     fn crossing(&mut self, c: &Crossing) {
@@ -1026,6 +1036,12 @@ impl Validator<'_> {
             0.0,
             300.0,
             "a number of frames",
+        );
+        self.positive(
+            "annotations.look_cone_deg",
+            a.look_cone_deg,
+            90.0,
+            "the half-angle of the cone around the gaze in which the camera counts as looked at, degrees",
         );
     }
 

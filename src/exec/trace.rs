@@ -115,6 +115,65 @@ pub struct PedFrame {
     pub gait_phase: f64,
     /// Whether the pedestrian is using a phone.
     pub on_phone: bool,
+    /// The gesture being made to the ego's driver, with the time since it began, seconds.
+    pub gesture: Option<(Gesture, f64)>,
+    /// The pedestrian's reaction to a vehicle, in JAAD's terms.
+    pub reaction: Option<Reaction>,
+}
+
+/// A gesture to the ego's driver (PIE's `gesture` labels; DATASET.md maps them to JAAD's).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Gesture {
+    /// A raised hand acknowledging (thanking) a driver who yields.
+    HandAck,
+    /// A wave of the hand letting the driver go first.
+    HandYield,
+    /// A nod acknowledging a driver who yields.
+    Nod,
+}
+
+impl Gesture {
+    /// The gesture's name as written in tables (PIE's words).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::HandAck => "hand_ack",
+            Self::HandYield => "hand_yield",
+            Self::Nod => "nod",
+        }
+    }
+
+    /// How long the gesture lasts, seconds.
+    pub fn duration_s(self) -> f64 {
+        match self {
+            Self::HandAck => 1.2,
+            Self::HandYield => 1.6,
+            Self::Nod => 0.8,
+        }
+    }
+}
+
+/// A pedestrian's reaction to a vehicle (JAAD's `reaction` labels).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Reaction {
+    /// Steps back out of the vehicle's path (a retreat).
+    ClearPath,
+    /// Hurries (running across because a vehicle approaches).
+    SpeedUp,
+    /// Stops on the road for a vehicle (a lookahead conflict).
+    SlowDown,
+}
+
+impl Reaction {
+    /// The reaction's name as written in tables (JAAD's words).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::ClearPath => "clear_path",
+            Self::SpeedUp => "speed_up",
+            Self::SlowDown => "slow_down",
+        }
+    }
 }
 
 /// Something that happened in a clip.

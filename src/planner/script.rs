@@ -8,12 +8,12 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::dsl::types::{
-    Body, GapAcceptance, Idm, Lookahead, Patience, Range, Retreat, Rgb, Spec, SpeedProfiles, Split, Visibility,
-    WeatherParams,
+    Body, GapAcceptance, Gestures, Idm, Lookahead, Patience, Range, Retreat, Rgb, Spec, SpeedProfiles, Split,
+    Visibility, WeatherParams,
 };
 
 /// Version of the plan format.
-pub const PLAN_FORMAT_VERSION: u32 = 4;
+pub const PLAN_FORMAT_VERSION: u32 = 5;
 
 /// A compiled dataset: the clip scripts in a stable order (town, weather, index).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,6 +68,8 @@ pub struct SimParams {
     pub camera: Rgb,
     /// The visibility gate, as the simulation estimates what the camera sees.
     pub visibility: Visibility,
+    /// Gestures to the ego's driver.
+    pub gestures: Gestures,
 }
 
 impl SimParams {
@@ -83,6 +85,7 @@ impl SimParams {
             speed_profiles: spec.pedestrians.speed_profiles.clone(),
             camera: spec.sensors.rgb.clone(),
             visibility: spec.annotations.visibility.clone(),
+            gestures: spec.pedestrians.gestures.clone(),
         }
     }
 }

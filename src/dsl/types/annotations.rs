@@ -14,6 +14,9 @@ pub struct Annotations {
     pub crossing_label_smoothing_frames: u32,
     /// Keypoint format of the `keypoints` and `keypoints_3d` columns.
     pub pose_format: PoseFormat,
+    /// A pedestrian is `look`ing at the ego when its gaze (the head's forward direction) is within this angle
+    /// of the direction from its eyes to the camera, degrees.
+    pub look_cone_deg: f64,
 }
 
 impl Default for Annotations {
@@ -22,6 +25,7 @@ impl Default for Annotations {
             visibility: Visibility::default(),
             crossing_label_smoothing_frames: 5,
             pose_format: PoseFormat::Coco17,
+            look_cone_deg: 30.0,
         }
     }
 }

@@ -21,6 +21,8 @@ pub struct Pedestrians {
     pub archetypes: BTreeMap<String, Archetype>,
     /// Situational speed profiles.
     pub speed_profiles: SpeedProfiles,
+    /// Gestures to the ego's driver.
+    pub gestures: Gestures,
 }
 
 impl Default for Pedestrians {
@@ -34,6 +36,7 @@ impl Default for Pedestrians {
                 .collect(),
             archetypes: archetypes.into_iter().map(|(name, (_, a))| (name, a)).collect(),
             speed_profiles: SpeedProfiles::default(),
+            gestures: Gestures::default(),
         }
     }
 }
@@ -183,6 +186,33 @@ impl Archetype {
                 ),
             ),
         ])
+    }
+}
+
+/// Gestures to the ego's driver (PIE's `gesture` labels). The paper lists gaze-based communication as future
+/// work; these are pedsynth's. Each pedestrian gestures at most once per clip, decided by a draw that is a pure
+/// function of the clip seed and the pedestrian (so gestures never shift any other random draw), and only when
+/// the ego yields: it is ahead, within 30 m and slower than 3 m/s. A pedestrian on the phone does not gesture.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Gestures {
+    /// Probability that a crosser stepping out in front of a yielding ego acknowledges the driver (a raised
+    /// hand, `hand_ack`, or a nod).
+    pub acknowledge_probability: f64,
+    /// Share of those acknowledgements that are a nod rather than a raised hand.
+    pub nod_share: f64,
+    /// Probability that a pedestrian at the curb who will not cross (a hard negative) waves a yielding ego on
+    /// (`hand_yield`).
+    pub wave_through_probability: f64,
+}
+
+impl Default for Gestures {
+    fn default() -> Self {
+        Gestures {
+            acknowledge_probability: 0.3,
+            nod_share: 0.3,
+            wave_through_probability: 0.5,
+        }
     }
 }
 

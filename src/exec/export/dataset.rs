@@ -21,6 +21,14 @@ pub struct AnnotatedFrame {
     /// Crossing label C.
     pub crossing: bool,
     pub state: String,
+    /// Looks at the ego's camera (the table's `look`).
+    pub look: bool,
+    /// `walking` or `standing` (the table's `action`).
+    pub action: String,
+    /// `none`, `hand_ack`, `hand_yield` or `nod` (the table's `gesture`).
+    pub gesture: String,
+    /// `none`, `clear_path`, `speed_up` or `slow_down` (the table's `reaction`).
+    pub reaction: String,
     pub occlusion: f32,
     /// Ground speed, m/s.
     pub speed_mps: f32,
@@ -345,6 +353,10 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         "box3d_width_m",
         "box3d_height_m",
         "keypoints",
+        "look",
+        "action",
+        "gesture",
+        "reaction",
     ];
     for b in tables::read(&file("annotations"), &cols)? {
         let (frame, ped) = (b.u32s("frame")?, b.u32s("pedestrian")?);
@@ -354,6 +366,8 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         let (yaw, distance) = (b.f32s("yaw_rad")?, b.f32s("distance_to_ego_m")?);
         let box3d: Vec<_> = cols[15..21].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
         let (kp, width) = b.f32_lists("keypoints")?;
+        let (look, action) = (b.bools("look")?, b.strings("action")?);
+        let (gesture, reaction) = (b.strings("gesture")?, b.strings("reaction")?);
         for i in 0..b.rows() {
             let p = clip.pedestrians.get_mut(&ped.value(i)).ok_or_else(|| {
                 refuse(format!(
@@ -367,6 +381,10 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
                 bbox_px: [bbox[0].value(i), bbox[1].value(i), bbox[2].value(i), bbox[3].value(i)],
                 crossing: crossing.value(i),
                 state: state[i].to_owned(),
+                look: look.value(i),
+                action: action[i].to_owned(),
+                gesture: gesture[i].to_owned(),
+                reaction: reaction[i].to_owned(),
                 occlusion: occlusion.value(i),
                 speed_mps: vx.value(i).hypot(vy.value(i)),
                 x_m: x.value(i),

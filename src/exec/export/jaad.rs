@@ -148,15 +148,23 @@ fn write_video(
         x.push_str("<track label=\"pedestrian\">\n");
         for f in &p.frames {
             let b = f.bbox_px;
-            let Labels { look, action, cross } = Labels::of(f);
+            let Labels {
+                look,
+                action,
+                cross,
+                hand_gesture,
+                nod,
+                reaction,
+                ..
+            } = Labels::of(f);
             let _ = writeln!(
                 x,
                 "<box frame=\"{}\" keyframe=\"1\" occluded=\"{}\" outside=\"0\" xbr=\"{:.2}\" xtl=\"{:.2}\" ybr=\"{:.2}\" \
                  ytl=\"{:.2}\"><attribute name=\"id\">{id}</attribute><attribute name=\"old_id\">pedestrian</attribute>\
-                 <attribute name=\"look\">{look}</attribute><attribute name=\"reaction\">__undefined__</attribute>\
+                 <attribute name=\"look\">{look}</attribute><attribute name=\"reaction\">{reaction}</attribute>\
                  <attribute name=\"action\">{action}</attribute><attribute name=\"cross\">{cross}</attribute>\
-                 <attribute name=\"hand_gesture\">__undefined__</attribute><attribute name=\"occlusion\">{}</attribute>\
-                 <attribute name=\"nod\">__undefined__</attribute></box>",
+                 <attribute name=\"hand_gesture\">{hand_gesture}</attribute><attribute name=\"occlusion\">{}</attribute>\
+                 <attribute name=\"nod\">{nod}</attribute></box>",
                 f.frame,
                 u8::from(f.occlusion >= 0.25),
                 b[2],

@@ -94,37 +94,47 @@ pub fn occlusion_class(fraction: f32) -> &'static str {
     }
 }
 
-/// Walking from this ground speed up, m/s.
-pub const WALKING_MPS: f32 = 0.3;
-
-/// States in which a pedestrian is looking (at the traffic, so at the ego among the rest).
-pub(crate) const LOOKING_STATES: [&str; 3] = ["LOOKING_AROUND", "CHECKING_TRAFFIC", "HESITATING"];
-
-/// The per-frame behaviour labels PIE and JAAD share, in their words.
+/// The per-frame behaviour labels of PIE and JAAD, in their words, from the `annotations` table (DATASET.md
+/// maps each to its definition in those datasets).
 pub struct Labels {
-    /// `looking` in the states that look at the traffic, `not-looking` otherwise.
+    /// `looking` or `not-looking` (the table's `look`).
     pub look: &'static str,
-    /// `walking` from [`WALKING_MPS`] up, `standing` below.
+    /// `walking` or `standing` (the table's `action`).
     pub action: &'static str,
     /// `crossing` when C = 1, `not-crossing` otherwise.
     pub cross: &'static str,
+    /// PIE's `gesture`: the table's gesture (`hand_ack`, `hand_yield`, `nod`) or `__undefined__`.
+    pub gesture: &'static str,
+    /// JAAD's `hand_gesture`: `greet` for an acknowledging hand, `yield` for a wave-through, or `__undefined__`.
+    pub hand_gesture: &'static str,
+    /// JAAD's `nod`: `nodding` or `__undefined__`.
+    pub nod: &'static str,
+    /// JAAD's `reaction`: the table's reaction (`clear_path`, `speed_up`, `slow_down`) or `__undefined__`.
+    pub reaction: &'static str,
 }
 
 impl Labels {
     /// The labels of an annotated frame.
     pub fn of(f: &super::dataset::AnnotatedFrame) -> Labels {
+        let (gesture, hand_gesture, nod) = match f.gesture.as_str() {
+            "hand_ack" => ("hand_ack", "greet", "__undefined__"),
+            "hand_yield" => ("hand_yield", "yield", "__undefined__"),
+            "nod" => ("nod", "__undefined__", "nodding"),
+            _ => ("__undefined__", "__undefined__", "__undefined__"),
+        };
         Labels {
-            look: if LOOKING_STATES.contains(&f.state.as_str()) {
-                "looking"
-            } else {
-                "not-looking"
-            },
-            action: if f.speed_mps >= WALKING_MPS {
-                "walking"
-            } else {
-                "standing"
-            },
+            look: if f.look { "looking" } else { "not-looking" },
+            action: if f.action == "walking" { "walking" } else { "standing" },
             cross: if f.crossing { "crossing" } else { "not-crossing" },
+            gesture,
+            hand_gesture,
+            nod,
+            reaction: match f.reaction.as_str() {
+                "clear_path" => "clear_path",
+                "speed_up" => "speed_up",
+                "slow_down" => "slow_down",
+                _ => "__undefined__",
+            },
         }
     }
 }
@@ -286,13 +296,19 @@ fn write_video(
         let _ = writeln!(x, "  <track label=\"pedestrian\">");
         for f in &p.frames {
             let b = f.bbox_px;
-            let Labels { look, action, cross } = Labels::of(f);
+            let Labels {
+                look,
+                action,
+                cross,
+                gesture,
+                ..
+            } = Labels::of(f);
             let _ = writeln!(
                 x,
                 "    <box frame=\"{}\" keyframe=\"1\" occluded=\"{}\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
                  xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{id}</attribute>\n      \
                  <attribute name=\"occlusion\">{}</attribute>\n      <attribute name=\"action\">{action}</attribute>\n      \
-                 <attribute name=\"gesture\">__undefined__</attribute>\n      <attribute name=\"look\">{look}</attribute>\n      \
+                 <attribute name=\"gesture\">{gesture}</attribute>\n      <attribute name=\"look\">{look}</attribute>\n      \
                  <attribute name=\"cross\">{cross}</attribute>\n    </box>",
                 f.frame,
                 u8::from(f.occlusion >= 0.25),

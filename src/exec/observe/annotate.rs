@@ -7,6 +7,10 @@
 //! leaves the driving lane while still in a crossing-type state (shoulders, parking strips, lane seams).
 //! Sequence label (JAAD/PIE): a crosser has C = 1 in at least one annotated frame. TTE counts the frames until
 //! the first C = 1 (0 at that frame, null after it and for pedestrians that never cross).
+//!
+//! Behaviour labels in PIE's and JAAD's terms: `look` (the head's gaze within `look_cone_deg` of the direction
+//! to the camera), `action` (walking from 0.3 m/s), the gesture and the reaction the trace records, and the
+//! gaze direction itself.
 
 use glam::{DVec2, DVec3};
 
@@ -15,7 +19,7 @@ use super::rig::{Camera, CameraPose};
 use super::scene;
 use crate::dsl::types::{Annotations, BoxSize};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
-use crate::exec::trace::{ClipTrace, Event, PedFrame, PedState};
+use crate::exec::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction};
 use crate::planner::ClipScript;
 use crate::world::{LaneType, RoadNetwork};
 
@@ -72,6 +76,26 @@ pub struct AnnotationRow {
     pub box3d_centre_m: [f32; 3],
     /// Extents of the 3D box (length, width, height), metres.
     pub box3d_size_m: [f32; 3],
+    /// Whether the pedestrian looks at the ego's camera ([`looks_at`]).
+    pub look: bool,
+    /// Whether it walks (ground speed at least [`WALKING_MPS`]) rather than stands.
+    pub walking: bool,
+    /// The gesture it makes to the ego's driver.
+    pub gesture: Option<Gesture>,
+    /// Its reaction to a vehicle.
+    pub reaction: Option<Reaction>,
+    /// The head's forward direction in the world (unit vector).
+    pub gaze: [f32; 3],
+}
+
+/// A pedestrian moving at least this fast walks (PIE's and JAAD's `action`), m/s.
+pub const WALKING_MPS: f64 = 0.3;
+
+/// Whether a head at `eyes` looking along the unit vector `gaze` looks at `target`: the angle between `gaze`
+/// and the direction to `target` is at most `cone_deg`.
+pub fn looks_at(gaze: DVec3, eyes: DVec3, target: DVec3, cone_deg: f64) -> bool {
+    let to_target = (target - eyes).normalize_or_zero();
+    to_target != DVec3::ZERO && gaze.dot(to_target) >= cone_deg.to_radians().cos()
 }
 
 /// Per-pedestrian results over the whole clip.
@@ -463,6 +487,16 @@ pub fn annotate(
                 lane_type: f.lane_type,
                 box3d_centre_m: [box_centre.x as f32, box_centre.y as f32, box_centre.z as f32],
                 box3d_size_m: [box_size.x as f32, box_size.y as f32, box_size.z as f32],
+                look: looks_at(
+                    pose.gaze,
+                    (pose.joints[1] + pose.joints[2]) * 0.5,
+                    cam.centre,
+                    annotations.look_cone_deg,
+                ),
+                walking: f.velocity.length() >= WALKING_MPS,
+                gesture: f.gesture.map(|g| g.0),
+                reaction: f.reaction,
+                gaze: pose.gaze.to_array().map(|x| x as f32),
             });
         }
     }
@@ -474,6 +508,21 @@ pub fn annotate(
 mod tests {
     use super::*;
 
+    #[test]
+    fn looks_at_is_a_cone_around_the_gaze() {
+        let eyes = DVec3::new(0.0, 0.0, 1.6);
+        let x = DVec3::X;
+        assert!(looks_at(x, eyes, DVec3::new(10.0, 0.0, 1.6), 30.0));
+        // 29° and 31° to the left, and 29° above.
+        let at = |deg: f64| DVec3::new(10.0 * deg.to_radians().cos(), 10.0 * deg.to_radians().sin(), 1.6);
+        assert!(looks_at(x, eyes, at(29.0), 30.0));
+        assert!(!looks_at(x, eyes, at(31.0), 30.0));
+        let up = DVec3::new(10.0, 0.0, 1.6 + 10.0 * 29f64.to_radians().tan());
+        assert!(looks_at(x, eyes, up, 30.0));
+        assert!(!looks_at(x, eyes, DVec3::new(-10.0, 0.0, 1.6), 90.0), "behind the head");
+        assert!(!looks_at(x, eyes, eyes, 30.0), "no direction to oneself");
+    }
+
     fn frame(state: PedState, lane: Option<LaneType>) -> PedFrame {
         PedFrame {
             pos: DVec3::ZERO,
@@ -484,6 +533,8 @@ mod tests {
             head_yaw_rad: 0.0,
             gait_phase: 0.0,
             on_phone: false,
+            gesture: None,
+            reaction: None,
         }
     }
 

@@ -1,6 +1,6 @@
 //! Articulated pedestrian body: COCO-17 joints and a capsule silhouette, animated from the simulation trace
 //! (gait phase and speed for walking, running and standing; head yaw for scanning and traffic checks; a phone
-//! pose when distracted).
+//! pose when distracted; gestures to the driver: a raised hand, a wave, a nod), and the head's gaze direction.
 //!
 //! Built in the body frame (x forward, y left, z up; origin on the ground under the body's centre) from
 //! anthropometric proportions of the body height, then placed in the world by the pedestrian's position and
@@ -11,7 +11,7 @@ use std::f64::consts::TAU;
 use glam::{DMat3, DVec3};
 
 use crate::dsl::types::PoseFormat;
-use crate::exec::trace::PedFrame;
+use crate::exec::trace::{Gesture, PedFrame};
 
 /// COCO-17 keypoint names, in COCO order.
 pub const COCO17: [&str; 17] = [
@@ -113,6 +113,8 @@ pub struct BodyPose {
     pub ground: DVec3,
     /// Body yaw.
     pub yaw_rad: f64,
+    /// The head's forward direction in the world (unit): where the pedestrian looks.
+    pub gaze: DVec3,
 }
 
 impl BodyPose {
@@ -138,6 +140,10 @@ impl BodyPose {
 
 /// Where a parent's child walks, in the parent's body frame, metres (beside the parent, on its left).
 pub const CHILD_OFFSET_M: DVec3 = DVec3::new(0.0, 0.55, 0.0);
+
+/// Head pitch of a pedestrian reading a phone, radians (≈ 34° down; literature: neck flexion while texting is
+/// 30–50°, Hansraj 2014).
+pub const PHONE_HEAD_PITCH_RAD: f64 = 0.6;
 
 /// Speed below which a pedestrian stands, m/s.
 const STAND_MPS: f64 = 0.15;
@@ -196,13 +202,36 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     let mut head_pitch = 0.0;
     if frame.on_phone {
         r_wrist = DVec3::new(0.25 * h * 0.8, -0.02 * h, 0.72 * h);
-        head_pitch = 0.45;
+        head_pitch = PHONE_HEAD_PITCH_RAD;
     }
-    let r_elbow = if frame.on_phone {
+    let mut r_elbow = if frame.on_phone {
         DVec3::new(0.06 * h, -shoulder_y, 0.66 * h)
     } else {
         r_elbow
     };
+    // Gestures to the driver: the right hand raised (acknowledging) or waving the car on, or a nod; the arm
+    // blends in and out of the walking swing over a quarter of a second.
+    if let Some((gesture, t)) = frame.gesture {
+        let blend = ((t / 0.25).min((gesture.duration_s() - t) / 0.25)).clamp(0.0, 1.0);
+        let blend = blend * blend * (3.0 - 2.0 * blend);
+        let raised = match gesture {
+            Gesture::HandAck => Some((DVec3::new(0.35, -0.6, 0.25), DVec3::new(0.15, 0.0, 1.0))),
+            Gesture::HandYield => {
+                let sweep = (TAU * 1.2 * t).sin();
+                Some((DVec3::new(0.6, -0.6, -0.1), DVec3::new(0.8, -0.3 + 0.6 * sweep, 0.1)))
+            }
+            Gesture::Nod => {
+                head_pitch += 0.35 * blend * (std::f64::consts::PI * t / 0.4).sin().powi(2);
+                None
+            }
+        };
+        if let Some((upper_dir, fore_dir)) = raised {
+            let elbow = r_shoulder + upper_dir.normalize() * upper;
+            let wrist = elbow + fore_dir.normalize() * fore;
+            r_elbow = r_elbow.lerp(elbow, blend);
+            r_wrist = r_wrist.lerp(wrist, blend);
+        }
+    }
 
     // Head: turned by the head yaw about the neck, pitched down when reading a phone.
     let neck = DVec3::new(0.0, 0.0, 0.87 * h);
@@ -253,6 +282,7 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
         height_m,
         ground: to_world(DVec3::ZERO),
         yaw_rad: frame.yaw_rad,
+        gaze: rot * head_rot * DVec3::X,
     }
 }
 
@@ -272,6 +302,8 @@ mod tests {
             head_yaw_rad: 0.0,
             gait_phase: phase,
             on_phone: false,
+            gesture: None,
+            reaction: None,
         }
     }
 
@@ -298,6 +330,65 @@ mod tests {
         let l = (p.joints[15] - p.joints[11]).truncate().dot(fwd);
         let r = (p.joints[16] - p.joints[12]).truncate().dot(fwd);
         assert!(l > 0.1 && r < -0.1, "left ankle forward, right back: {l} {r}");
+    }
+
+    /// The gaze's heading equals the heading from the ears' midpoint to the nose (the keypoints show where the
+    /// head looks), for any head yaw and with the phone's pitch; reading a phone looks down by its pitch.
+    #[test]
+    fn the_gaze_follows_the_head_keypoints() {
+        for (head_yaw, on_phone) in [(0.0, false), (0.7, false), (-1.2, false), (0.4, true)] {
+            let mut f = frame(1.0, 0.3);
+            f.head_yaw_rad = head_yaw;
+            f.on_phone = on_phone;
+            let p = pose(&f, 1.7, DVec3::ZERO);
+            assert!((p.gaze.length() - 1.0).abs() < 1e-12);
+            let nose_dir = p.joints[0] - (p.joints[3] + p.joints[4]) * 0.5;
+            let heading = |v: DVec3| v.y.atan2(v.x);
+            assert!(
+                (heading(p.gaze) - heading(nose_dir)).abs() < 1e-9,
+                "yaw {head_yaw}: gaze {} vs nose {}",
+                heading(p.gaze),
+                heading(nose_dir)
+            );
+            assert!((heading(p.gaze) - (f.yaw_rad + head_yaw)).abs() < 1e-9);
+            let down = (-p.gaze.z).asin();
+            let want = if on_phone { PHONE_HEAD_PITCH_RAD } else { 0.0 };
+            assert!((down - want).abs() < 1e-9, "pitch {down} vs {want}");
+        }
+    }
+
+    /// A raised hand puts the right wrist above the head in the middle of the gesture and returns it to the
+    /// walking swing at its end; a wave-through holds the arm out in front at shoulder height; a nod pitches
+    /// the head down and leaves the arms alone.
+    #[test]
+    fn gestures_move_the_right_arm_or_the_head() {
+        let h = 1.7;
+        let plain = pose(&frame(0.0, 0.0), h, DVec3::ZERO);
+        let at = |g: Gesture, t: f64| {
+            let mut f = frame(0.0, 0.0);
+            f.gesture = Some((g, t));
+            pose(&f, h, DVec3::ZERO)
+        };
+        let up = at(Gesture::HandAck, 0.6);
+        assert!(up.joints[10].z > up.joints[0].z, "wrist above the nose");
+        assert_eq!(up.joints[9], plain.joints[9], "the left wrist does not move");
+        let end = at(Gesture::HandAck, Gesture::HandAck.duration_s());
+        assert!(
+            end.joints[10].distance(plain.joints[10]) < 1e-9,
+            "back to the swing at the end"
+        );
+        let wave = at(Gesture::HandYield, 0.8);
+        let fwd = (wave.joints[10] - wave.joints[6])
+            .truncate()
+            .dot(glam::DVec2::from_angle(0.3));
+        assert!(fwd > 0.2 * h, "the hand is held out in front: {fwd}");
+        assert!(
+            (wave.joints[10].z - wave.joints[6].z).abs() < 0.1 * h,
+            "at shoulder height"
+        );
+        let nod = at(Gesture::Nod, 0.2);
+        assert!(nod.gaze.z < -0.3, "nodding looks down: {}", nod.gaze.z);
+        assert_eq!(nod.joints[10], plain.joints[10]);
     }
 
     #[test]

@@ -1004,6 +1004,11 @@ fn lerp_ped(a: &PedFrame, b: &PedFrame, t: f64) -> PedFrame {
     let mut dp = b.gait_phase - a.gait_phase;
     dp -= dp.round();
     out.gait_phase = (a.gait_phase + dp * t).rem_euclid(1.0);
+    if let (Some((ga, ta)), Some((gb, tb))) = (a.gesture, b.gesture)
+        && ga == gb
+    {
+        out.gesture = Some((ga, ta + (tb - ta) * t));
+    }
     out
 }
 
@@ -1112,7 +1117,8 @@ impl FrameScene {
             let pose = body::pose(&frame, ps.identity.height_m, DVec3::ZERO);
             self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id));
             if let (Some(child), Some(child_outfit)) = (&ps.child, child_outfit) {
-                let pose = body::pose(&frame, child.height_m, CHILD_OFFSET_M);
+                let child_frame = PedFrame { gesture: None, ..frame };
+                let pose = body::pose(&child_frame, child.height_m, CHILD_OFFSET_M);
                 let inst = CHILD_INSTANCE_BASE.saturating_add(ps.id.min(16_383) as u16);
                 self.push_body(stat, &pose, child_outfit, inst);
             }

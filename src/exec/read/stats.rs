@@ -79,6 +79,20 @@ pub struct DatasetStats {
     pub state_samples: BTreeMap<String, u64>,
     /// Annotated samples with C = 1.
     pub crossing_samples: u64,
+    /// Annotated samples in which the pedestrian looks at the ego's camera (`look`).
+    pub looking_samples: u64,
+    /// looking_samples / annotated_samples.
+    pub looking_share: f64,
+    /// Annotated samples in which the pedestrian walks (`action` = walking).
+    pub walking_samples: u64,
+    /// walking_samples / annotated_samples.
+    pub walking_share: f64,
+    /// Annotated samples per gesture (`hand_ack`, `hand_yield`, `nod`; none left out).
+    pub gesture_samples: BTreeMap<String, u64>,
+    /// Pedestrians seen making each gesture in at least one annotated frame.
+    pub gesturing_pedestrians: BTreeMap<String, u64>,
+    /// Annotated samples per reaction (`clear_path`, `speed_up`, `slow_down`; none left out).
+    pub reaction_samples: BTreeMap<String, u64>,
     /// Per archetype.
     pub archetypes: BTreeMap<String, ArchetypeStats>,
     /// Per split.
@@ -179,17 +193,39 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.crossers += u64::from(crosser);
             }
         }
+        let mut gestured = std::collections::BTreeSet::new();
         for b in tables::read(
             &layout.table("annotations", &clip_id),
-            &["pedestrian", "state", "crossing", "vx_mps", "vy_mps"],
+            &[
+                "pedestrian",
+                "state",
+                "crossing",
+                "vx_mps",
+                "vy_mps",
+                "look",
+                "action",
+                "gesture",
+                "reaction",
+            ],
         )? {
             let ped = b.u32s("pedestrian")?;
             let state = b.strings("state")?;
             let crossing = b.bools("crossing")?;
             let (vx, vy) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?);
+            let (look, action) = (b.bools("look")?, b.strings("action")?);
+            let (gesture, reaction) = (b.strings("gesture")?, b.strings("reaction")?);
             for (i, state) in state.iter().enumerate() {
                 *states.entry((*state).to_owned()).or_default() += 1;
                 s.crossing_samples += u64::from(crossing.value(i));
+                s.looking_samples += u64::from(look.value(i));
+                s.walking_samples += u64::from(action[i] == "walking");
+                if gesture[i] != "none" {
+                    *s.gesture_samples.entry(gesture[i].to_owned()).or_default() += 1;
+                    gestured.insert((gesture[i].to_owned(), ped.value(i)));
+                }
+                if reaction[i] != "none" {
+                    *s.reaction_samples.entry(reaction[i].to_owned()).or_default() += 1;
+                }
                 let speed = f64::from(vx.value(i)).hypot(f64::from(vy.value(i)));
                 if speed > 0.2
                     && let Some(a) = archetype_of.get(ped.value(i) as usize)
@@ -199,6 +235,9 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                     e.1 += 1;
                 }
             }
+        }
+        for (g, _) in gestured {
+            *s.gesturing_pedestrians.entry(g).or_default() += 1;
         }
     }
     s.non_crossing = s.pedestrians - s.crossing;
@@ -210,6 +249,8 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     s.mean_frames_per_clip = ratio(s.frames, s.clips);
     s.mean_duration_s = if s.clips == 0 { 0.0 } else { duration_s / s.clips as f64 };
     s.samples_per_clip = ratio(s.annotated_samples, s.clips);
+    s.looking_share = ratio(s.looking_samples, s.annotated_samples);
+    s.walking_share = ratio(s.walking_samples, s.annotated_samples);
     let total: u64 = states.values().sum();
     s.state_shares = states.iter().map(|(k, v)| (k.clone(), ratio(*v, total))).collect();
     s.state_samples = states;
@@ -278,6 +319,26 @@ impl std::fmt::Display for DatasetStats {
         writeln!(o, "\nshare of annotated samples per state")?;
         for (k, v) in &s.state_shares {
             writeln!(o, "  {k:<20} {:6.2}%", 100.0 * v)?;
+        }
+        writeln!(o, "\nbehaviour labels (annotated samples)")?;
+        writeln!(
+            o,
+            "  looking at the ego         {} ({:.1}%)",
+            s.looking_samples,
+            100.0 * s.looking_share
+        )?;
+        writeln!(
+            o,
+            "  walking                    {} ({:.1}%)",
+            s.walking_samples,
+            100.0 * s.walking_share
+        )?;
+        for (k, v) in &s.gesture_samples {
+            let peds = s.gesturing_pedestrians.get(k).copied().unwrap_or(0);
+            writeln!(o, "  gesture {k:<18} {v} ({peds} pedestrians)")?;
+        }
+        for (k, v) in &s.reaction_samples {
+            writeln!(o, "  reaction {k:<17} {v}")?;
         }
         writeln!(
             o,

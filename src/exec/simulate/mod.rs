@@ -16,7 +16,9 @@
 //!    pedestrians in its path ahead, the ego's braking rule), all computed before any moves;
 //! 6. **integrate** the vehicles along their paths;
 //! 7. **contact check**: a pedestrian disc overlapping a vehicle footprint, or two overlapping footprints, is an
-//!    [`Event::Contact`]; the vehicle is stopped (and moved back) so that nothing overlaps in the next frame.
+//!    [`Event::Contact`]; the vehicle is stopped (and moved back) so that nothing overlaps in the next frame;
+//! 8. **gestures and heads**: each pedestrian's gesture advances, ends or starts (when the ego yields to it),
+//!    then its head turns (to the ego while gesturing). Neither changes any motion.
 //!
 //! Events carry the first frame whose recorded state reflects them (a transition decided in step `f` is an
 //! event of frame `f + 1`; a mid-road jaywalker's injection is a decision at frame 0).
@@ -25,7 +27,8 @@
 //!
 //! Each pedestrian draws from its own stream, `clip_rng(seed, "sim/ped/{id}")`, in program order (constants at
 //! set-up, then one draw per retreat conflict, patience expiry, scan or abandonment), so adding draws for one
-//! pedestrian never shifts another's. Vehicles draw nothing. One clip runs on one thread; [`simulate_all`]
+//! pedestrian never shifts another's; its two gesture draws come from `clip_rng(seed, "sim/ped/{id}/gesture")`
+//! at set-up, so gestures (which change no motion) shift no behaviour draw. Vehicles draw nothing. One clip runs on one thread; [`simulate_all`]
 //! runs clips in parallel with rayon and returns them in plan order, identical for any thread count.
 
 mod contacts;
@@ -135,7 +138,8 @@ impl<'a> Sim<'a> {
             .iter()
             .map(|p| {
                 let rng = seeds::clip_rng(script.seed, &format!("sim/ped/{}", p.id));
-                Ped::new(p, params, net, rng)
+                let gesture_rng = seeds::clip_rng(script.seed, &format!("sim/ped/{}/gesture", p.id));
+                Ped::new(p, params, net, rng, gesture_rng)
             })
             .collect();
         // A pedestrian's place along the ego's route is its planned distance ahead of the ego's start.
@@ -223,6 +227,8 @@ impl<'a> Sim<'a> {
                 head_yaw_rad: b.head_yaw_rad,
                 gait_phase: b.gait_phase,
                 on_phone: p.on_phone(),
+                gesture: p.gesture,
+                reaction: p.reaction(),
             });
         }
     }
@@ -353,6 +359,7 @@ impl<'a> Sim<'a> {
 
         let time_s = f64::from(f + 1) * self.dt_s;
         for p in self.peds.iter_mut() {
+            p.update_gesture(self.dt_s, &self.vehicles[0], &self.params.gestures);
             p.update_head(time_s, &self.vehicles);
         }
     }

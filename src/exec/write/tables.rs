@@ -26,7 +26,7 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 5;
+pub const SCHEMA_VERSION: u32 = 6;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
 pub const TABLES: [&str; 9] = [
@@ -349,11 +349,18 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
             field("bbox_y_max", DataType::Float32, false),
             field("crossing", DataType::Boolean, false),
             field("state", DataType::Utf8, false),
+            field("look", DataType::Boolean, false),
+            field("action", DataType::Utf8, false),
+            field("gesture", DataType::Utf8, false),
+            field("reaction", DataType::Utf8, false),
             field("distance_to_ego_m", DataType::Float32, false),
             field("tte_frames", DataType::Int32, true),
             field("occlusion", DataType::Float32, false),
             field("keypoints", list.clone(), false),
             field("keypoints_3d", list, false),
+            field("gaze_x", DataType::Float32, false),
+            field("gaze_y", DataType::Float32, false),
+            field("gaze_z", DataType::Float32, false),
             field("x_m", DataType::Float32, false),
             field("y_m", DataType::Float32, false),
             field("z_m", DataType::Float32, false),
@@ -378,11 +385,24 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
             f32c(|r| r.bbox_px[3]),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.crossing)))),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.state.name()))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.look)))),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| if r.walking { "walking" } else { "standing" }),
+            )),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| r.gesture.map_or("none", |g| g.name())),
+            )),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| r.reaction.map_or("none", |g| g.name())),
+            )),
             f32c(|r| r.distance_m),
             Arc::new(Int32Array::from_iter(rows.iter().map(|r| r.tte_frames))),
             f32c(|r| r.occlusion),
             keypoint_list(rows, format, true, |r| &r.keypoints),
             keypoint_list(rows, format, false, |r| &r.keypoints_3d),
+            f32c(|r| r.gaze[0]),
+            f32c(|r| r.gaze[1]),
+            f32c(|r| r.gaze[2]),
             f32c(|r| r.pos_m[0]),
             f32c(|r| r.pos_m[1]),
             f32c(|r| r.pos_m[2]),

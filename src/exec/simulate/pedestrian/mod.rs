@@ -28,7 +28,7 @@ use rand::RngExt;
 use rand_chacha::ChaCha20Rng;
 
 use crate::dsl::types::SpeedProfileMultipliers;
-use crate::exec::trace::{PedState, PedestrianId};
+use crate::exec::trace::{Gesture, PedState, PedestrianId};
 use crate::planner::{Behaviour, CrosserSource, PedestrianScript, Role, SimParams, SpawnPlace, SpeedProfile};
 use crate::world::{LaneType, RoadNetwork};
 use params::{CHECK_MIN_S, CURB_STANDOFF_M, DISTRACTION_EPISODE_S, FINISH_BEYOND_CURB_M, STANDING_SHARE};
@@ -155,6 +155,9 @@ pub(crate) struct Traits {
     pub in_view_before_crossing_s: Option<f64>,
     /// A hard negative waits at the curb this long before walking on, seconds.
     pub curb_wait_s: Option<f64>,
+    /// Two uniform draws in [0, 1) from the pedestrian's gesture stream: whether it gestures when the occasion
+    /// comes, and which acknowledgement (nod or hand).
+    pub gesture_draws: (f64, f64),
 }
 
 /// The body's kinematics.
@@ -211,6 +214,10 @@ pub(crate) struct Ped {
     pub followers_seen: bool,
     pub percept: Percept,
     pub rng: ChaCha20Rng,
+    /// The gesture it is making and for how long so far, seconds.
+    pub gesture: Option<(Gesture, f64)>,
+    /// Whether its one occasion to gesture has come (and been taken or not).
+    pub gestured: bool,
 }
 
 /// Read-only context of one step.
@@ -224,8 +231,15 @@ pub(crate) struct StepCtx<'a> {
 }
 
 impl Ped {
-    /// Sets a pedestrian up from its script; draws its per-pedestrian constants from its own stream.
-    pub fn new(script: &PedestrianScript, params: &SimParams, net: &RoadNetwork, mut rng: ChaCha20Rng) -> Ped {
+    /// Sets a pedestrian up from its script; draws its per-pedestrian constants from its own stream, and its
+    /// gesture draws from `gesture_rng` (a stream of its own, so gestures shift no other draw).
+    pub fn new(
+        script: &PedestrianScript,
+        params: &SimParams,
+        net: &RoadNetwork,
+        mut rng: ChaCha20Rng,
+        mut gesture_rng: ChaCha20Rng,
+    ) -> Ped {
         let retreat_speed_mps = draw(&mut rng, params.retreat.speed_mps.min(), params.retreat.speed_mps.max());
         let distraction_len_s = draw(&mut rng, DISTRACTION_EPISODE_S.0, DISTRACTION_EPISODE_S.1);
         let standing = rng.random_bool(STANDING_SHARE);
@@ -259,6 +273,7 @@ impl Ped {
                 height_m: script.identity.height_m,
                 in_view_before_crossing_s: script.in_view_before_crossing_s,
                 curb_wait_s: script.curb_wait_s,
+                gesture_draws: (gesture_rng.random::<f64>(), gesture_rng.random::<f64>()),
             },
             body: Body {
                 pos: script.spawn,
@@ -289,6 +304,8 @@ impl Ped {
             followers_seen: true,
             percept: Percept::default(),
             rng,
+            gesture: None,
+            gestured: false,
         };
         if let Some(h) = net.lane_at(p.body.pos) {
             p.body.z_m = h.z_m;

@@ -10,13 +10,16 @@ use rand_chacha::ChaCha20Rng;
 
 use super::machine::LeaderFacts;
 use super::params::{
-    AVOID_RADIUS_M, BRIEF_SCAN_S, CURB_ARRIVAL_M, CURB_SLOWDOWN_M, CURB_SLOWDOWN_MIN, CURB_STANDOFF_M,
-    DISTRACTION_STANDSTILL, FOLLOWER_SPEED_SLACK, FULL_SCAN_S, HEADING_MIN_STEP_M, IDLE_HEAD_SWAY, LINE_OFFSET_KEEP,
-    LOOK_AROUND_HEAD, MAX_HEAD_TURN_RAD, SCAN_INTERVAL_MEAN_S, STRIDE_M, WALKER_MAX_SKIPS, WALKER_NODE_REACHED_M,
+    ACKNOWLEDGE_WINDOW_S, AVOID_RADIUS_M, BRIEF_SCAN_S, CURB_ARRIVAL_M, CURB_SLOWDOWN_M, CURB_SLOWDOWN_MIN,
+    CURB_STANDOFF_M, DISTRACTION_STANDSTILL, FOLLOWER_SPEED_SLACK, FULL_SCAN_S, GESTURE_EGO_MAX_DIST_M,
+    GESTURE_EGO_MAX_SPEED_MPS, HEADING_MIN_STEP_M, IDLE_HEAD_SWAY, LINE_OFFSET_KEEP, LOOK_AROUND_HEAD,
+    MAX_HEAD_TURN_RAD, SCAN_INTERVAL_MEAN_S, STRIDE_M, WALKER_MAX_SKIPS, WALKER_NODE_REACHED_M,
 };
-use super::state::{Activity, Attempt};
+use super::state::{Activity, Attempt, CrossMode, PauseCause};
 use super::{Ped, StepCtx};
+use crate::dsl::types::Gestures;
 use crate::exec::simulate::vehicle::Vehicle;
+use crate::exec::trace::{Gesture, Reaction};
 use crate::world::LaneType;
 
 /// Time until the next attention-driven scan of a walker, seconds (more attentive: more often).
@@ -192,34 +195,94 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
 }
 
 impl Ped {
-    /// Head yaw relative to the body for this frame: scanning sweeps, checks look at the nearest vehicle.
+    /// Head yaw relative to the body for this frame: scanning sweeps, checks look at the nearest vehicle, a
+    /// gesture looks at the ego (`vehicles[0]`).
     pub fn update_head(&mut self, time_s: f64, vehicles: &[Vehicle]) {
+        let pos = self.body.pos;
+        let toward = |v: &Vehicle| {
+            let d = v.pose.pos - pos;
+            wrap(d.y.atan2(d.x) - self.body.yaw_rad).clamp(-MAX_HEAD_TURN_RAD, MAX_HEAD_TURN_RAD)
+        };
         self.body.head_yaw_rad = match self.activity {
+            _ if self.gesture.is_some() => vehicles.first().map_or(0.0, toward),
             Activity::LookingAround => {
                 LOOK_AROUND_HEAD.0 * (std::f64::consts::TAU * LOOK_AROUND_HEAD.1 * self.state_time_s).sin()
             }
             Activity::CheckingTraffic
             | Activity::Hesitating
-            | Activity::Crossing(super::state::CrossMode::RunningAcross)
+            | Activity::Crossing(CrossMode::RunningAcross)
             | Activity::PausingMidCross { .. } => {
-                let pos = self.body.pos;
                 let nearest = vehicles.iter().min_by(|a, b| {
                     a.pose
                         .pos
                         .distance_squared(pos)
                         .total_cmp(&b.pose.pos.distance_squared(pos))
                 });
-                match nearest {
-                    Some(v) => {
-                        let d = v.pose.pos - pos;
-                        wrap(d.y.atan2(d.x) - self.body.yaw_rad).clamp(-MAX_HEAD_TURN_RAD, MAX_HEAD_TURN_RAD)
-                    }
-                    None => 0.0,
-                }
+                nearest.map_or(0.0, toward)
             }
             _ if self.on_phone() => 0.0,
             _ => IDLE_HEAD_SWAY.0 * (time_s * IDLE_HEAD_SWAY.1 + f64::from(self.traits.id.0)).sin(),
         };
+    }
+
+    /// Advances a gesture by `dt_s` and ends it when it is over; starts one the first time the ego yields to
+    /// the pedestrian (ahead, near and slow): an acknowledgement by a crosser that has just stepped out, a
+    /// wave-through by a hard negative checking the traffic at the curb, each with its probability, decided by
+    /// the pedestrian's own gesture draws. At most one gesture per pedestrian; none on the phone.
+    pub fn update_gesture(&mut self, dt_s: f64, ego: &Vehicle, g: &Gestures) {
+        if let Some((kind, elapsed_s)) = &mut self.gesture {
+            *elapsed_s += dt_s;
+            if *elapsed_s >= kind.duration_s() {
+                self.gesture = None;
+            }
+        }
+        if self.on_phone() {
+            // The phone takes the right hand and the eyes.
+            self.gesture = None;
+            return;
+        }
+        if self.gestured {
+            return;
+        }
+        let yielding = self.percept.ego_ahead
+            && ego.speed_mps < GESTURE_EGO_MAX_SPEED_MPS
+            && ego.pose.pos.distance(self.body.pos) < GESTURE_EGO_MAX_DIST_M;
+        if !yielding {
+            return;
+        }
+        let (kind, probability) = match self.activity {
+            Activity::Crossing(CrossMode::CrossingRoad | CrossMode::Jaywalking)
+                if self.state_time_s <= ACKNOWLEDGE_WINDOW_S =>
+            {
+                let kind = if self.traits.gesture_draws.1 < g.nod_share {
+                    Gesture::Nod
+                } else {
+                    Gesture::HandAck
+                };
+                (kind, g.acknowledge_probability)
+            }
+            Activity::CheckingTraffic if self.traits.curb_wait_s.is_some() => {
+                (Gesture::HandYield, g.wave_through_probability)
+            }
+            _ => return,
+        };
+        self.gestured = true;
+        if self.traits.gesture_draws.0 < probability {
+            self.gesture = Some((kind, 0.0));
+        }
+    }
+
+    /// The reaction to a vehicle that the current activity shows (JAAD's `reaction`).
+    pub fn reaction(&self) -> Option<Reaction> {
+        match self.activity {
+            Activity::Crossing(CrossMode::RunningAcross) => Some(Reaction::SpeedUp),
+            Activity::PausingMidCross {
+                cause: PauseCause::Conflict { .. },
+                ..
+            } => Some(Reaction::SlowDown),
+            Activity::Retreat => Some(Reaction::ClearPath),
+            _ => None,
+        }
     }
 }
 

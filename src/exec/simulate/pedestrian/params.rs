@@ -138,6 +138,18 @@ pub const MAX_HEAD_TURN_RAD: f64 = 1.4;
 /// Idle head sway while walking: amplitude (radians) and angular frequency (rad/s). pedsynth.
 pub const IDLE_HEAD_SWAY: (f64, f64) = (0.15, 0.7);
 
+// --- Gestures -------------------------------------------------------------------------------------------------
+
+/// The ego counts as yielding to a pedestrian when it is ahead, nearer than this (metres) and slower than
+/// [`GESTURE_EGO_MAX_SPEED_MPS`]. pedsynth: the distances at which drivers and pedestrians exchange gestures in
+/// naturalistic studies are a few car lengths (Rasouli et al., "Agreeing to cross", 2017, report most
+/// communication within ~30 m).
+pub const GESTURE_EGO_MAX_DIST_M: f64 = 30.0;
+/// See [`GESTURE_EGO_MAX_DIST_M`], m/s. pedsynth: a car at walking pace or stopped.
+pub const GESTURE_EGO_MAX_SPEED_MPS: f64 = 3.0;
+/// A crosser acknowledges a yielding driver only within this long after stepping out, seconds. pedsynth.
+pub const ACKNOWLEDGE_WINDOW_S: f64 = 1.0;
+
 // --- Groups ---------------------------------------------------------------------------------------------------
 
 /// A follower walks a line parallel to its leader's when their own crossing lines point in directions whose
