@@ -1,5 +1,5 @@
 //! Statistical tests of the simulation over thousands of pedestrians planned from the shipped specs: every one
-//! of the 12 states occurs, retreat happens in 15 ± 3 % of eligible in-road conflicts, walking speeds stay within
+//! of the 12 states occurs, walkers scan as often and as long as their archetype's attention says, retreat happens in 15 ± 3 % of eligible in-road conflicts, walking speeds stay within
 //! each archetype's range times its speed profile, planned crossers cross, the CARLA-like baseline gives about
 //! 9 % crossers, and no pedestrian ever overlaps a vehicle.
 //!
@@ -231,4 +231,120 @@ fn carla_baseline_gives_about_nine_percent_crossers() {
     assert!((share - 0.09).abs() <= 0.03, "crossing share {share:.3}");
     assert_eq!(s.overlaps, 0);
     assert_eq!(s.non_crossers_on_road, 0);
+}
+
+/// The attention of an archetype sets how often and how long its walkers scan (LOOKING_AROUND): a walker
+/// starts a scan after an exponential wait of mean `SCAN_INTERVAL_MEAN_S.0 + SCAN_INTERVAL_MEAN_S.1 × (1 −
+/// attention)` counted from the last scan's start, and scans for `BRIEF_SCAN_S.0 + BRIEF_SCAN_S.1 ×
+/// attention`. Measured per archetype over the non-crossers that never use a phone: the walking time per scan
+/// started (the exponential's memorylessness makes this the mean wait whatever the clip cuts off, once the
+/// one-frame walks between back-to-back scans are left out) and the scans' length; and the LOOKING_AROUND
+/// share of their frames against the stationary share these give, `d / (d + m·e^(−d/m))` (within 25 %: clips
+/// start mid-walk, which lowers it a little).
+#[test]
+fn walkers_scan_as_often_and_as_long_as_their_attention_says() {
+    use pedsynth::exec::simulate::behaviour_params::{BRIEF_SCAN_S, SCAN_INTERVAL_MEAN_S};
+    use pedsynth::planner::Behaviour;
+    let (plan, traces) = plan_and_simulate("specs/pedsynth_pp.yaml", &["dataset.clips.count=40"]);
+    // Per archetype: attention, fps, walking frames, scans started, complete scans, their frames, looking
+    // frames, walking + looking frames.
+    #[derive(Default)]
+    struct Walkers {
+        attention: f64,
+        fps: f64,
+        walking_frames: usize,
+        scans: usize,
+        complete_scans: usize,
+        complete_scan_frames: usize,
+        looking_frames: usize,
+        frames: usize,
+    }
+    let mut by_archetype: BTreeMap<String, Walkers> = BTreeMap::new();
+    for (clip, trace) in plan.clips.iter().zip(&traces) {
+        for (i, ps) in clip.pedestrians.iter().enumerate() {
+            let states: Vec<PedState> = trace.pedestrians[i].iter().map(|f| f.state).collect();
+            if ps.role != Role::NonCrosser
+                || ps.behaviour == Behaviour::HardNegative
+                || ps.group.is_some()
+                || states.contains(&PedState::DistractedBehavior)
+            {
+                continue;
+            }
+            assert!(
+                states
+                    .iter()
+                    .all(|s| matches!(s, PedState::WalkingSidewalk | PedState::LookingAround)),
+                "{} ped {}: a walker in another state",
+                clip.clip_id,
+                ps.id
+            );
+            let w = by_archetype.entry(ps.archetype.clone()).or_default();
+            w.attention = ps.attention;
+            w.fps = f64::from(clip.fps);
+            // Spells of one state: (state, first frame, length).
+            let mut spells: Vec<(PedState, usize, usize)> = Vec::new();
+            for (f, s) in states.iter().enumerate() {
+                match spells.last_mut() {
+                    Some(last) if last.0 == *s => last.2 += 1,
+                    _ => spells.push((*s, f, 1)),
+                }
+            }
+            for (k, &(state, _, len)) in spells.iter().enumerate() {
+                let after_scan = k > 0;
+                let ends_in_scan = k + 1 < spells.len();
+                w.frames += len;
+                match state {
+                    PedState::WalkingSidewalk => {
+                        if after_scan && ends_in_scan && len == 1 {
+                            continue; // a back-to-back scan (its wait was shorter than the scan)
+                        }
+                        w.walking_frames += len;
+                        w.scans += usize::from(ends_in_scan);
+                    }
+                    _ => {
+                        w.looking_frames += len;
+                        if ends_in_scan {
+                            w.complete_scans += 1;
+                            w.complete_scan_frames += len;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        by_archetype.len() >= 4,
+        "{} archetypes with walkers",
+        by_archetype.len()
+    );
+    for (name, w) in &by_archetype {
+        let mean_wait_s = SCAN_INTERVAL_MEAN_S.0 + SCAN_INTERVAL_MEAN_S.1 * (1.0 - w.attention);
+        let scan_s = BRIEF_SCAN_S.0 + BRIEF_SCAN_S.1 * w.attention;
+        // Walking time per scan started, after the scan itself (the wait counts from the scan's start).
+        let measured_wait_s = w.walking_frames as f64 / w.fps / w.scans as f64;
+        let se = measured_wait_s / (w.scans as f64).sqrt();
+        let measured_scan_s = w.complete_scan_frames as f64 / w.fps / w.complete_scans as f64;
+        let model_share = scan_s / (scan_s + mean_wait_s * (-scan_s / mean_wait_s).exp());
+        let share = w.looking_frames as f64 / w.frames as f64;
+        println!(
+            "{name:<26} attention {:.2}: wait {measured_wait_s:.2} ± {se:.2} s (model {mean_wait_s:.2}), scan \
+             {measured_scan_s:.3} s (model {scan_s:.3}) over {} scans; LOOKING_AROUND share {:.3} (stationary model \
+             {model_share:.3})",
+            w.attention, w.scans, share
+        );
+        assert!(w.scans >= 100, "{name}: only {} scans", w.scans);
+        assert!(
+            (measured_wait_s - mean_wait_s).abs() <= 4.0 * se,
+            "{name}: mean wait {measured_wait_s:.2} s vs {mean_wait_s:.2} s"
+        );
+        assert!(
+            (share - model_share).abs() <= 0.25 * model_share,
+            "{name}: LOOKING_AROUND share {share:.3} vs {model_share:.3}"
+        );
+        // A scan ends at the first step at or after its length: up to one frame longer.
+        assert!(
+            measured_scan_s >= scan_s - 1e-9 && measured_scan_s <= scan_s + 1.0 / w.fps + 1e-9,
+            "{name}: scans last {measured_scan_s:.3} s vs {scan_s:.3} s"
+        );
+    }
 }
