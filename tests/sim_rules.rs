@@ -96,6 +96,7 @@ fn vehicle(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64, pct: f64, i
         ignores_lights: false,
         ignores_walkers,
         route: route(net, towards_plus_x, x),
+        emergency: None,
     }
 }
 
@@ -825,4 +826,97 @@ fn the_ego_eases_off_and_stops_short_for_a_pedestrian_waiting_at_the_curb() {
     assert!(kind.ego.last().expect("frames").pos.x > 155.0, "drives on");
     assert_eq!(kind.pedestrians[0][moves_on].state, PedState::CheckingTraffic);
     assert_no_interpenetration(&kind);
+}
+
+fn emergency(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64) -> VehicleScript {
+    VehicleScript {
+        emergency: Some(pedsynth::planner::EmergencyKind::Ambulance),
+        ..vehicle(net, id, towards_plus_x, x, -30.0, false)
+    }
+}
+
+#[test]
+fn vehicles_stop_for_an_oncoming_emergency_vehicle_which_drives_above_the_limit() {
+    let net = road();
+    // The ego (towards +x) and a car behind it meet an ambulance coming the other way at 1.3 × the limit.
+    let script = clip(
+        ego_at(&net, 0.0, 0.0),
+        vec![
+            vehicle(&net, 0, true, -20.0, 0.0, false),
+            emergency(&net, 1, false, 150.0),
+        ],
+        vec![],
+        14,
+    );
+    let trace = simulate::simulate(&script, &params(), &net);
+    let limit = 30.0 / 3.6;
+    let ev = &trace.vehicles[1];
+    let ev_speed = ev.iter().map(|f| f.speed_mps).fold(0.0, f64::max);
+    assert!((ev_speed - 1.3 * limit).abs() < 0.1, "ambulance at {ev_speed} m/s");
+    assert!(ev.iter().all(|f| !f.yielding), "the ambulance yields to nobody");
+    // Where they pass each other, the ego and the car behind it stand (or nearly); before the ambulance came
+    // near they drove at the limit, and after it passed they drive on.
+    let pass = (0..trace.ego.len())
+        .find(|&f| ev[f].pos.x < trace.ego[f].pos.x)
+        .expect("the ambulance passes the ego");
+    for (name, frames) in [("ego", &trace.ego), ("car behind", &trace.vehicles[0])] {
+        assert!(frames[0].speed_mps > 0.95 * limit, "{name} starts at the limit");
+        assert!(
+            frames[pass].speed_mps < 0.5,
+            "{name} at {} m/s when passed",
+            frames[pass].speed_mps
+        );
+        assert!(frames[pass].yielding, "{name} yields when passed");
+        let after = frames.len() - 1;
+        assert!(
+            !frames[after].yielding && frames[after].speed_mps > 2.0,
+            "{name} drives on"
+        );
+        // It began to yield only once the ambulance was within 70 m and closing.
+        let first = frames.iter().position(|f| f.yielding).expect("yields");
+        let d = (ev[first - 1].pos - frames[first - 1].pos).truncate().length();
+        assert!(d < 70.0 + 1.0 && d > 60.0, "{name} began to yield {d:.1} m away");
+    }
+    assert_no_interpenetration(&trace);
+}
+
+#[test]
+fn pedestrians_hold_at_the_curb_for_a_siren_and_cross_after_it_passes() {
+    let net = road();
+    // The ego has passed the crosser; a vehicle comes along the far lane towards it. With a small TTC threshold
+    // the gap would be accepted at once; a siren holds the crosser until the vehicle has passed.
+    let run = |siren: bool| {
+        let mut c = crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated);
+        c.ttc_threshold_s = 0.5;
+        c.safety_margin_s = 0.0;
+        let v = if siren {
+            emergency(&net, 0, false, 240.0)
+        } else {
+            vehicle(&net, 0, false, 240.0, -30.0, false)
+        };
+        let script = clip(ego_at(&net, 160.0, 0.0), vec![v], vec![c], 20);
+        simulate::simulate(&script, &params(), &net)
+    };
+    let decision = |t: &ClipTrace| {
+        t.events.iter().find_map(|e| match e {
+            Event::CrossingDecision { frame, .. } => Some(*frame as usize),
+            _ => None,
+        })
+    };
+    let (plain, with_siren) = (run(false), run(true));
+    let early = decision(&plain).expect("crosses without a siren");
+    let held = decision(&with_siren).expect("crosses after the siren");
+    let v = &with_siren.vehicles[0];
+    let passed = (0..v.len())
+        .find(|&f| v[f].pos.x < 150.0)
+        .expect("the ambulance passes the crossing");
+    assert!(
+        early < passed,
+        "without a siren it goes first (frame {early}, vehicle past at {passed})"
+    );
+    assert!(
+        held >= passed,
+        "with a siren it waits until it has passed: decided at {held}, passed at {passed}"
+    );
+    assert_no_interpenetration(&with_siren);
 }

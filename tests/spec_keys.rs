@@ -267,6 +267,19 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         // The JPEG quality shows in JPEG files only.
         "output.jpeg_quality" => vec![("output.rgb_encoding", json!("jpeg"))],
         "output.h264_qp" => vec![("output.rgb_encoding", json!("h264"))],
+        // Emergency vehicles exist only when enabled, in the walk's few clips only with a large share.
+        "traffic.emergency.enabled" => vec![("traffic.emergency.clip_share", json!(1.0))],
+        "traffic.emergency.clip_share" => vec![("traffic.emergency.enabled", json!(true))],
+        // A kind's share shows in the exact quota of a few emergency clips per stratum.
+        p if p.starts_with("traffic.emergency.mix.") => vec![
+            ("traffic.emergency.enabled", json!(true)),
+            ("traffic.emergency.clip_share", json!(1.0)),
+            ("dataset.clips.count", json!(5)),
+        ],
+        p if p.starts_with("traffic.emergency.") => vec![
+            ("traffic.emergency.enabled", json!(true)),
+            ("traffic.emergency.clip_share", json!(1.0)),
+        ],
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }

@@ -67,6 +67,7 @@ def recompute(root: Path) -> dict:
             "rejected_too_small",
             "rejected_outside_image",
             "rejected_occluded",
+            "emergency",
         ],
     )
     frames = read_table(root, "frames", ["clip_id", "frame"])
@@ -131,6 +132,11 @@ def recompute(root: Path) -> dict:
             if k != "none"
         },
         "reaction_samples": {k: v for k, v in counts_by(ann, "reaction").items() if k != "none"},
+        "emergency_clips": counts_by(clips.filter(pc.is_valid(clips["emergency"])), "emergency"),
+        "yielding_vehicle_frames": int(
+            pc.sum(pc.cast(read_table(root, "vehicles", ["yielding"])["yielding"], pa.int64())).as_py() or 0
+        )
+        + int(pc.sum(pc.cast(read_table(root, "frames", ["ego_yielding"])["ego_yielding"], pa.int64())).as_py() or 0),
     }
 
 
@@ -165,7 +171,8 @@ def compare(mine: dict, stats: dict) -> Checker:
     c.equal("weathers", mine["weathers"], stats.get("weathers"))
     c.equal("contacts", mine["contacts"], stats.get("contacts"))
     c.equal("rejected", mine["rejected"], stats.get("rejected"))
-    for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples"]:
+    for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples",
+                "emergency_clips", "yielding_vehicle_frames"]:
         c.equal(key, mine[key], stats.get(key))
     their_counts = stats.get("state_samples")
     if their_counts is not None:

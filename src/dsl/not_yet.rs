@@ -25,10 +25,6 @@ pub struct NotYet {
 /// Every key not implemented yet.
 pub const NOT_YET: &[NotYet] = &[
     NotYet {
-        path: "traffic.emergency",
-        why: "emergency vehicles are not simulated yet",
-    },
-    NotYet {
         path: "traffic.profiles.aggressive.ignore_lights_probability",
         why: "no town has traffic lights yet, so there are no lights to ignore",
     },

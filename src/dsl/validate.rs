@@ -765,6 +765,23 @@ impl Validator<'_> {
             "a deceleration in m/s²",
         );
         self.positive("traffic.idm.exponent", t.idm.exponent, 10.0, "the IDM exponent δ");
+        let e = &t.emergency;
+        self.probability("traffic.emergency.clip_share", e.clip_share);
+        self.mix(
+            "traffic.emergency.mix",
+            &[
+                ("ambulance", e.mix.ambulance),
+                ("fire_truck", e.mix.fire_truck),
+                ("police", e.mix.police),
+            ],
+        );
+        self.num(
+            "traffic.emergency.speed_above_limit_pct",
+            e.speed_above_limit_pct,
+            0.0,
+            100.0,
+            "a percentage above the speed limit",
+        );
         self.range(
             "traffic.ego.speed_below_limit_pct",
             t.ego.speed_below_limit_pct,

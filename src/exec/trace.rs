@@ -94,6 +94,8 @@ pub struct VehicleFrame {
     pub speed_mps: f64,
     /// Longitudinal acceleration, m/s².
     pub accel_mps2: f64,
+    /// Whether it is stopping for an emergency vehicle (an approaching siren).
+    pub yielding: bool,
 }
 
 /// A pedestrian in one frame.

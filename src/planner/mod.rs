@@ -409,6 +409,8 @@ struct ClipBasics {
     first_pedestrian: usize,
     /// Stratum-wide index of the clip's first vehicle (in the stratum's driving profiles).
     first_vehicle: usize,
+    /// The clip's emergency vehicle, if it is one of the stratum's emergency clips.
+    emergency: Option<EmergencyKind>,
 }
 
 /// Per-pedestrian allocations made at the stratum level (16 bytes: a plan holds one per pedestrian).
@@ -483,12 +485,15 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
                 vehicles: rng.random_range(v.min()..=v.max()) as usize,
                 first_pedestrian,
                 first_vehicle,
+                emergency: None,
             };
             first_pedestrian += basics.pedestrians;
             first_vehicle += basics.vehicles;
             basics
         })
         .collect();
+    let mut basics = basics;
+    allocate_emergencies(spec, stratum, &mut basics);
 
     let allocs = allocate_pedestrians(spec, stratum, &basics);
     let m = &spec.traffic.profile_mix;
@@ -504,6 +509,55 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
         basics,
         allocs,
         profiles,
+    }
+}
+
+/// Emergency clips: `clip_share` of the dataset's clips, exact over the whole dataset (systematic sampling over
+/// the strata in plan order with a seeded offset, so each stratum gets its share within one clip and no state
+/// is kept), the stratum's ones chosen at random, their kinds by the mix along a seeded golden-ratio sequence
+/// over the dataset's emergency clips. All from streams of their own, drawn only when emergencies are enabled
+/// (turning them on shifts no other draw).
+fn allocate_emergencies(spec: &Spec, stratum: &Stratum, basics: &mut [ClipBasics]) {
+    let e = &spec.traffic.emergency;
+    if !e.enabled || basics.is_empty() {
+        return;
+    }
+    let seed = spec.dataset.seed;
+    let unit = |tag: &str| (seeds::seed_u64(seed, tag) >> 11) as f64 / (1u64 << 53) as f64;
+    let (phi, phi_kind) = (unit("emergency/offset"), unit("emergency/kinds"));
+    let share = e.clip_share.clamp(0.0, 1.0);
+    let before: usize = strata(spec)
+        .iter()
+        .take_while(|s| !(s.town.name() == stratum.town.name() && s.weather.name() == stratum.weather.name()))
+        .map(|s| s.clips)
+        .sum();
+    let cumulative = |n: usize| (n as f64 * share + phi).floor() as usize;
+    let count = cumulative(before + basics.len()) - cumulative(before);
+    let first = cumulative(before) - cumulative(0);
+    let mut rng = seeds::rng_for(
+        seed,
+        &format!("stratum/{}/{}/emergency", stratum.town.name(), stratum.weather.name()),
+    );
+    let chosen = quota::weighted_choice(count, &vec![1.0; basics.len()], &mut rng);
+    let mix = [e.mix.ambulance, e.mix.fire_truck, e.mix.police];
+    let total: f64 = mix.iter().sum();
+    for (j, b) in basics
+        .iter_mut()
+        .zip(chosen)
+        .filter(|(_, c)| *c)
+        .map(|(b, _)| b)
+        .enumerate()
+    {
+        let u = (phi_kind + (first + j) as f64 * 0.618_033_988_749_894_9).fract() * total;
+        let mut acc = 0.0;
+        let kind = (0..mix.len())
+            .find(|&k| {
+                acc += mix[k];
+                u < acc && mix[k] > 0.0
+            })
+            .or_else(|| (0..mix.len()).rev().find(|&k| mix[k] > 0.0))
+            .unwrap_or(0);
+        b.emergency = Some(EmergencyKind::ALL[kind]);
     }
 }
 
@@ -734,9 +788,20 @@ fn plan_clip(
             Err(e) => last_error = e,
         }
     }
-    let Some((ego, pedestrians, vehicles)) = planned else {
+    let Some((ego, pedestrians, mut vehicles)) = planned else {
         return Err(format!("{last_error} (tried {ROUTE_ATTEMPTS} ego routes)"));
     };
+    if let Some(kind) = basics.emergency {
+        vehicles.push(plan_emergency(
+            spec,
+            town,
+            &ego.route,
+            &vehicles,
+            kind,
+            needed_m,
+            basics.seed,
+        )?);
+    }
     // The clip lasts at least as long as its crossers' timelines, up to a cap.
     let cruise_mps = ego_cruise_mps(net, &ego);
     let needed_s = pedestrians
@@ -1325,9 +1390,79 @@ fn plan_vehicles(
             ignores_lights: rng.random_bool(p.ignore_lights_probability.clamp(0.0, 1.0)),
             ignores_walkers: rng.random_bool(p.ignore_walkers_probability.clamp(0.0, 1.0)),
             route,
+            emergency: None,
         });
     }
     Ok(out)
+}
+
+/// The clip's emergency vehicle: on a driving lane 40–150 m ahead of the ego's start heading towards it
+/// (oncoming) where the town has one, else anywhere 20–150 m away; from its own stream.
+fn plan_emergency(
+    spec: &Spec,
+    town: &TownContext,
+    ego_route: &RouteScript,
+    vehicles: &[VehicleScript],
+    kind: EmergencyKind,
+    needed_m: f64,
+    clip_seed: u64,
+) -> Result<VehicleScript, String> {
+    let net = &town.network;
+    let mut rng = seeds::clip_rng(clip_seed, "emergency");
+    let ego_start = ego_route.start;
+    let ego_dir = DVec2::from_angle(ego_route.start_heading_rad);
+    let free = |sp: &&SpawnPoint| {
+        vehicles
+            .iter()
+            .all(|v| v.route.start.distance(sp.pos) >= VEHICLE_SPACING_M)
+    };
+    let oncoming: Vec<&SpawnPoint> = town
+        .spawn_points
+        .iter()
+        .filter(|sp| {
+            let d = sp.pos - ego_start;
+            (40.0..150.0).contains(&d.length())
+                && d.dot(ego_dir) > 0.7 * d.length()
+                && DVec2::from_angle(sp.heading_rad).dot(ego_dir) < -0.7
+        })
+        .filter(free)
+        .collect();
+    let any: Vec<&SpawnPoint> = town
+        .spawn_points
+        .iter()
+        .filter(|sp| (20.0..150.0).contains(&sp.pos.distance(ego_start)))
+        .filter(free)
+        .collect();
+    for candidates in [oncoming, any] {
+        for _ in 0..PLACEMENT_ATTEMPTS.min(candidates.len().max(1) * 2) {
+            if candidates.is_empty() {
+                break;
+            }
+            let sp = candidates[rng.random_range(0..candidates.len())];
+            let Some(lanes) = net.lane_walk(sp.lane, needed_m + sp.lane_s_m, &mut rng) else {
+                continue;
+            };
+            let length_m = lanes.iter().map(|&l| net.lanes[l as usize].length_m).sum();
+            return Ok(VehicleScript {
+                id: vehicles.len() as u32,
+                profile: DrivingProfileKind::Aggressive,
+                speed_difference_pct: -spec.traffic.emergency.speed_above_limit_pct,
+                min_gap_m: 2.0,
+                time_headway_s: 1.0,
+                ignores_lights: true,
+                ignores_walkers: false,
+                route: RouteScript {
+                    lanes,
+                    length_m,
+                    start_s_m: sp.lane_s_m,
+                    start: sp.pos,
+                    start_heading_rad: sp.heading_rad,
+                },
+                emergency: Some(kind),
+            });
+        }
+    }
+    Err("cannot place the emergency vehicle on a free driving lane within 150 m of the ego".to_owned())
 }
 
 fn wrap_angle(a: f64) -> f64 {

@@ -192,6 +192,31 @@ impl DrivingProfileKind {
     }
 }
 
+/// Kinds of emergency vehicle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EmergencyKind {
+    /// An ambulance (white).
+    Ambulance,
+    /// A fire truck (red).
+    FireTruck,
+    /// A police car (dark blue).
+    Police,
+}
+
+impl EmergencyKind {
+    /// All kinds in spec order.
+    pub const ALL: [EmergencyKind; 3] = [Self::Ambulance, Self::FireTruck, Self::Police];
+    /// The kind's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ambulance => "ambulance",
+            Self::FireTruck => "fire_truck",
+            Self::Police => "police",
+        }
+    }
+}
+
 /// One traffic vehicle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct VehicleScript {
@@ -211,6 +236,9 @@ pub struct VehicleScript {
     pub ignores_walkers: bool,
     /// Route.
     pub route: RouteScript,
+    /// An emergency vehicle with lights and siren on (`traffic.emergency`): others stop for it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emergency: Option<EmergencyKind>,
 }
 
 /// Role of a pedestrian.

@@ -167,8 +167,11 @@ pub struct PlanStats {
     pub speed_profiles: BTreeMap<String, usize>,
     /// Traffic vehicles.
     pub vehicles: usize,
-    /// Vehicles per driving profile.
+    /// Vehicles per driving profile (emergency vehicles not counted).
     pub driving_profiles: BTreeMap<String, usize>,
+    /// Clips with an emergency vehicle, per kind (`traffic.emergency`).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub emergency_clips: BTreeMap<String, usize>,
     /// Pedestrian-frames (every pedestrian in every frame).
     pub pedestrian_frames: u64,
     /// Estimated annotated samples (pedestrian-frames that pass the visibility gate).
@@ -240,6 +243,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
             .iter()
             .map(|p| (p.name().to_owned(), 0))
             .collect(),
+        emergency_clips: BTreeMap::new(),
         pedestrian_frames: 0,
         estimated_annotated_samples: 0,
         estimated_bytes: SizeEstimate::default(),
@@ -296,7 +300,10 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
             }
         }
         for v in &clip.vehicles {
-            *stats.driving_profiles.entry(v.profile.name().to_owned()).or_default() += 1;
+            match v.emergency {
+                Some(kind) => *stats.emergency_clips.entry(kind.name().to_owned()).or_default() += 1,
+                None => *stats.driving_profiles.entry(v.profile.name().to_owned()).or_default() += 1,
+            }
         }
         in_view.extend(clip.pedestrians.iter().filter_map(|p| p.in_view_before_crossing_s));
         if clip.timeline_extension_s > 0.0 {
@@ -515,6 +522,15 @@ impl std::fmt::Display for PlanStats {
             )?;
         }
         writeln!(out, "vehicles              {}", stats.vehicles)?;
+        if !stats.emergency_clips.is_empty() {
+            let kinds: Vec<String> = stats.emergency_clips.iter().map(|(k, n)| format!("{k} {n}")).collect();
+            writeln!(
+                out,
+                "emergency clips       {} ({})",
+                stats.emergency_clips.values().sum::<usize>(),
+                kinds.join(", ")
+            )?;
+        }
         writeln!(
             out,
             "pedestrian-frames     {} (≈ {} annotated samples)",

@@ -180,14 +180,36 @@ impl Default for Ego {
     }
 }
 
-/// Emergency scenarios.
+/// Emergency scenarios (the seed system's `--enable_emergency`): a share of the clips gets an oncoming
+/// emergency vehicle with lights and siren on, faster than the limit; other vehicles stop for it and pedestrians
+/// hold at the curb (those on the road hurry).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Emergency {
     /// Whether emergency scenarios are generated.
     pub enabled: bool,
-    /// Share of clips with an emergency scenario.
+    /// Share of the dataset's clips with an emergency vehicle (exact over the dataset; each town × weather
+    /// stratum within one clip of its share).
     pub clip_share: f64,
+    /// Share of each kind of emergency vehicle; must sum to 1.
+    pub mix: EmergencyMix,
+    /// How much faster than the speed limit an emergency vehicle drives, percent.
+    pub speed_above_limit_pct: f64,
+}
+
+/// Shares of the three kinds of emergency vehicle (missing ones are 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct EmergencyMix {
+    /// Share of ambulances.
+    #[serde(default)]
+    pub ambulance: f64,
+    /// Share of fire trucks.
+    #[serde(default)]
+    pub fire_truck: f64,
+    /// Share of police cars.
+    #[serde(default)]
+    pub police: f64,
 }
 
 impl Default for Emergency {
@@ -195,6 +217,12 @@ impl Default for Emergency {
         Emergency {
             enabled: false,
             clip_share: 0.1,
+            mix: EmergencyMix {
+                ambulance: 0.4,
+                fire_truck: 0.2,
+                police: 0.4,
+            },
+            speed_above_limit_pct: 30.0,
         }
     }
 }

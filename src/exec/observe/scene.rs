@@ -23,7 +23,7 @@ use super::body::{self, CAPSULES, CHILD_OFFSET_M};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::{ClipTrace, PedFrame, VehicleFrame};
 use crate::mix::splitmix64;
-use crate::planner::{ClipScript, Identity};
+use crate::planner::{ClipScript, EmergencyKind, Identity};
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
 
 /// CARLA's semantic tags (CARLA 0.9.14+, `carla.CityObjectLabel`), as written in the `semantic` stream.
@@ -175,6 +175,8 @@ pub enum Material {
     HeadLamp,
     /// Tail lamps (emissive at night).
     TailLamp,
+    /// An emergency vehicle's flashing light (emits its albedo, by day too).
+    Beacon,
     /// Skin or clothing of a body part; `aux` is the capsule's index in [`FrameScene::capsules`] (smooth
     /// normals).
     Body,
@@ -879,7 +881,12 @@ impl StaticScene {
                 .map(|vi| {
                     let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
                     let h = splitmix64(seed ^ 0x5eed_ca75 ^ splitmix64(u64::from(id)));
-                    linear(CAR_COLOURS[(h % CAR_COLOURS.len() as u64) as usize])
+                    match script.vehicles.get(vi).and_then(|v| v.emergency) {
+                        Some(EmergencyKind::Ambulance) => linear([235, 235, 228]),
+                        Some(EmergencyKind::FireTruck) => linear([190, 20, 18]),
+                        Some(EmergencyKind::Police) => linear([22, 30, 70]),
+                        None => linear(CAR_COLOURS[(h % CAR_COLOURS.len() as u64) as usize]),
+                    }
                 })
                 .collect(),
         }
@@ -1099,11 +1106,17 @@ impl FrameScene {
             let (pos, yaw) = lerp_vehicle(a, b, t.alpha);
             let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
             let paint = stat.car_paint.get(vi).copied().unwrap_or(Vec3::splat(0.5));
+            // An emergency vehicle's light bar flashes red and blue, alternating at 2 Hz.
+            let flash = script.vehicles.get(vi).and_then(|v| v.emergency).map(|_| {
+                let time_s = (f64::from(t.frame) + t.alpha) / f64::from(trace.fps.max(1));
+                (time_s * 2.0).fract() < 0.5
+            });
             self.push_vehicle(
                 stat.rel(pos),
                 yaw as f32,
                 paint,
                 VEHICLE_INSTANCE_BASE.saturating_add(id as u16),
+                flash,
             );
         }
         for (pi, frames) in trace.pedestrians.iter().enumerate() {
@@ -1125,7 +1138,9 @@ impl FrameScene {
         }
     }
 
-    fn push_vehicle(&mut self, pos: Vec3, yaw: f32, paint: Vec3, instance: u16) {
+    /// Pushes a car; `light_bar`: an emergency vehicle's light bar on the roof, with its red half lit (`true`)
+    /// or its blue half.
+    fn push_vehicle(&mut self, pos: Vec3, yaw: f32, paint: Vec3, instance: u16, light_bar: Option<bool>) {
         let (l, w, h) = (VEHICLE_LENGTH_M as f32, VEHICLE_WIDTH_M as f32, VEHICLE_HEIGHT_M as f32);
         let (s, c) = yaw.sin_cos();
         let fwd = Vec2::new(c, s);
@@ -1179,6 +1194,21 @@ impl FrameScene {
                     [base + 0.6, base + 0.75],
                     car(mat, albedo),
                     car(mat, albedo),
+                );
+            }
+        }
+        if let Some(red_lit) = light_bar {
+            let roof = centre - fwd * (0.08 * l);
+            for (sy, lit, colour) in [(1.0f32, red_lit, [255, 20, 20]), (-1.0, !red_lit, [30, 60, 255])] {
+                let albedo = if lit { linear(colour) } else { linear(colour) * 0.15 };
+                let lamp = car(Material::Beacon, albedo);
+                self.mesh.upright_box(
+                    roof + fwd.perp() * (sy * 0.3),
+                    yaw,
+                    Vec2::new(0.12, 0.28),
+                    [base + h, base + h + 0.14],
+                    lamp,
+                    lamp,
                 );
             }
         }

@@ -101,6 +101,10 @@ pub struct DatasetStats {
     pub rejected: BTreeMap<String, u64>,
     /// Vehicle contacts recorded.
     pub contacts: u64,
+    /// Clips with an emergency vehicle, per kind.
+    pub emergency_clips: BTreeMap<String, u64>,
+    /// Vehicle-frames (traffic and ego) stopping for an emergency vehicle.
+    pub yielding_vehicle_frames: u64,
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
@@ -138,11 +142,13 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 "rejected_outside_image",
                 "rejected_occluded",
                 "contacts",
+                "emergency",
             ],
         )? {
             let (town, weather, splits) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
             let (frame_count, samples_col) = (b.u32s("frame_count")?, b.u64s("annotated_samples")?);
             let (durations, contacts) = (b.f64s("duration_s")?, b.u32s("contacts")?);
+            let emergency = b.strings("emergency")?;
             for i in 0..b.rows() {
                 split = splits[i].to_owned();
                 let frames = u64::from(frame_count.value(i));
@@ -162,6 +168,9 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.samples += samples;
                 towns.insert(town[i].to_owned());
                 weathers.insert(weather[i].to_owned());
+                if !emergency[i].is_empty() {
+                    *s.emergency_clips.entry(emergency[i].to_owned()).or_default() += 1;
+                }
             }
         }
         let clip_id = path
@@ -192,6 +201,14 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.pedestrians += 1;
                 sp.crossers += u64::from(crosser);
             }
+        }
+        for b in tables::read(&layout.table("vehicles", &clip_id), &["yielding"])? {
+            let y = b.bools("yielding")?;
+            s.yielding_vehicle_frames += y.true_count() as u64;
+        }
+        for b in tables::read(&layout.table("frames", &clip_id), &["ego_yielding"])? {
+            let y = b.bools("ego_yielding")?;
+            s.yielding_vehicle_frames += y.true_count() as u64;
         }
         let mut gestured = std::collections::BTreeSet::new();
         for b in tables::read(
@@ -367,6 +384,12 @@ impl std::fmt::Display for DatasetStats {
             writeln!(o, "  {k:<14} {v}")?;
         }
         writeln!(o, "vehicle contacts             {}", s.contacts)?;
+        let emergencies: u64 = s.emergency_clips.values().sum();
+        if emergencies > 0 {
+            let kinds: Vec<String> = s.emergency_clips.iter().map(|(k, n)| format!("{k} {n}")).collect();
+            writeln!(o, "emergency clips              {emergencies} ({})", kinds.join(", "))?;
+            writeln!(o, "vehicle-frames yielding      {}", s.yielding_vehicle_frames)?;
+        }
         Ok(())
     }
 }

@@ -209,6 +209,7 @@ impl<'a> Sim<'a> {
                 yaw_rad: v.pose.heading_rad,
                 speed_mps: v.speed_mps,
                 accel_mps2: v.accel_mps2,
+                yielding: v.yielding,
             };
             if k == 0 {
                 self.trace.ego.push(frame);
@@ -337,6 +338,11 @@ impl<'a> Sim<'a> {
             approaching_curb: p.heading_for_curb(),
             waiting_at_curb: p.waiting_at_curb(),
         }));
+        // Vehicles closing in on an emergency vehicle stop for it.
+        for i in 0..self.vehicles.len() {
+            let yielding = self.vehicles.iter().any(|e| self.vehicles[i].yields_to(e));
+            self.vehicles[i].yielding = yielding;
+        }
         self.accels.clear();
         for i in 0..self.vehicles.len() {
             self.accels.push(vehicle::accel_for(

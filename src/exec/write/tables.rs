@@ -129,6 +129,7 @@ pub fn clips_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotations
         field("weather", DataType::Utf8, false),
         field("difficulty", DataType::Utf8, false),
         field("split", DataType::Utf8, false),
+        field("emergency", DataType::Utf8, true),
     ];
     let mut columns: Vec<ArrayRef> = vec![
         utf8(1, &script.clip_id),
@@ -136,6 +137,9 @@ pub fn clips_batch(script: &ClipScript, trace: &ClipTrace, ann: &ClipAnnotations
         utf8(1, &script.weather),
         utf8(1, &snake(&w.difficulty)),
         utf8(1, &snake(&script.split)),
+        Arc::new(StringArray::from(vec![
+            script.vehicles.iter().find_map(|v| v.emergency).map(|k| k.name()),
+        ])),
     ];
     for (name, v) in u64s {
         fields.push(field(name, DataType::UInt64, false));
@@ -174,6 +178,7 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("ego_yaw_rad", DataType::Float64, false),
             field("ego_speed_mps", DataType::Float64, false),
             field("ego_accel_mps2", DataType::Float64, false),
+            field("ego_yielding", DataType::Boolean, false),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -185,6 +190,7 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             col(|f| f.yaw_rad),
             col(|f| f.speed_mps),
             col(|f| f.accel_mps2),
+            Arc::new(BooleanArray::from_iter(trace.ego.iter().map(|f| Some(f.yielding)))),
         ],
     )
 }
@@ -441,6 +447,7 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             .get(v as usize)
             .map_or_else(String::new, |s| snake(&s.profile))
     };
+    let emergency = |v: u32| script.vehicles.get(v as usize).and_then(|s| s.emergency);
     batch(
         vec![
             field("clip_id", DataType::Utf8, false),
@@ -453,6 +460,9 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("speed_mps", DataType::Float32, false),
             field("accel_mps2", DataType::Float32, false),
             field("profile", DataType::Utf8, false),
+            field("kind", DataType::Utf8, false),
+            field("siren", DataType::Boolean, false),
+            field("yielding", DataType::Boolean, false),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -465,6 +475,13 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             f32c(|f| f.speed_mps),
             f32c(|f| f.accel_mps2),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| profile(r.1)))),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| emergency(r.1).map_or("car", |k| k.name())),
+            )),
+            Arc::new(BooleanArray::from_iter(
+                rows.iter().map(|r| Some(emergency(r.1).is_some())),
+            )),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.2.yielding)))),
         ],
     )
 }

@@ -157,6 +157,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         Material::CarGlass => gloss = 0.12,
         Material::HeadLamp => emissive = Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night),
         Material::TailLamp => emissive = Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night),
+        Material::Beacon => emissive = prim.albedo * (1.5 + 2.0 * l.night),
         Material::Body | Material::Head => {
             if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
                 normal = c.normal(p);

@@ -110,9 +110,13 @@ fn baseline_clear(p: &Ped) -> bool {
 /// Whether the crosser's timeline lets it step out `lead_s` seconds from now: the ego's camera has seen it (and
 /// its group's followers) for its planned time; or it has been seen briefly and the ego drives on close by (the
 /// timeline is cut short, as real observations sometimes are); or the ego has passed (then no camera sees it
-/// either way).
+/// either way). Never while an emergency vehicle's siren is near: pedestrians hold at the curb.
 fn timeline_allows(p: &Ped, lead_s: f64) -> bool {
     let percept = &p.percept;
+    if percept.siren_near {
+        // An emergency vehicle is coming: nobody steps out.
+        return false;
+    }
     // The ego drives on close by: a crosser seen at least briefly goes now rather than cross behind it, unseen.
     let cut_short = percept.ego_speed_mps > CUT_SHORT_EGO_SPEED_MPS
         && percept.ego_dist_m < CUT_SHORT_EGO_DISTANCE_M
@@ -131,9 +135,10 @@ fn ego_can_stop(p: &Ped) -> bool {
     v * v / (2.0 * COMFORTABLE_STOP_DECEL_MPS2) + STOP_MARGIN_M < p.percept.ego_dist_m
 }
 
-/// Whether a vehicle approaches a crosser on the road so fast that it runs.
+/// Whether a vehicle approaches a crosser on the road so fast that it runs, or an emergency vehicle's siren is
+/// near (it hurries across).
 fn must_run(p: &Ped) -> bool {
-    p.percept.min_ttc_s < RUN_TTC_FRACTION * p.traits.ttc_threshold_s
+    p.percept.min_ttc_s < RUN_TTC_FRACTION * p.traits.ttc_threshold_s || p.percept.siren_near
 }
 
 /// The behaviour machine of a pedestrian that decides for itself (a single or a group leader). `group_ready`

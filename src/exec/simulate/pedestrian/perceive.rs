@@ -14,6 +14,12 @@ use crate::exec::trace::VehicleId;
 use crate::planner::SimParams;
 use crate::world::RoadNetwork;
 
+/// A pedestrian holds at the curb (or hurries across) while an emergency vehicle closes in from nearer than
+/// this, metres. pedsynth: a siren is heard some 100 m away in a city street.
+pub(crate) const SIREN_HOLD_M: f64 = 100.0;
+/// ... or while one passes within this distance, metres. pedsynth.
+pub(crate) const SIREN_PASSING_M: f64 = 15.0;
+
 /// What a pedestrian perceives of the traffic.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Percept {
@@ -36,6 +42,9 @@ pub(crate) struct Percept {
     pub blocked_by_standing: bool,
     /// Whether the ego's camera sees the pedestrian (the simulation's estimate, `view`).
     pub in_view: bool,
+    /// Whether an emergency vehicle's siren is near: closing in from nearer than [`SIREN_HOLD_M`], or passing
+    /// within [`SIREN_PASSING_M`].
+    pub siren_near: bool,
 }
 
 impl Default for Percept {
@@ -50,6 +59,7 @@ impl Default for Percept {
             conflict_vehicle: None,
             blocked_by_standing: false,
             in_view: false,
+            siren_near: false,
         }
     }
 }
@@ -100,6 +110,11 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings,
     percept.ego_dist_m = ego.pose.pos.distance(pos);
     percept.ego_speed_mps = ego.speed_mps;
     percept.ego_ahead = ego.s_m < p.traits.route_s_m;
+    percept.siren_near = vehicles.iter().filter(|v| v.emergency.is_some()).any(|v| {
+        let d = pos - v.pose.pos;
+        let dist = d.length();
+        dist < SIREN_PASSING_M || (dist < SIREN_HOLD_M && v.velocity().dot(d) > 0.0)
+    });
     percept.conflict_vehicle = None;
     let Some(line) = p.traits.line else {
         return;

@@ -58,6 +58,10 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
     let idm_to =
         |gap: f64, lead: f64| idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, Some((gap, lead)));
     let mut accel = idm_accel_mps2(idm, v, target, me.min_gap_m, me.time_headway_s, None);
+    if me.yielding {
+        // Stopping for an emergency vehicle, at a comfortable rate.
+        accel = accel.min(-idm.comfortable_decel_mps2.min(v / 0.5));
+    }
 
     // End of route: a standing obstacle.
     let end_gap = me.path.length_m() - me.s_m - HALF_LENGTH_M;

@@ -17,7 +17,7 @@ use glam::DVec2;
 
 use super::{VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::VehicleId;
-use crate::planner::{EgoScript, VehicleScript};
+use crate::planner::{EgoScript, EmergencyKind, VehicleScript};
 use crate::world::RoadNetwork;
 pub(crate) use conflict_zones::{ConflictZone, conflict_zones};
 pub(crate) use idm::accel_for;
@@ -30,6 +30,10 @@ pub const EGO_TIME_HEADWAY_S: f64 = 1.5;
 pub(crate) const HALF_LENGTH_M: f64 = VEHICLE_LENGTH_M * 0.5;
 /// Half the vehicle width, metres.
 pub(crate) const HALF_WIDTH_M: f64 = VEHICLE_WIDTH_M * 0.5;
+
+/// A vehicle stops for an emergency vehicle closing in from nearer than this, metres. pedsynth: drivers hear a
+/// siren and see the lights some 50–100 m away; stopping from 50 km/h at a comfortable 2 m/s² takes ~48 m.
+pub(crate) const YIELD_TO_SIREN_M: f64 = 70.0;
 
 /// A simulated vehicle (the ego or traffic).
 #[derive(Clone, Debug)]
@@ -51,6 +55,10 @@ pub(crate) struct Vehicle {
     pub courtesy: Option<Courtesy>,
     /// Cached pose at `s_m`.
     pub pose: PathPose,
+    /// An emergency vehicle (lights and siren on).
+    pub emergency: Option<EmergencyKind>,
+    /// Whether it stops for an approaching emergency vehicle this step.
+    pub yielding: bool,
 }
 
 impl Vehicle {
@@ -95,6 +103,24 @@ impl Vehicle {
             script.ignores_walkers,
             None,
         )
+        .with_emergency(script.emergency)
+    }
+
+    fn with_emergency(mut self, emergency: Option<EmergencyKind>) -> Vehicle {
+        self.emergency = emergency;
+        self
+    }
+
+    /// Whether it yields to the emergency vehicle `e`: `e` is nearer than [`YIELD_TO_SIREN_M`] and closing in,
+    /// unless it follows this vehicle in the same direction (it cannot get past a stopped car in its lane).
+    pub fn yields_to(&self, e: &Vehicle) -> bool {
+        if self.emergency.is_some() || e.emergency.is_none() {
+            return false;
+        }
+        let d = e.pose.pos - self.pose.pos;
+        let closing = (e.velocity() - self.velocity()).dot(d) < 0.0;
+        let following = d.dot(self.pose.dir) < 0.0 && e.pose.dir.dot(self.pose.dir) > 0.7;
+        d.length() < YIELD_TO_SIREN_M && closing && !following
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -124,6 +150,8 @@ impl Vehicle {
             courtesy: None,
             pose,
             path,
+            emergency: None,
+            yielding: false,
         }
     }
 
