@@ -836,7 +836,7 @@ fn emergency(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64) -> Vehicl
 }
 
 #[test]
-fn vehicles_stop_for_an_oncoming_emergency_vehicle_which_drives_above_the_limit() {
+fn vehicles_pull_over_and_stop_for_an_oncoming_emergency_vehicle_which_drives_above_the_limit() {
     let net = road();
     // The ego (towards +x) and a car behind it meet an ambulance coming the other way at 1.3 × the limit.
     let script = clip(
@@ -871,6 +871,17 @@ fn vehicles_stop_for_an_oncoming_emergency_vehicle_which_drives_above_the_limit(
         assert!(
             !frames[after].yielding && frames[after].speed_mps > 2.0,
             "{name} drives on"
+        );
+        // It pulled over to the right (its lane's centre is y = −1.75), and back after.
+        assert!(
+            frames[pass].pos.y < -1.75 - 0.3,
+            "{name} at y {} when passed",
+            frames[pass].pos.y
+        );
+        assert!(
+            (frames[after].pos.y + 1.75).abs() < 0.05,
+            "{name} back at y {}",
+            frames[after].pos.y
         );
         // It began to yield only once the ambulance was within 70 m and closing.
         let first = frames.iter().position(|f| f.yielding).expect("yields");

@@ -34,6 +34,10 @@ pub(crate) const HALF_WIDTH_M: f64 = VEHICLE_WIDTH_M * 0.5;
 /// A vehicle stops for an emergency vehicle closing in from nearer than this, metres. pedsynth: drivers hear a
 /// siren and see the lights some 50–100 m away; stopping from 50 km/h at a comfortable 2 m/s² takes ~48 m.
 pub(crate) const YIELD_TO_SIREN_M: f64 = 70.0;
+/// How far a yielding vehicle pulls over to the right, metres (a 1.9 m car stays inside a 3 m lane).
+pub(crate) const PULL_RIGHT_M: f64 = 0.5;
+/// Sideways metres per metre driven while pulling over or back.
+pub(crate) const PULL_RIGHT_PER_M: f64 = 0.15;
 
 /// A simulated vehicle (the ego or traffic).
 #[derive(Clone, Debug)]
@@ -59,6 +63,8 @@ pub(crate) struct Vehicle {
     pub emergency: Option<EmergencyKind>,
     /// Whether it stops for an approaching emergency vehicle this step.
     pub yielding: bool,
+    /// How far it has pulled over to the right of its path (yielding), metres.
+    pub pull_right_m: f64,
 }
 
 impl Vehicle {
@@ -152,6 +158,7 @@ impl Vehicle {
             path,
             emergency: None,
             yielding: false,
+            pull_right_m: 0.0,
         }
     }
 
@@ -172,7 +179,20 @@ impl Vehicle {
         self.s_m = (self.s_m + 0.5 * (v0 + v1) * dt_s).min(self.path.length_m());
         self.accel_mps2 = (v1 - v0) / dt_s;
         self.speed_mps = if self.s_m >= self.path.length_m() { 0.0 } else { v1 };
+        // Pulling over to the right while yielding, back to the lane centre after: sideways by at most a
+        // fraction of the distance driven (a car steers; it does not slide).
+        let target = if self.yielding { PULL_RIGHT_M } else { 0.0 };
+        let step = PULL_RIGHT_PER_M * 0.5 * (v0 + v1) * dt_s;
+        self.pull_right_m += (target - self.pull_right_m).clamp(-step, step);
+        self.place();
+    }
+
+    /// Caches the pose at `s_m`, moved `pull_right_m` to the right of the path.
+    fn place(&mut self) {
         self.pose = self.path.pose_at(self.s_m);
+        if self.pull_right_m > 0.0 {
+            self.pose.pos -= self.pose.dir.perp() * self.pull_right_m;
+        }
     }
 
     /// Counts the time the ego yields: while an attentive pedestrian waits at the curb ahead (`yielding`), for
@@ -198,7 +218,7 @@ impl Vehicle {
     pub fn back_off_and_stop(&mut self, ds_m: f64) {
         self.s_m = (self.s_m - ds_m).max(0.0);
         self.speed_mps = 0.0;
-        self.pose = self.path.pose_at(self.s_m);
+        self.place();
     }
 }
 
