@@ -796,6 +796,7 @@ fn plan_clip(
             spec,
             town,
             &ego.route,
+            &pedestrians,
             &vehicles,
             kind,
             needed_m,
@@ -1326,11 +1327,7 @@ fn plan_vehicles(
         .iter()
         .filter(|sp| {
             let d = sp.pos.distance(ego_start);
-            d > VEHICLE_SPACING_M
-                && d < 150.0
-                && peds
-                    .iter()
-                    .all(|p| p.spawn_place != SpawnPlace::DrivingLane || p.spawn.distance(sp.pos) > 15.0)
+            d > VEHICLE_SPACING_M && d < 150.0 && clear_of_road_pedestrians(sp, peds)
         })
         .collect();
     let mut out: Vec<VehicleScript> = Vec::with_capacity(profiles.len());
@@ -1357,21 +1354,9 @@ fn plan_vehicles(
             if taken.iter().any(|t| t.distance(sp.pos) < VEHICLE_SPACING_M) {
                 continue;
             }
-            // A lane walk, not a polyline: the executor builds the polyline (planning 10k clips stays fast).
-            let Some(lanes) = net.lane_walk(sp.lane, needed_m + sp.lane_s_m, rng) else {
+            let Some(script) = route_from_spawn(net, sp, needed_m, rng) else {
                 continue;
             };
-            let length_m = lanes.iter().map(|&l| net.lanes[l as usize].length_m).sum();
-            let script = RouteScript {
-                lanes,
-                length_m,
-                start_s_m: sp.lane_s_m,
-                start: sp.pos,
-                start_heading_rad: sp.heading_rad,
-            };
-            if taken.iter().any(|t| t.distance(script.start) < VEHICLE_SPACING_M) {
-                continue;
-            }
             placed = Some((script.start, script));
             break;
         }
@@ -1396,12 +1381,35 @@ fn plan_vehicles(
     Ok(out)
 }
 
+/// Whether a vehicle may spawn at `sp`: no pedestrian starts on the road within 15 m of it.
+fn clear_of_road_pedestrians(sp: &SpawnPoint, peds: &[PedestrianScript]) -> bool {
+    peds.iter()
+        .all(|p| p.spawn_place != SpawnPlace::DrivingLane || p.spawn.distance(sp.pos) > 15.0)
+}
+
+/// A route from a spawn point: a lane walk of `needed_m` beyond it, not a polyline (the executor builds the
+/// polyline, so planning 10k clips stays fast).
+fn route_from_spawn(net: &RoadNetwork, sp: &SpawnPoint, needed_m: f64, rng: &mut ChaCha20Rng) -> Option<RouteScript> {
+    let lanes = net.lane_walk(sp.lane, needed_m + sp.lane_s_m, rng)?;
+    let length_m = lanes.iter().map(|&l| net.lanes[l as usize].length_m).sum();
+    Some(RouteScript {
+        lanes,
+        length_m,
+        start_s_m: sp.lane_s_m,
+        start: sp.pos,
+        start_heading_rad: sp.heading_rad,
+    })
+}
+
 /// The clip's emergency vehicle: on a driving lane 40–150 m ahead of the ego's start heading towards it
-/// (oncoming) where the town has one, else anywhere 20–150 m away; from its own stream.
+/// (oncoming) where the town has one, else anywhere 20–150 m away; clear of the other vehicles and of
+/// pedestrians on the road; from its own stream.
+#[allow(clippy::too_many_arguments)]
 fn plan_emergency(
     spec: &Spec,
     town: &TownContext,
     ego_route: &RouteScript,
+    peds: &[PedestrianScript],
     vehicles: &[VehicleScript],
     kind: EmergencyKind,
     needed_m: f64,
@@ -1412,9 +1420,10 @@ fn plan_emergency(
     let ego_start = ego_route.start;
     let ego_dir = DVec2::from_angle(ego_route.start_heading_rad);
     let free = |sp: &&SpawnPoint| {
-        vehicles
-            .iter()
-            .all(|v| v.route.start.distance(sp.pos) >= VEHICLE_SPACING_M)
+        clear_of_road_pedestrians(sp, peds)
+            && vehicles
+                .iter()
+                .all(|v| v.route.start.distance(sp.pos) >= VEHICLE_SPACING_M)
     };
     let oncoming: Vec<&SpawnPoint> = town
         .spawn_points
@@ -1439,10 +1448,9 @@ fn plan_emergency(
                 break;
             }
             let sp = candidates[rng.random_range(0..candidates.len())];
-            let Some(lanes) = net.lane_walk(sp.lane, needed_m + sp.lane_s_m, &mut rng) else {
+            let Some(route) = route_from_spawn(net, sp, needed_m, &mut rng) else {
                 continue;
             };
-            let length_m = lanes.iter().map(|&l| net.lanes[l as usize].length_m).sum();
             return Ok(VehicleScript {
                 id: vehicles.len() as u32,
                 profile: DrivingProfileKind::Aggressive,
@@ -1451,13 +1459,7 @@ fn plan_emergency(
                 time_headway_s: 1.0,
                 ignores_lights: true,
                 ignores_walkers: false,
-                route: RouteScript {
-                    lanes,
-                    length_m,
-                    start_s_m: sp.lane_s_m,
-                    start: sp.pos,
-                    start_heading_rad: sp.heading_rad,
-                },
+                route,
                 emergency: Some(kind),
             });
         }

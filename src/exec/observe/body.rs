@@ -141,8 +141,8 @@ impl BodyPose {
 /// Where a parent's child walks, in the parent's body frame, metres (beside the parent, on its left).
 pub const CHILD_OFFSET_M: DVec3 = DVec3::new(0.0, 0.55, 0.0);
 
-/// Head pitch of a pedestrian reading a phone, radians (≈ 34° down; literature: neck flexion while texting is
-/// 30–50°, Hansraj 2014).
+/// Head pitch of a pedestrian reading a phone, radians (≈ 34° down). pedsynth: a typical texting posture, and
+/// beyond the 30° `look` cone, so a pedestrian reading a phone does not count as looking at a level camera.
 pub const PHONE_HEAD_PITCH_RAD: f64 = 0.6;
 
 /// Speed below which a pedestrian stands, m/s.

@@ -127,6 +127,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     let mut speed_sums: BTreeMap<String, (f64, u64)> = BTreeMap::new();
     for path in tables::files(&layout, "clips")? {
         let mut split = String::new();
+        let mut emergency_clip = false;
         for b in tables::read(
             &path,
             &[
@@ -168,6 +169,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.samples += samples;
                 towns.insert(town[i].to_owned());
                 weathers.insert(weather[i].to_owned());
+                emergency_clip |= !emergency[i].is_empty();
                 if !emergency[i].is_empty() {
                     *s.emergency_clips.entry(emergency[i].to_owned()).or_default() += 1;
                 }
@@ -202,13 +204,13 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 sp.crossers += u64::from(crosser);
             }
         }
-        for b in tables::read(&layout.table("vehicles", &clip_id), &["yielding"])? {
-            let y = b.bools("yielding")?;
-            s.yielding_vehicle_frames += y.true_count() as u64;
-        }
-        for b in tables::read(&layout.table("frames", &clip_id), &["ego_yielding"])? {
-            let y = b.bools("ego_yielding")?;
-            s.yielding_vehicle_frames += y.true_count() as u64;
+        // Only a clip with an emergency vehicle has vehicles yielding to one.
+        if emergency_clip {
+            for (table, column) in [("vehicles", "yielding"), ("frames", "ego_yielding")] {
+                for b in tables::read(&layout.table(table, &clip_id), &[column])? {
+                    s.yielding_vehicle_frames += b.bools(column)?.true_count() as u64;
+                }
+            }
         }
         let mut gestured = std::collections::BTreeSet::new();
         for b in tables::read(

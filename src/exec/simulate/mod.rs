@@ -104,6 +104,8 @@ pub fn simulate(script: &ClipScript, params: &SimParams, town: &RoadNetwork) -> 
 struct Sim<'a> {
     params: &'a SimParams,
     net: &'a RoadNetwork,
+    /// Whether the clip has an emergency vehicle (only then does anyone yield to one).
+    sirens: bool,
     dt_s: f64,
     /// The ego first (`VehicleId::Ego`), then traffic in script order.
     vehicles: Vec<Vehicle>,
@@ -163,6 +165,7 @@ impl<'a> Sim<'a> {
             p.update_head(0.0, &vehicles);
         }
         let zones = vehicle::conflict_zones(&vehicles);
+        let sirens = vehicles.iter().any(|v| v.emergency.is_some());
         let trace = ClipTrace {
             clip_id: script.clip_id.clone(),
             fps,
@@ -175,6 +178,7 @@ impl<'a> Sim<'a> {
         Sim {
             params,
             net,
+            sirens,
             dt_s: 1.0 / f64::from(fps),
             vehicles,
             peds,
@@ -339,9 +343,11 @@ impl<'a> Sim<'a> {
             waiting_at_curb: p.waiting_at_curb(),
         }));
         // Vehicles closing in on an emergency vehicle stop for it.
-        for i in 0..self.vehicles.len() {
-            let yielding = self.vehicles.iter().any(|e| self.vehicles[i].yields_to(e));
-            self.vehicles[i].yielding = yielding;
+        if self.sirens {
+            for i in 0..self.vehicles.len() {
+                let yielding = self.vehicles.iter().any(|e| self.vehicles[i].yields_to(e));
+                self.vehicles[i].yielding = yielding;
+            }
         }
         self.accels.clear();
         for i in 0..self.vehicles.len() {

@@ -141,9 +141,7 @@ pub const IDLE_HEAD_SWAY: (f64, f64) = (0.15, 0.7);
 // --- Gestures -------------------------------------------------------------------------------------------------
 
 /// The ego counts as yielding to a pedestrian when it is ahead, nearer than this (metres) and slower than
-/// [`GESTURE_EGO_MAX_SPEED_MPS`]. pedsynth: the distances at which drivers and pedestrians exchange gestures in
-/// naturalistic studies are a few car lengths (Rasouli et al., "Agreeing to cross", 2017, report most
-/// communication within ~30 m).
+/// [`GESTURE_EGO_MAX_SPEED_MPS`]. pedsynth: near enough for a driver to see a hand or a nod.
 pub const GESTURE_EGO_MAX_DIST_M: f64 = 30.0;
 /// See [`GESTURE_EGO_MAX_DIST_M`], m/s. pedsynth: a car at walking pace or stopped.
 pub const GESTURE_EGO_MAX_SPEED_MPS: f64 = 3.0;

@@ -31,8 +31,8 @@ pub(crate) const HALF_LENGTH_M: f64 = VEHICLE_LENGTH_M * 0.5;
 /// Half the vehicle width, metres.
 pub(crate) const HALF_WIDTH_M: f64 = VEHICLE_WIDTH_M * 0.5;
 
-/// A vehicle stops for an emergency vehicle closing in from nearer than this, metres. pedsynth: drivers hear a
-/// siren and see the lights some 50–100 m away; stopping from 50 km/h at a comfortable 2 m/s² takes ~48 m.
+/// A vehicle stops for an emergency vehicle closing in from nearer than this, metres. pedsynth: room to stop
+/// from 50 km/h at the default comfortable 3 m/s² (~32 m) before the two meet, at their closing speeds.
 pub(crate) const YIELD_TO_SIREN_M: f64 = 70.0;
 /// How far a yielding vehicle pulls over to the right, metres (a 1.9 m car stays inside a 3 m lane).
 pub(crate) const PULL_RIGHT_M: f64 = 0.5;
