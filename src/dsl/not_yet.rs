@@ -23,20 +23,7 @@ pub struct NotYet {
 }
 
 /// Every key not implemented yet.
-pub const NOT_YET: &[NotYet] = &[
-    NotYet {
-        path: "traffic.profiles.aggressive.ignore_lights_probability",
-        why: "no town has traffic lights yet, so there are no lights to ignore",
-    },
-    NotYet {
-        path: "traffic.profiles.normal.ignore_lights_probability",
-        why: "no town has traffic lights yet, so there are no lights to ignore",
-    },
-    NotYet {
-        path: "traffic.profiles.cautious.ignore_lights_probability",
-        why: "no town has traffic lights yet, so there are no lights to ignore",
-    },
-];
+pub const NOT_YET: &[NotYet] = &[];
 
 /// Reports every not-yet key of `spec` whose value differs from the default; `tree` (the user's YAML)
 /// locates it.

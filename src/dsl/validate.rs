@@ -845,6 +845,10 @@ impl Validator<'_> {
             "a waiting time in seconds",
         );
         self.probability("traffic.emergency.clip_share", t.emergency.clip_share);
+        let g = &t.signals;
+        self.positive("traffic.signals.green_s", g.green_s, 300.0, "a green time in seconds");
+        self.num("traffic.signals.amber_s", g.amber_s, 0.0, 30.0, "an amber time in seconds");
+        self.num("traffic.signals.all_red_s", g.all_red_s, 0.0, 60.0, "an all-red time in seconds");
     }
 
     fn mount(&mut self, base: &str, m: &Mount) {

@@ -7,6 +7,8 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
+pub use crate::exec::simulate::signals::LightState;
+
 use crate::world::LaneType;
 
 /// The paper's 12 behaviour states.
@@ -96,6 +98,9 @@ pub struct VehicleFrame {
     pub accel_mps2: f64,
     /// Whether it is stopping for an emergency vehicle (an approaching siren).
     pub yielding: bool,
+    /// The state of the traffic light at the next stop line on its path, if one is within 80 m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<LightState>,
 }
 
 /// A pedestrian in one frame.
@@ -222,6 +227,21 @@ pub enum Event {
         /// Whether it then crossed suddenly (otherwise it abandoned the attempt).
         sudden_crossing: bool,
     },
+    /// A vehicle met a red light: it passed the stop line on red (`ran`), or it came to a stop before it.
+    RedLight {
+        /// Frame: the first whose recorded state is past the line, or stopped.
+        frame: u32,
+        /// The vehicle.
+        vehicle: VehicleId,
+        /// The light (index into the trace's `signals`).
+        signal: u32,
+        /// Whether it ran the red light (else it stopped for it).
+        ran: bool,
+        /// For a light run by a vehicle that heeds lights: it could not stop when it first saw the light amber
+        /// or red (the dilemma zone, or placed too close to a red light at the clip's start). A light run by a
+        /// vehicle drawn to ignore lights, or by an emergency vehicle, is not.
+        unavoidable: bool,
+    },
     /// A vehicle touched a pedestrian or another vehicle (recorded, never hidden).
     Contact {
         /// Frame.
@@ -286,4 +306,24 @@ pub struct ClipTrace {
     pub pedestrians: Vec<Vec<PedFrame>>,
     /// Events in frame order.
     pub events: Vec<Event>,
+    /// The town's traffic lights and their state per frame (empty where lights do not run).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub signals: Vec<SignalTrack>,
+}
+
+/// One traffic light of a clip's town and its state in every frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SignalTrack {
+    /// The light's id in the town (`pedsynth town show` lists them).
+    pub id: String,
+    /// Its junction's id.
+    pub junction: String,
+    /// The phase of the junction's plan in which it is green.
+    pub phase: u32,
+    /// Centre of the head, world metres.
+    pub position: DVec3,
+    /// The direction its lamps face, radians.
+    pub facing_rad: f64,
+    /// State per frame.
+    pub states: Vec<LightState>,
 }

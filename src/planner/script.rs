@@ -8,7 +8,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::dsl::types::{
-    Body, GapAcceptance, Gestures, Idm, Lookahead, Patience, Range, Retreat, Rgb, Spec, SpeedProfiles, Split,
+    Body, GapAcceptance, Gestures, Idm, Lookahead, Patience, Range, Retreat, Rgb, Signals, Spec, SpeedProfiles, Split,
     Visibility, WeatherParams,
 };
 
@@ -70,6 +70,9 @@ pub struct SimParams {
     pub visibility: Visibility,
     /// Gestures to the ego's driver.
     pub gestures: Gestures,
+    /// Traffic lights (absent when they do not run, and then absent from the plan file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signals: Option<Signals>,
 }
 
 impl SimParams {
@@ -86,6 +89,7 @@ impl SimParams {
             camera: spec.sensors.rgb.clone(),
             visibility: spec.annotations.visibility.clone(),
             gestures: spec.pedestrians.gestures.clone(),
+            signals: spec.traffic.signals.enabled.then(|| spec.traffic.signals.clone()),
         }
     }
 }

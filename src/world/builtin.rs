@@ -181,6 +181,7 @@ pub(crate) fn build(name: &str) -> Option<RoadNetwork> {
         p.name,
         "",
         Some(obstacles),
+        true,
     )
     .expect("built-in towns are valid OpenDRIVE (covered by tests/world_builtin.rs)");
     Some(net)
@@ -296,6 +297,8 @@ impl Gen {
             }],
             sections: vec![RawSection { s: 0.0, pos: 0, lanes }],
             objects: Vec::new(),
+            signals: Vec::new(),
+            signal_refs: Vec::new(),
         });
         id
     }
@@ -677,6 +680,7 @@ fn generate(p: &Params) -> (RawNetwork, Vec<Obstacle>) {
                 id: jid.to_string(),
                 name: format!("junction {i},{j}"),
                 connections,
+                controllers: Vec::new(),
             });
         }
     }
@@ -740,6 +744,7 @@ fn generate(p: &Params) -> (RawNetwork, Vec<Obstacle>) {
         RawNetwork {
             roads: g.roads,
             junctions,
+            controllers: Vec::new(),
         },
         obstacles,
     )

@@ -54,6 +54,30 @@ pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<S
         s.bounds_m[1],
         s.bounds_m[3]
     );
+    if s.signal_count > 0 {
+        out.push_str(&format!(
+            "  traffic lights: {} heads at {} junctions, {} controllers (phases)\n",
+            s.signal_count, s.signalised_junction_count, s.signal_controller_count
+        ));
+        for (j, junction) in net.junctions.iter().enumerate() {
+            let phases = super::signals::junction_phases(&net.signals, j as u32);
+            if phases == 0 {
+                continue;
+            }
+            let heads: Vec<String> = (0..phases)
+                .map(|k| {
+                    let ids: Vec<&str> = net
+                        .signals
+                        .iter()
+                        .filter(|g| g.junction == j as u32 && g.phase == k)
+                        .map(|g| g.id.as_str())
+                        .collect();
+                    format!("phase {k}: {}", ids.join(" "))
+                })
+                .collect();
+            out.push_str(&format!("    junction {}: {}\n", junction.id, heads.join("; ")));
+        }
+    }
     if let Some(path) = png {
         out.push_str(&format!("  map written to {}\n", path.display()));
     }

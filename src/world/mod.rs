@@ -31,6 +31,7 @@ mod obstacles;
 pub mod opendrive;
 mod render;
 mod routes;
+pub mod signals;
 
 use std::ops::Range;
 use std::path::Path;
@@ -40,6 +41,7 @@ use serde::Serialize;
 
 pub use cli::{town_export, town_list_text, town_show};
 pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSample, SpawnPoint};
+pub use signals::Signal;
 
 /// Names of the built-in procedural towns, in the order `pedsynth town list` shows them. They are modelled on
 /// the paper's CARLA towns but are not CARLA's maps, hence the `_like` suffix.
@@ -411,6 +413,12 @@ pub struct TownSummary {
     pub junction_count: usize,
     pub crosswalk_count: usize,
     pub obstacle_count: usize,
+    /// Traffic light heads (one per signalised junction approach).
+    pub signal_count: usize,
+    /// Junctions with traffic lights.
+    pub signalised_junction_count: usize,
+    /// Signal controllers: the phases of all signalised junctions' plans together.
+    pub signal_controller_count: usize,
     /// Total centre-line length of driving lanes (junction connecting lanes included), km, 2 decimals.
     pub driving_lane_km: f64,
     /// Total centre-line length of sidewalk lanes, km, 2 decimals.
@@ -432,6 +440,8 @@ pub struct RoadNetwork {
     pub junctions: Vec<Junction>,
     pub crosswalks: Vec<Crosswalk>,
     pub obstacles: Vec<Obstacle>,
+    /// Traffic light heads, sorted by junction and approach road ([`signals`]).
+    pub signals: Vec<Signal>,
     /// `(min, max)` corners of the axis-aligned bounds of all lane pieces.
     pub bounds: (DVec2, DVec2),
     index: index::LaneIndex,
@@ -447,7 +457,7 @@ impl RoadNetwork {
     }
 
     /// A fingerprint of the town's geometry and topology (blake3 of the JSON of its roads, lanes, pieces,
-    /// junctions, crosswalks and obstacles; not its name or source path): a plan records it for every town, so
+    /// junctions, crosswalks, obstacles and traffic lights; not its name or source path): a plan records it for every town, so
     /// that a plan made for another version of a map is refused instead of indexing the wrong lanes.
     pub fn fingerprint(&self) -> String {
         #[derive(Serialize)]
@@ -458,6 +468,8 @@ impl RoadNetwork {
             junctions: &'a [Junction],
             crosswalks: &'a [Crosswalk],
             obstacles: &'a [Obstacle],
+            #[serde(skip_serializing_if = "<[_]>::is_empty")]
+            signals: &'a [Signal],
         }
         let geometry = Geometry {
             roads: &self.roads,
@@ -466,6 +478,7 @@ impl RoadNetwork {
             junctions: &self.junctions,
             crosswalks: &self.crosswalks,
             obstacles: &self.obstacles,
+            signals: &self.signals,
         };
         let mut hasher = blake3::Hasher::new();
         // Serialising plain data into a hasher cannot fail; were it to, the fingerprint would still differ
@@ -571,6 +584,13 @@ impl RoadNetwork {
             junction_count: self.junctions.len(),
             crosswalk_count: self.crosswalks.len(),
             obstacle_count: self.obstacles.len(),
+            signal_count: self.signals.len(),
+            signalised_junction_count: (0..self.junctions.len() as u32)
+                .filter(|&j| signals::junction_phases(&self.signals, j) > 0)
+                .count(),
+            signal_controller_count: (0..self.junctions.len() as u32)
+                .map(|j| signals::junction_phases(&self.signals, j) as usize)
+                .sum(),
             driving_lane_km: km(LaneType::Driving),
             sidewalk_km: km(LaneType::Sidewalk),
             routable_lane_count: self.lane_graph.routable_lane_count(),

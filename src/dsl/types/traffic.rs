@@ -22,6 +22,8 @@ pub struct Traffic {
     pub ego: Ego,
     /// Emergency scenarios (a vehicle braking hard or a pedestrian darting out close to the ego).
     pub emergency: Emergency,
+    /// Traffic lights at the town's signalised junctions.
+    pub signals: Signals,
 }
 
 impl Default for Traffic {
@@ -37,6 +39,38 @@ impl Default for Traffic {
             idm: Idm::default(),
             ego: Ego::default(),
             emergency: Emergency::default(),
+            signals: Signals::default(),
+        }
+    }
+}
+
+/// Traffic lights: the heads of the town (an OpenDRIVE map's `<signal dynamic="yes">` records; built-in towns'
+/// junctions of three or more approaches) run a fixed-time plan per junction, its phases green one after the
+/// other as CARLA's traffic-light groups do (green, amber, then all red before the next phase), with a seeded
+/// offset per junction and clip. Vehicles stop at red, and at amber when they can stop comfortably; a vehicle
+/// drawn to ignore lights (its profile's `ignore_lights_probability`) drives through, and emergency vehicles
+/// are allowed through.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Signals {
+    /// Whether the lights run. Off by default: the crossing-rate calibration was measured without them (the ego
+    /// stopping at red lights changes when crossers are in view).
+    pub enabled: bool,
+    /// Green time of each phase, seconds (CARLA's default: 10).
+    pub green_s: f64,
+    /// Amber (yellow) time after each green, seconds (CARLA's default: 3).
+    pub amber_s: f64,
+    /// All-red time after each amber, seconds (CARLA's default red time: 2).
+    pub all_red_s: f64,
+}
+
+impl Default for Signals {
+    fn default() -> Self {
+        Signals {
+            enabled: false,
+            green_s: 10.0,
+            amber_s: 3.0,
+            all_red_s: 2.0,
         }
     }
 }

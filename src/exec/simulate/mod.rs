@@ -33,6 +33,7 @@
 
 mod contacts;
 pub(crate) mod pedestrian;
+pub mod signals;
 pub mod ttc;
 pub(crate) mod vehicle;
 pub(crate) mod view;
@@ -42,7 +43,7 @@ use std::collections::BTreeMap;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::exec::trace::{ClipTrace, Event, PedFrame, VehicleFrame};
+use crate::exec::trace::{ClipTrace, Event, PedFrame, SignalTrack, VehicleFrame};
 use crate::planner::{ClipScript, Plan, SimParams, TownContext, seeds};
 use crate::world::RoadNetwork;
 use contacts::Contacts;
@@ -106,6 +107,8 @@ struct Sim<'a> {
     net: &'a RoadNetwork,
     /// Whether the clip has an emergency vehicle (only then does anyone yield to one).
     sirens: bool,
+    /// The traffic lights' plans, where lights run.
+    lights: Option<signals::SignalPlans>,
     dt_s: f64,
     /// The ego first (`VehicleId::Ego`), then traffic in script order.
     vehicles: Vec<Vehicle>,
@@ -166,6 +169,32 @@ impl<'a> Sim<'a> {
         }
         let zones = vehicle::conflict_zones(&vehicles);
         let sirens = vehicles.iter().any(|v| v.emergency.is_some());
+        let lights = params
+            .signals
+            .as_ref()
+            .filter(|_| !net.signals.is_empty())
+            .map(|t| signals::SignalPlans::new(net, t, script.seed));
+        if lights.is_some() {
+            vehicles[0].set_stop_lines(signals::stop_lines(&script.ego.route, net));
+            for (v, s) in vehicles[1..].iter_mut().zip(&script.vehicles) {
+                v.set_stop_lines(signals::stop_lines(&s.route, net));
+            }
+        }
+        let signal_tracks = if lights.is_some() {
+            net.signals
+                .iter()
+                .map(|g| SignalTrack {
+                    id: g.id.clone(),
+                    junction: net.junctions[g.junction as usize].id.clone(),
+                    phase: g.phase,
+                    position: g.position,
+                    facing_rad: g.facing_rad,
+                    states: Vec::with_capacity(frames),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let trace = ClipTrace {
             clip_id: script.clip_id.clone(),
             fps,
@@ -174,11 +203,13 @@ impl<'a> Sim<'a> {
             vehicles: (0..script.vehicles.len()).map(|_| Vec::with_capacity(frames)).collect(),
             pedestrians: (0..np).map(|_| Vec::with_capacity(frames)).collect(),
             events,
+            signals: signal_tracks,
         };
         Sim {
             params,
             net,
             sirens,
+            lights,
             dt_s: 1.0 / f64::from(fps),
             vehicles,
             peds,
@@ -199,6 +230,7 @@ impl<'a> Sim<'a> {
     fn run(&mut self) {
         let frames = self.trace.frame_count;
         for f in 0..frames {
+            self.see_lights(f);
             self.record();
             if f + 1 < frames {
                 self.step(f);
@@ -214,6 +246,7 @@ impl<'a> Sim<'a> {
                 speed_mps: v.speed_mps,
                 accel_mps2: v.accel_mps2,
                 yielding: v.yielding,
+                light: v.light_ahead.map(|(_, state)| state),
             };
             if k == 0 {
                 self.trace.ego.push(frame);
@@ -235,6 +268,71 @@ impl<'a> Sim<'a> {
                 gesture: p.gesture,
                 reaction: p.reaction(),
             });
+        }
+    }
+
+    /// The lights' states at frame `f` (recorded), and each vehicle's next light within range.
+    fn see_lights(&mut self, f: u32) {
+        let Some(plans) = &self.lights else { return };
+        let time_s = f64::from(f) * self.dt_s;
+        for (track, g) in self.trace.signals.iter_mut().zip(&self.net.signals) {
+            track.states.push(plans.state_at(g, time_s));
+        }
+        let idm = &self.params.idm;
+        for v in &mut self.vehicles {
+            v.light_ahead = v.stop_lines.get(v.next_stop).and_then(|l| {
+                let gap = l.s_m - (v.s_m + vehicle::HALF_LENGTH_M);
+                (gap <= vehicle::LIGHT_RANGE_M).then(|| (gap, plans.state_at(&self.net.signals[l.signal as usize], time_s)))
+            });
+            // The dilemma zone: a light that turns amber (or is red when first seen) too close to stop for, at a
+            // comfortable rate for amber and the hardest for red, is driven through.
+            if let Some((gap, state)) = v.light_ahead
+                && v.bound_by_light()
+            {
+                let stoppable = match state {
+                    signals::LightState::Green => true,
+                    signals::LightState::Amber => signals::can_stop(gap, v.speed_mps, idm.comfortable_decel_mps2),
+                    signals::LightState::Red => signals::can_stop(gap, v.speed_mps, idm.max_decel_mps2),
+                };
+                if !stoppable {
+                    v.committed = Some(v.next_stop);
+                }
+            }
+        }
+    }
+
+    /// After the vehicles moved in the step to frame `frame`: a front bumper past its next stop line while that
+    /// light was red ran it; a vehicle standing before a red line has stopped for it (once per line).
+    fn pass_stop_lines(&mut self, frame: u32) {
+        if self.lights.is_none() {
+            return;
+        }
+        for v in &mut self.vehicles {
+            let Some(line) = v.stop_lines.get(v.next_stop).copied() else {
+                continue;
+            };
+            let red = matches!(v.light_ahead, Some((_, signals::LightState::Red)));
+            if v.s_m + vehicle::HALF_LENGTH_M >= line.s_m {
+                if red {
+                    self.trace.events.push(Event::RedLight {
+                        frame,
+                        vehicle: v.id,
+                        signal: line.signal,
+                        ran: true,
+                        unavoidable: v.heeds_lights(),
+                    });
+                }
+                v.next_stop += 1;
+            } else if red && v.bound_by_light() && v.speed_mps < 0.1 && v.stopped_at != Some(v.next_stop) {
+                v.stopped_at = Some(v.next_stop);
+                self.trace.events.push(Event::RedLight {
+                    frame,
+                    vehicle: v.id,
+                    signal: line.signal,
+                    ran: false,
+                    unavoidable: false,
+                });
+            }
         }
     }
 
@@ -365,6 +463,7 @@ impl<'a> Sim<'a> {
         for (v, &a) in self.vehicles.iter_mut().zip(&self.accels) {
             v.integrate(a, self.dt_s);
         }
+        self.pass_stop_lines(f + 1);
         // 7. Contacts.
         self.contacts
             .resolve(f + 1, &mut self.vehicles, &mut self.peds, &mut self.trace.events);

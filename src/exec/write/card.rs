@@ -53,7 +53,8 @@ fn table_summary(table: &str) -> &'static str {
         }
         "tracks" => "one row per pedestrian and frame, seen or not: position, velocity, state, C",
         "vehicles" => "one row per traffic vehicle and frame: pose, speed, driving profile",
-        "events" => "state changes, crossing decisions, conflicts, contacts",
+        "events" => "state changes, crossing decisions, conflicts, contacts, red lights run or stopped for",
+        "traffic_lights" => "one row per traffic light near the ego and frame: id, junction, phase, state, position",
         "sensor_poses" => "each sensor's world pose per frame",
         "sensors" => "one row per sensor file (path, size, SHA-256)",
         _ => "",

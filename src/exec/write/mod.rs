@@ -149,6 +149,7 @@ impl DatasetWriter {
             ("tracks", tables::tracks_batch(script, trace, ann)),
             ("vehicles", tables::vehicles_batch(script, trace)),
             ("events", tables::events_batch(script, trace)),
+            ("traffic_lights", tables::traffic_lights_batch(script, trace)),
             (
                 "sensor_poses",
                 tables::sensor_poses_batch(script, trace, rig, &plan.spec.sensors),

@@ -21,21 +21,22 @@ use parquet::file::properties::WriterProperties;
 use crate::dsl::types::{Compression, Output, PoseFormat};
 use crate::error::{Error, code};
 use crate::exec::observe::annotate::ClipAnnotations;
-use crate::exec::trace::{ClipTrace, Event, PedestrianId, VehicleId};
+use crate::exec::trace::{ClipTrace, Event, LightState, PedestrianId, VehicleId};
 use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 6;
+pub const SCHEMA_VERSION: u32 = 7;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 9] = [
+pub const TABLES: [&str; 10] = [
     "frames",
     "pedestrians",
     "annotations",
     "tracks",
     "vehicles",
     "events",
+    "traffic_lights",
     "sensor_poses",
     "sensors",
     "clips",
@@ -179,6 +180,7 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("ego_speed_mps", DataType::Float64, false),
             field("ego_accel_mps2", DataType::Float64, false),
             field("ego_yielding", DataType::Boolean, false),
+            field("ego_light_state", DataType::Utf8, true),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -191,6 +193,67 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             col(|f| f.speed_mps),
             col(|f| f.accel_mps2),
             Arc::new(BooleanArray::from_iter(trace.ego.iter().map(|f| Some(f.yielding)))),
+            Arc::new(StringArray::from_iter(trace.ego.iter().map(|f| f.light.map(LightState::name)))),
+        ],
+    )
+}
+
+/// Traffic lights within this distance of the ego (plan view) get a row in the `traffic_lights` table, metres.
+pub const TRAFFIC_LIGHT_RANGE_M: f64 = 100.0;
+
+/// The `traffic_lights` table: per frame, every traffic light within [`TRAFFIC_LIGHT_RANGE_M`] of the ego: its
+/// id, junction, phase, state, head position and facing, distance to the ego, and whether it faces the ego
+/// from ahead (its lamps turned within 30° of the ego, the ego within 45° of its heading to it). Empty where
+/// lights do not run.
+pub fn traffic_lights_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
+    let cos_30 = 30f64.to_radians().cos();
+    let cos_45 = std::f64::consts::FRAC_1_SQRT_2;
+    let mut rows: Vec<(u32, usize, f64, bool)> = Vec::new();
+    for (f, ego) in trace.ego.iter().enumerate() {
+        let e = ego.pos.truncate();
+        for (k, g) in trace.signals.iter().enumerate() {
+            let to_light = g.position.truncate() - e;
+            let d = to_light.length();
+            if d > TRAFFIC_LIGHT_RANGE_M {
+                continue;
+            }
+            let dir = to_light / d.max(1e-9);
+            let facing = glam::DVec2::from_angle(g.facing_rad).dot(-dir) >= cos_30
+                && glam::DVec2::from_angle(ego.yaw_rad).dot(dir) >= cos_45;
+            rows.push((f as u32, k, d, facing));
+        }
+    }
+    let n = rows.len();
+    let sig = |r: &(u32, usize, f64, bool)| &trace.signals[r.1];
+    let state = |r: &(u32, usize, f64, bool)| sig(r).states.get(r.0 as usize).map_or("green", |s| s.name());
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("signal", DataType::Utf8, false),
+            field("junction", DataType::Utf8, false),
+            field("phase", DataType::UInt32, false),
+            field("state", DataType::Utf8, false),
+            field("x_m", DataType::Float32, false),
+            field("y_m", DataType::Float32, false),
+            field("z_m", DataType::Float32, false),
+            field("facing_rad", DataType::Float32, false),
+            field("distance_m", DataType::Float32, false),
+            field("faces_ego", DataType::Boolean, false),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| sig(r).id.as_str()))),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| sig(r).junction.as_str()))),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| sig(r).phase))),
+            Arc::new(StringArray::from_iter_values(rows.iter().map(state))),
+            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.x as f32))),
+            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.y as f32))),
+            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.z as f32))),
+            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).facing_rad as f32))),
+            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| r.2 as f32))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.3)))),
         ],
     )
 }
@@ -463,6 +526,8 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("kind", DataType::Utf8, false),
             field("siren", DataType::Boolean, false),
             field("yielding", DataType::Boolean, false),
+            field("ignores_lights", DataType::Boolean, false),
+            field("light_state", DataType::Utf8, true),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -482,6 +547,10 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 rows.iter().map(|r| Some(emergency(r.1).is_some())),
             )),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.2.yielding)))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| {
+                Some(script.vehicles.get(r.1 as usize).is_some_and(|s| s.ignores_lights))
+            }))),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.2.light.map(LightState::name)))),
         ],
     )
 }
@@ -562,6 +631,8 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         retreated: Option<bool>,
         sudden: Option<bool>,
         other: Option<u32>,
+        signal: Option<u32>,
+        unavoidable: Option<bool>,
     }
     let rows: Vec<Row> = trace
         .events
@@ -625,6 +696,20 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 other: other_vehicle.and_then(VehicleId::traffic),
                 ..Row::default()
             },
+            Event::RedLight {
+                frame,
+                vehicle,
+                signal,
+                ran,
+                unavoidable,
+            } => Row {
+                frame,
+                kind: if ran { "ran_red_light" } else { "stopped_at_red_light" },
+                vehicle: vehicle.traffic(),
+                signal: Some(signal),
+                unavoidable: ran.then_some(unavoidable),
+                ..Row::default()
+            },
         })
         .collect();
     let n = rows.len();
@@ -642,6 +727,8 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("retreated", DataType::Boolean, true),
             field("sudden_crossing", DataType::Boolean, true),
             field("other_vehicle", DataType::UInt32, true),
+            field("signal", DataType::Utf8, true),
+            field("unavoidable", DataType::Boolean, true),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -661,6 +748,9 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                     } | Event::Contact {
                         other_vehicle: Some(VehicleId::Ego),
                         ..
+                    } | Event::RedLight {
+                        vehicle: VehicleId::Ego,
+                        ..
                     }
                 ))
             }))),
@@ -670,6 +760,12 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.retreated))),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.sudden))),
             Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.other))),
+            Arc::new(StringArray::from_iter(rows.iter().map(|r| {
+                r.signal
+                    .and_then(|k| trace.signals.get(k as usize))
+                    .map(|g| g.id.as_str())
+            }))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.unavoidable))),
         ],
     )
 }

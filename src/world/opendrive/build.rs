@@ -165,7 +165,7 @@ pub(crate) fn build(
     path: &str,
     xml: &str,
 ) -> Result<RoadNetwork, WorldError> {
-    build_with(raw, name, source, path, xml, None)
+    build_with(raw, name, source, path, xml, None, false)
 }
 
 pub(crate) fn build_with(
@@ -175,6 +175,7 @@ pub(crate) fn build_with(
     path: &str,
     xml: &str,
     given_obstacles: Option<Vec<Obstacle>>,
+    synthesize_signals: bool,
 ) -> Result<RoadNetwork, WorldError> {
     let mut roads = Vec::with_capacity(raw.roads.len());
     let mut lanes: Vec<Lane> = Vec::new();
@@ -338,6 +339,7 @@ pub(crate) fn build_with(
         junctions,
         crosswalks,
         obstacles: Vec::new(),
+        signals: Vec::new(),
         bounds: (lo, hi),
         index: index::LaneIndex::default(),
         lane_graph: routes::LaneGraph::default(),
@@ -353,6 +355,7 @@ pub(crate) fn build_with(
     net.obstacle_index = obstacles::ObstacleIndex::build(&net.obstacles);
     net.lane_graph = routes::LaneGraph::build(&net);
     net.sidewalk_graph = routes::SidewalkGraph::build(&net);
+    net.signals = crate::world::signals::derive(&raw, &net, synthesize_signals);
     Ok(net)
 }
 

@@ -16,6 +16,8 @@ use crate::world::{JunctionConnection, LaneType, RoadLink, TravelDirection, Worl
 pub(crate) struct RawNetwork {
     pub roads: Vec<RawRoad>,
     pub junctions: Vec<RawJunction>,
+    /// Top-level `<controller>` records: (controller id, the signal ids it controls).
+    pub controllers: Vec<(String, Vec<String>)>,
 }
 
 #[derive(Clone, Debug)]
@@ -37,6 +39,19 @@ pub(crate) struct RawRoad {
     pub lane_offsets: Vec<Poly3At>,
     pub sections: Vec<RawSection>,
     pub objects: Vec<RawObject>,
+    /// Dynamic vehicle signals (`<signal dynamic="yes">`, traffic lights) on this road.
+    pub signals: Vec<RawSignal>,
+    /// Ids of the signals this road's `<signalReference>`s name (a junction's connecting roads name the
+    /// signal that controls them).
+    pub signal_refs: Vec<String>,
+}
+
+/// A `<signal dynamic="yes">` (a traffic light) in road coordinates.
+#[derive(Clone, Debug)]
+pub(crate) struct RawSignal {
+    pub id: String,
+    pub s: f64,
+    pub t: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -66,6 +81,8 @@ pub(crate) struct RawJunction {
     pub id: String,
     pub name: String,
     pub connections: Vec<JunctionConnection>,
+    /// `<controller id sequence>` children: (controller id, sequence), the junction's signal phases in order.
+    pub controllers: Vec<(String, u32)>,
 }
 
 /// An `<object>`; crosswalks and buildings are used.
@@ -226,6 +243,12 @@ pub(crate) fn parse(xml: &str, path: &str) -> Result<RawNetwork, WorldError> {
         match n.tag_name().name() {
             "road" => net.roads.push(parse_road(&cx, n)?),
             "junction" => net.junctions.push(parse_junction(&cx, n)?),
+            "controller" => net.controllers.push((
+                n.attribute("id").unwrap_or("").to_string(),
+                children(n, "control")
+                    .filter_map(|c| c.attribute("signalId").map(str::to_string))
+                    .collect(),
+            )),
             _ => {}
         }
     }
@@ -267,6 +290,8 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
         lane_offsets: Vec::new(),
         sections: Vec::new(),
         objects: Vec::new(),
+        signals: Vec::new(),
+        signal_refs: Vec::new(),
     };
     if let Some(link) = child(n, "link") {
         road.predecessor = child(link, "predecessor").and_then(parse_link);
@@ -325,6 +350,25 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
         for o in children(objs, "object") {
             road.objects.push(parse_object(cx, o)?);
         }
+    }
+    if let Some(sigs) = child(n, "signals") {
+        for g in children(sigs, "signal") {
+            // Traffic lights only: dynamic signals (static ones are signs).
+            if !g.attribute("dynamic").is_some_and(|d| d.trim().eq_ignore_ascii_case("yes")) {
+                continue;
+            }
+            let s = cx.num_or(g, "s", 0.0)?;
+            cx.bounded(g, "s", s, -1e-6, MAX_LENGTH_M)?;
+            let t = cx.num_or(g, "t", 0.0)?;
+            cx.bounded(g, "t", t, -1e4, 1e4)?;
+            road.signals.push(RawSignal {
+                id: g.attribute("id").unwrap_or("").to_string(),
+                s: s.max(0.0),
+                t,
+            });
+        }
+        road.signal_refs
+            .extend(children(sigs, "signalReference").filter_map(|r| r.attribute("id").map(str::to_string)));
     }
     Ok(road)
 }
@@ -492,10 +536,17 @@ fn parse_junction(cx: &Ctx, n: Node) -> Result<RawJunction, WorldError> {
             lane_links,
         });
     }
+    let controllers = children(n, "controller")
+        .filter_map(|c| {
+            let seq = c.attribute("sequence").and_then(|v| v.trim().parse::<u32>().ok()).unwrap_or(0);
+            Some((c.attribute("id")?.to_string(), seq))
+        })
+        .collect();
     Ok(RawJunction {
         id: n.attribute("id").unwrap_or("").to_string(),
         name: n.attribute("name").unwrap_or("").to_string(),
         connections,
+        controllers,
     })
 }
 

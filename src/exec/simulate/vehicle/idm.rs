@@ -2,6 +2,7 @@
 //! junction conflict zones, the end of the route, and the ego's braking rule for crossing pedestrians.
 
 use super::conflict_zones::{ConflictZone, zone_yield_gap_m};
+use super::super::signals::LightState;
 use super::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
 use crate::dsl::types::Idm;
 use crate::exec::simulate::{PED_RADIUS_M, VEHICLE_LENGTH_M};
@@ -13,6 +14,8 @@ const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
 /// The ego stops at least this many metres short of a waiting pedestrian per metre it stands to the side (1.4:
 /// about 35° off the heading, inside the camera's 45° half field of view).
 const COURTESY_STOP_PER_LATERAL: f64 = 1.4;
+/// A vehicle stopping for a light aims this far short of the stop line, metres.
+const STOP_LINE_MARGIN_M: f64 = 1.0;
 /// Time constant of the ego's easing off to its courtesy speed, seconds.
 const COURTESY_RESPONSE_S: f64 = 1.5;
 
@@ -61,6 +64,20 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
     if me.yielding {
         // Stopping for an emergency vehicle, at a comfortable rate.
         accel = accel.min(-idm.comfortable_decel_mps2.min(v / 0.5));
+    }
+
+    // A red or amber light at a line it has not committed to (it could stop when it first saw it): a standing
+    // obstacle at the stop line.
+    if let Some((gap, state)) = me.light_ahead.filter(|_| me.bound_by_light()) {
+        if state != LightState::Green {
+            // Aim a little short of the line, so that the car-following's overshoot never crosses it.
+            let short = (gap - STOP_LINE_MARGIN_M).max(0.0);
+            accel = accel.min(idm_to(short + me.min_gap_m, 0.0));
+            let need = v * v / (2.0 * short.max(0.05));
+            if need > idm.comfortable_decel_mps2 {
+                accel = accel.min(-need.min(idm.max_decel_mps2));
+            }
+        }
     }
 
     // End of route: a standing obstacle.

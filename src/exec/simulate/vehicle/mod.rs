@@ -6,8 +6,9 @@
 //! [`VEHICLE_LENGTH_M`] × [`VEHICLE_WIDTH_M`] box centred on that point and aligned with the path. Leaders are
 //! found geometrically: anything whose footprint (a vehicle) or disc (a pedestrian) intrudes on the corridor of
 //! half-width `VEHICLE_WIDTH_M / 2 + margin` around the path ahead, within the look-ahead distance. This also
-//! covers vehicles on crossing paths inside junctions, since there are no traffic lights in the world model
-//! (`ignores_lights` has nothing to act on).
+//! covers vehicles on crossing paths inside junctions. Where traffic lights run, the next stop line on the path
+//! whose light is red (or amber, when the vehicle can stop comfortably) is a standing leader, unless the
+//! vehicle ignores lights or is an emergency vehicle.
 
 mod conflict_zones;
 mod idm;
@@ -65,7 +66,24 @@ pub(crate) struct Vehicle {
     pub yielding: bool,
     /// How far it has pulled over to the right of its path (yielding), metres.
     pub pull_right_m: f64,
+    /// Whether it drives through red lights (drawn per vehicle from its profile).
+    pub ignores_lights: bool,
+    /// The stop lines of traffic lights along its path, in path order (empty where lights do not run).
+    pub stop_lines: Vec<super::signals::StopLine>,
+    /// Index into `stop_lines` of the next one ahead of its front bumper.
+    pub next_stop: usize,
+    /// The next stop line's light this step, if within [`LIGHT_RANGE_M`]: (front bumper to the line, metres,
+    /// its state).
+    pub light_ahead: Option<(f64, super::signals::LightState)>,
+    /// The stop line (index into `stop_lines`) at which a stop for red has been recorded.
+    pub stopped_at: Option<usize>,
+    /// The stop line (index into `stop_lines`) it drives through because it could not stop when it first saw
+    /// its light amber or red (the dilemma zone; at a clip's start, a vehicle placed too close to a red light).
+    pub committed: Option<usize>,
 }
+
+/// A vehicle heeds (and the tables report) the light of its next stop line from this far, metres.
+pub(crate) const LIGHT_RANGE_M: f64 = 80.0;
 
 impl Vehicle {
     /// The ego vehicle, at its route start, at its target speed.
@@ -110,11 +128,34 @@ impl Vehicle {
             None,
         )
         .with_emergency(script.emergency)
+        .with_ignores_lights(script.ignores_lights)
     }
 
     fn with_emergency(mut self, emergency: Option<EmergencyKind>) -> Vehicle {
         self.emergency = emergency;
         self
+    }
+
+    fn with_ignores_lights(mut self, ignores_lights: bool) -> Vehicle {
+        self.ignores_lights = ignores_lights;
+        self
+    }
+
+    /// Sets the stop lines along its path; those its front bumper has passed are behind it.
+    pub fn set_stop_lines(&mut self, stop_lines: Vec<super::signals::StopLine>) {
+        let front = self.s_m + HALF_LENGTH_M;
+        self.next_stop = stop_lines.iter().take_while(|l| l.s_m <= front).count();
+        self.stop_lines = stop_lines;
+    }
+
+    /// Whether red lights bind it (not for those drawn to ignore them, nor for emergency vehicles).
+    pub fn heeds_lights(&self) -> bool {
+        !self.ignores_lights && self.emergency.is_none()
+    }
+
+    /// Whether the light at its next stop line binds it: it heeds lights and has not committed to the line.
+    pub fn bound_by_light(&self) -> bool {
+        self.heeds_lights() && self.committed != Some(self.next_stop)
     }
 
     /// Whether it yields to the emergency vehicle `e`: `e` is nearer than [`YIELD_TO_SIREN_M`] and closing in,
@@ -159,6 +200,12 @@ impl Vehicle {
             emergency: None,
             yielding: false,
             pull_right_m: 0.0,
+            ignores_lights: false,
+            stop_lines: Vec::new(),
+            next_stop: 0,
+            light_ahead: None,
+            stopped_at: None,
+            committed: None,
         }
     }
 
