@@ -281,7 +281,9 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
             ("traffic.emergency.clip_share", json!(1.0)),
         ],
         // The lights' timing shows only where they run.
-        p if p.starts_with("traffic.signals.") => vec![("traffic.signals.enabled", json!(true))],
+        p if p.starts_with("traffic.signals.") && p != "traffic.signals.enabled" => {
+            vec![("traffic.signals.enabled", json!(true))]
+        }
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }

@@ -77,7 +77,7 @@ def recompute(root: Path) -> dict:
         "annotations",
         ["clip_id", "frame", "pedestrian", "state", "crossing", "look", "action", "gesture", "reaction"],
     )
-    events = read_table(root, "events", ["clip_id", "kind"])
+    events = read_table(root, "events", ["clip_id", "kind", "unavoidable"])
 
     split_of = clips.select(["clip_id", "split"])
     n_peds = peds.num_rows
@@ -137,6 +137,15 @@ def recompute(root: Path) -> dict:
             pc.sum(pc.cast(read_table(root, "vehicles", ["yielding"])["yielding"], pa.int64())).as_py() or 0
         )
         + int(pc.sum(pc.cast(read_table(root, "frames", ["ego_yielding"])["ego_yielding"], pa.int64())).as_py() or 0),
+        "red_lights_stopped_for": sum(1 for k in events["kind"].to_pylist() if k == "stopped_at_red_light"),
+        "red_light_violations": sum(
+            1 for k, u in zip(events["kind"].to_pylist(), events["unavoidable"].to_pylist())
+            if k == "ran_red_light" and not u
+        ),
+        "red_lights_run_unavoidably": sum(
+            1 for k, u in zip(events["kind"].to_pylist(), events["unavoidable"].to_pylist())
+            if k == "ran_red_light" and u
+        ),
     }
 
 
@@ -172,7 +181,8 @@ def compare(mine: dict, stats: dict) -> Checker:
     c.equal("contacts", mine["contacts"], stats.get("contacts"))
     c.equal("rejected", mine["rejected"], stats.get("rejected"))
     for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples",
-                "emergency_clips", "yielding_vehicle_frames"]:
+                "emergency_clips", "yielding_vehicle_frames", "red_lights_stopped_for", "red_light_violations",
+                "red_lights_run_unavoidably"]:
         c.equal(key, mine[key], stats.get(key))
     their_counts = stats.get("state_samples")
     if their_counts is not None:

@@ -847,8 +847,20 @@ impl Validator<'_> {
         self.probability("traffic.emergency.clip_share", t.emergency.clip_share);
         let g = &t.signals;
         self.positive("traffic.signals.green_s", g.green_s, 300.0, "a green time in seconds");
-        self.num("traffic.signals.amber_s", g.amber_s, 0.0, 30.0, "an amber time in seconds");
-        self.num("traffic.signals.all_red_s", g.all_red_s, 0.0, 60.0, "an all-red time in seconds");
+        self.num(
+            "traffic.signals.amber_s",
+            g.amber_s,
+            0.0,
+            30.0,
+            "an amber time in seconds",
+        );
+        self.num(
+            "traffic.signals.all_red_s",
+            g.all_red_s,
+            0.0,
+            60.0,
+            "an all-red time in seconds",
+        );
     }
 
     fn mount(&mut self, base: &str, m: &Mount) {

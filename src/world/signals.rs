@@ -228,14 +228,14 @@ fn from_file(raw: &RawNetwork, net: &RoadNetwork, approaches: &[Approach]) -> Ve
                     .iter()
                     .any(|&(id, j)| id == sig.id && net.junctions[a.junction as usize].id == j)
             });
-            let nearer_end = candidates
-                .iter()
-                .min_by(|a, b| {
-                    let len = raw.roads[approach_road].length;
-                    let d = |x: &Approach| if x.at_road_end { (len - sig.s).abs() } else { sig.s };
-                    d(a).total_cmp(&d(b))
-                });
-            let Some(a) = by_reference.or(nearer_end).copied().copied() else { continue };
+            let nearer_end = candidates.iter().min_by(|a, b| {
+                let len = raw.roads[approach_road].length;
+                let d = |x: &Approach| if x.at_road_end { (len - sig.s).abs() } else { sig.s };
+                d(a).total_cmp(&d(b))
+            });
+            let Some(a) = by_reference.or(nearer_end).copied().copied() else {
+                continue;
+            };
             let (p, h) = ref_at(road, sig.s);
             let q = p + DVec2::new(-h.sin(), h.cos()) * sig.t;
             let ground = net.lane_at(q).map_or_else(
@@ -265,7 +265,9 @@ fn from_file(raw: &RawNetwork, net: &RoadNetwork, approaches: &[Approach]) -> Ve
     let mut signals = Vec::with_capacity(out.len());
     for j in 0..net.junctions.len() as u32 {
         let mine: Vec<&(Signal, Option<u32>, f64)> = out.iter().filter(|(s, _, _)| s.junction == j).collect();
-        let Some(first_heading) = mine.first().map(|m| m.2) else { continue };
+        let Some(first_heading) = mine.first().map(|m| m.2) else {
+            continue;
+        };
         let mut sequences: Vec<u32> = mine.iter().filter_map(|(_, seq, _)| *seq).collect();
         sequences.sort_unstable();
         sequences.dedup();

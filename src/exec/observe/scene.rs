@@ -21,7 +21,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::body::{self, CAPSULES, CHILD_OFFSET_M};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
-use crate::exec::trace::{ClipTrace, PedFrame, VehicleFrame};
+use crate::exec::trace::{ClipTrace, LightState, PedFrame, VehicleFrame};
 use crate::mix::splitmix64;
 use crate::planner::{ClipScript, EmergencyKind, Identity};
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
@@ -38,6 +38,8 @@ pub mod tag {
     pub const BUILDING: u8 = 3;
     /// Poles and street lamps.
     pub const POLE: u8 = 6;
+    /// Traffic light heads.
+    pub const TRAFFIC_LIGHT: u8 = 7;
     /// Trees.
     pub const VEGETATION: u8 = 9;
     /// Grass and soil beside the roads.
@@ -606,6 +608,22 @@ pub fn clip_lamp_posts(trace: &ClipTrace, town: &RoadNetwork) -> Vec<LampPost> {
     posts
 }
 
+/// Half the width of a traffic light's post, metres.
+const SIGNAL_POST_HALF_WIDTH_M: f32 = 0.06;
+/// Half the height of a traffic light's housing (three lamps above each other), metres.
+const SIGNAL_HOUSING_HALF_HEIGHT_M: f32 = 0.45;
+/// Half the width of a traffic light's housing, metres.
+const SIGNAL_HOUSING_HALF_WIDTH_M: f32 = 0.17;
+/// Half the depth of a traffic light's housing (along its facing), metres.
+const SIGNAL_HOUSING_HALF_DEPTH_M: f32 = 0.12;
+/// Half the side of a traffic light's lamp, metres.
+const SIGNAL_LAMP_HALF_M: f32 = 0.11;
+
+/// `p` relative to the scene origin, f32.
+fn stat_rel(origin: DVec3, p: DVec3) -> Vec3 {
+    (p - origin).as_vec3()
+}
+
 impl StaticScene {
     /// Builds the static scene of a clip: the town within [`SCENE_MARGIN_M`] of the ego's path.
     pub fn build(script: &ClipScript, trace: &ClipTrace, town: &RoadNetwork) -> StaticScene {
@@ -854,6 +872,39 @@ impl StaticScene {
             lamps.push(Lamp {
                 pos: Vec3::new(arm_end.x, arm_end.y, top - 0.15),
             });
+            close_cluster(&b, &mut clusters, &mut cluster_start);
+        }
+
+        // Traffic lights (where they run): a post and a dark housing; the lamps are lit per frame.
+        let post = flat(Material::Metal, tag::POLE, linear([60, 62, 64]), Vec3::Z, 0);
+        let housing = flat(Material::Metal, tag::TRAFFIC_LIGHT, linear([28, 30, 26]), Vec3::Z, 0);
+        for g in &trace.signals {
+            let p = g.position.truncate();
+            if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
+                continue;
+            }
+            let head = stat_rel(origin, g.position);
+            let yaw = g.facing_rad as f32;
+            let ground = head.z - crate::world::signals::SIGNAL_HEAD_HEIGHT_M as f32;
+            b.mesh.upright_box(
+                head.truncate(),
+                yaw,
+                Vec2::splat(SIGNAL_POST_HALF_WIDTH_M),
+                [ground, head.z - SIGNAL_HOUSING_HALF_HEIGHT_M],
+                post,
+                post,
+            );
+            b.mesh.upright_box(
+                head.truncate(),
+                yaw,
+                Vec2::new(SIGNAL_HOUSING_HALF_DEPTH_M, SIGNAL_HOUSING_HALF_WIDTH_M),
+                [
+                    head.z - SIGNAL_HOUSING_HALF_HEIGHT_M,
+                    head.z + SIGNAL_HOUSING_HALF_HEIGHT_M,
+                ],
+                housing,
+                housing,
+            );
             close_cluster(&b, &mut clusters, &mut cluster_start);
         }
         close_cluster(&b, &mut clusters, &mut cluster_start);
@@ -1118,6 +1169,43 @@ impl FrameScene {
                 VEHICLE_INSTANCE_BASE.saturating_add(id as u16),
                 flash,
             );
+        }
+        // Traffic lights' lamps: red on top, amber, green at the bottom, the one of the frame's state lit.
+        for g in &trace.signals {
+            let Some(&state) = g.states.get(f0) else { continue };
+            let head = stat.rel(g.position);
+            let (s, c) = (g.facing_rad as f32).sin_cos();
+            let face = head.truncate() + Vec2::new(c, s) * (SIGNAL_HOUSING_HALF_DEPTH_M + 0.01);
+            for (k, lamp_state, colour) in [
+                (1.0f32, LightState::Red, [255, 30, 20]),
+                (0.0, LightState::Amber, [255, 170, 0]),
+                (-1.0, LightState::Green, [40, 255, 90]),
+            ] {
+                // The lit lamp glows (by day too); the others are dark glass.
+                let (material, albedo) = if state == lamp_state {
+                    (Material::Beacon, linear(colour))
+                } else {
+                    (Material::Metal, linear(colour) * 0.08)
+                };
+                let lamp = Prim {
+                    material,
+                    tag: tag::TRAFFIC_LIGHT,
+                    instance: 0,
+                    albedo,
+                    albedo2: albedo,
+                    normal: Vec3::Z,
+                    aux: 0,
+                };
+                let z = head.z + k * 0.28;
+                self.mesh.upright_box(
+                    face,
+                    g.facing_rad as f32,
+                    Vec2::new(0.02, SIGNAL_LAMP_HALF_M),
+                    [z - SIGNAL_LAMP_HALF_M, z + SIGNAL_LAMP_HALF_M],
+                    lamp,
+                    lamp,
+                );
+            }
         }
         for (pi, frames) in trace.pedestrians.iter().enumerate() {
             let Some(a) = frames.get(f0) else { continue };

@@ -105,6 +105,15 @@ pub struct DatasetStats {
     pub emergency_clips: BTreeMap<String, u64>,
     /// Vehicle-frames (traffic and ego) stopping for an emergency vehicle.
     pub yielding_vehicle_frames: u64,
+    /// Red lights a vehicle (traffic or ego) stopped for.
+    pub red_lights_stopped_for: u64,
+    /// Red lights run by vehicles that ignore lights or by emergency vehicles: the violations.
+    pub red_light_violations: u64,
+    /// Red lights run from the dilemma zone by vehicles that heed lights (too close to stop when the light
+    /// turned amber, or placed too close to a red light at a clip's start).
+    pub red_lights_run_unavoidably: u64,
+    /// Signal compliance: stops at red / (stops at red + violations); `None` without either.
+    pub signal_compliance: Option<f64>,
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
@@ -212,6 +221,17 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 }
             }
         }
+        for b in tables::read(&layout.table("events", &clip_id), &["kind", "unavoidable"])? {
+            let (kind, unavoidable) = (b.strings("kind")?, b.bools("unavoidable")?);
+            for (i, kind) in kind.iter().enumerate() {
+                match *kind {
+                    "stopped_at_red_light" => s.red_lights_stopped_for += 1,
+                    "ran_red_light" if unavoidable.value(i) => s.red_lights_run_unavoidably += 1,
+                    "ran_red_light" => s.red_light_violations += 1,
+                    _ => {}
+                }
+            }
+        }
         let mut gestured = std::collections::BTreeSet::new();
         for b in tables::read(
             &layout.table("annotations", &clip_id),
@@ -265,6 +285,8 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
     s.non_crossing_share = ratio(s.non_crossing, s.pedestrians);
     s.c_nc_ratio = ratio(s.crossing, s.non_crossing);
     s.achieved_crossing_ratio = s.crossing_share;
+    let faced = s.red_lights_stopped_for + s.red_light_violations;
+    s.signal_compliance = (faced > 0).then(|| ratio(s.red_lights_stopped_for, faced));
     s.mean_frames_per_clip = ratio(s.frames, s.clips);
     s.mean_duration_s = if s.clips == 0 { 0.0 } else { duration_s / s.clips as f64 };
     s.samples_per_clip = ratio(s.annotated_samples, s.clips);
@@ -391,6 +413,17 @@ impl std::fmt::Display for DatasetStats {
             let kinds: Vec<String> = s.emergency_clips.iter().map(|(k, n)| format!("{k} {n}")).collect();
             writeln!(o, "emergency clips              {emergencies} ({})", kinds.join(", "))?;
             writeln!(o, "vehicle-frames yielding      {}", s.yielding_vehicle_frames)?;
+        }
+        if let Some(c) = s.signal_compliance {
+            writeln!(
+                o,
+                "red lights                   {} stopped for, {} violations, {} run from the dilemma zone \
+                 (compliance {:.1} %)",
+                s.red_lights_stopped_for,
+                s.red_light_violations,
+                s.red_lights_run_unavoidably,
+                100.0 * c
+            )?;
         }
         Ok(())
     }

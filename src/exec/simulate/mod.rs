@@ -282,7 +282,8 @@ impl<'a> Sim<'a> {
         for v in &mut self.vehicles {
             v.light_ahead = v.stop_lines.get(v.next_stop).and_then(|l| {
                 let gap = l.s_m - (v.s_m + vehicle::HALF_LENGTH_M);
-                (gap <= vehicle::LIGHT_RANGE_M).then(|| (gap, plans.state_at(&self.net.signals[l.signal as usize], time_s)))
+                (gap <= vehicle::LIGHT_RANGE_M)
+                    .then(|| (gap, plans.state_at(&self.net.signals[l.signal as usize], time_s)))
             });
             // The dilemma zone: a light that turns amber (or is red when first seen) too close to stop for, at a
             // comfortable rate for amber and the hardest for red, is driven through.
@@ -302,7 +303,8 @@ impl<'a> Sim<'a> {
     }
 
     /// After the vehicles moved in the step to frame `frame`: a front bumper past its next stop line while that
-    /// light was red ran it; a vehicle standing before a red line has stopped for it (once per line).
+    /// light was red ran it; a vehicle standing at a red line (its front within [`signals::STOPPED_AT_LINE_M`]
+    /// of it) has stopped for it (once per line; those queued behind it are not counted).
     fn pass_stop_lines(&mut self, frame: u32) {
         if self.lights.is_none() {
             return;
@@ -323,7 +325,12 @@ impl<'a> Sim<'a> {
                     });
                 }
                 v.next_stop += 1;
-            } else if red && v.bound_by_light() && v.speed_mps < 0.1 && v.stopped_at != Some(v.next_stop) {
+            } else if red
+                && v.bound_by_light()
+                && v.speed_mps < 0.1
+                && line.s_m - (v.s_m + vehicle::HALF_LENGTH_M) < signals::STOPPED_AT_LINE_M
+                && v.stopped_at != Some(v.next_stop)
+            {
                 v.stopped_at = Some(v.next_stop);
                 self.trace.events.push(Event::RedLight {
                     frame,

@@ -54,11 +54,7 @@ impl SignalPlans {
             .map(|j| {
                 let phases = junction_phases(&net.signals, j);
                 let cycle = f64::from(phases) * slot;
-                let offset = if cycle > 0.0 {
-                    rng.random_range(0.0..cycle)
-                } else {
-                    0.0
-                };
+                let offset = if cycle > 0.0 { rng.random_range(0.0..cycle) } else { 0.0 };
                 (phases, offset)
             })
             .collect();
@@ -104,6 +100,10 @@ pub fn phase_state(timing: &Signals, phases: u32, phase: u32, t_s: f64) -> Light
         LightState::Red
     }
 }
+
+/// A vehicle at rest before a red light with its front bumper within this distance of the stop line has stopped
+/// for the light (it aims 1 m short of the line plus its minimum gap), metres.
+pub const STOPPED_AT_LINE_M: f64 = 8.0;
 
 /// Where a light applies on a vehicle's path: its stop line at arc length `s_m`, and the signal (index into
 /// [`RoadNetwork::signals`]).

@@ -193,7 +193,9 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             col(|f| f.speed_mps),
             col(|f| f.accel_mps2),
             Arc::new(BooleanArray::from_iter(trace.ego.iter().map(|f| Some(f.yielding)))),
-            Arc::new(StringArray::from_iter(trace.ego.iter().map(|f| f.light.map(LightState::name)))),
+            Arc::new(StringArray::from_iter(
+                trace.ego.iter().map(|f| f.light.map(LightState::name)),
+            )),
         ],
     )
 }
@@ -245,13 +247,23 @@ pub fn traffic_lights_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBat
             utf8(n, &script.clip_id),
             Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
             Arc::new(StringArray::from_iter_values(rows.iter().map(|r| sig(r).id.as_str()))),
-            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| sig(r).junction.as_str()))),
+            Arc::new(StringArray::from_iter_values(
+                rows.iter().map(|r| sig(r).junction.as_str()),
+            )),
             Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| sig(r).phase))),
             Arc::new(StringArray::from_iter_values(rows.iter().map(state))),
-            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.x as f32))),
-            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.y as f32))),
-            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).position.z as f32))),
-            Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| sig(r).facing_rad as f32))),
+            Arc::new(Float32Array::from_iter_values(
+                rows.iter().map(|r| sig(r).position.x as f32),
+            )),
+            Arc::new(Float32Array::from_iter_values(
+                rows.iter().map(|r| sig(r).position.y as f32),
+            )),
+            Arc::new(Float32Array::from_iter_values(
+                rows.iter().map(|r| sig(r).position.z as f32),
+            )),
+            Arc::new(Float32Array::from_iter_values(
+                rows.iter().map(|r| sig(r).facing_rad as f32),
+            )),
             Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| r.2 as f32))),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.3)))),
         ],
@@ -550,7 +562,9 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| {
                 Some(script.vehicles.get(r.1 as usize).is_some_and(|s| s.ignores_lights))
             }))),
-            Arc::new(StringArray::from_iter(rows.iter().map(|r| r.2.light.map(LightState::name)))),
+            Arc::new(StringArray::from_iter(
+                rows.iter().map(|r| r.2.light.map(LightState::name)),
+            )),
         ],
     )
 }

@@ -354,7 +354,10 @@ fn parse_road(cx: &Ctx, n: Node) -> Result<RawRoad, WorldError> {
     if let Some(sigs) = child(n, "signals") {
         for g in children(sigs, "signal") {
             // Traffic lights only: dynamic signals (static ones are signs).
-            if !g.attribute("dynamic").is_some_and(|d| d.trim().eq_ignore_ascii_case("yes")) {
+            if !g
+                .attribute("dynamic")
+                .is_some_and(|d| d.trim().eq_ignore_ascii_case("yes"))
+            {
                 continue;
             }
             let s = cx.num_or(g, "s", 0.0)?;
@@ -538,7 +541,10 @@ fn parse_junction(cx: &Ctx, n: Node) -> Result<RawJunction, WorldError> {
     }
     let controllers = children(n, "controller")
         .filter_map(|c| {
-            let seq = c.attribute("sequence").and_then(|v| v.trim().parse::<u32>().ok()).unwrap_or(0);
+            let seq = c
+                .attribute("sequence")
+                .and_then(|v| v.trim().parse::<u32>().ok())
+                .unwrap_or(0);
             Some((c.attribute("id")?.to_string(), seq))
         })
         .collect();

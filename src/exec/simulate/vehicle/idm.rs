@@ -1,8 +1,8 @@
 //! Car following: the Intelligent Driver Model with vehicles **and** pedestrians in the path ahead as leaders,
 //! junction conflict zones, the end of the route, and the ego's braking rule for crossing pedestrians.
 
-use super::conflict_zones::{ConflictZone, zone_yield_gap_m};
 use super::super::signals::LightState;
+use super::conflict_zones::{ConflictZone, zone_yield_gap_m};
 use super::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
 use crate::dsl::types::Idm;
 use crate::exec::simulate::{PED_RADIUS_M, VEHICLE_LENGTH_M};
@@ -68,15 +68,16 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
 
     // A red or amber light at a line it has not committed to (it could stop when it first saw it): a standing
     // obstacle at the stop line.
-    if let Some((gap, state)) = me.light_ahead.filter(|_| me.bound_by_light()) {
-        if state != LightState::Green {
-            // Aim a little short of the line, so that the car-following's overshoot never crosses it.
-            let short = (gap - STOP_LINE_MARGIN_M).max(0.0);
-            accel = accel.min(idm_to(short + me.min_gap_m, 0.0));
-            let need = v * v / (2.0 * short.max(0.05));
-            if need > idm.comfortable_decel_mps2 {
-                accel = accel.min(-need.min(idm.max_decel_mps2));
-            }
+    if let Some((gap, _)) = me
+        .light_ahead
+        .filter(|&(_, state)| state != LightState::Green && me.bound_by_light())
+    {
+        // Aim a little short of the line, so that the car-following's overshoot never crosses it.
+        let short = (gap - STOP_LINE_MARGIN_M).max(0.0);
+        accel = accel.min(idm_to(short + me.min_gap_m, 0.0));
+        let need = v * v / (2.0 * short.max(0.05));
+        if need > idm.comfortable_decel_mps2 {
+            accel = accel.min(-need.min(idm.max_decel_mps2));
         }
     }
 
