@@ -235,17 +235,101 @@ fn with_every_vehicle_ignoring_lights_the_reds_are_run_and_without_lights_nothin
 
     // Lights off (the default): no light traced, no red-light event, and the same plan but for the setting.
     let (off_plan, off) = run("specs/pedsynth_pp.yaml", &["dataset.clips.count=2"]);
-    let (on_plan, _) = run(
+    let (mut on_plan, _) = run(
         "specs/pedsynth_pp.yaml",
-        &["traffic.signals.enabled=true", "dataset.clips.count=2"],
+        &[
+            "traffic.signals.enabled=true",
+            "traffic.signals.crosswalk_share=0",
+            "dataset.clips.count=2",
+        ],
     );
-    assert_eq!(
-        off_plan.clips, on_plan.clips,
-        "turning the lights on changes no clip script"
+    // With nobody placed at a signalised crosswalk, the lights change no draw of the clip scripts but the
+    // violation draws (from a stream of their own).
+    for p in on_plan.clips.iter_mut().flat_map(|c| c.pedestrians.iter_mut()) {
+        p.red_light_violator = false;
+    }
+    assert!(
+        off_plan.clips == on_plan.clips,
+        "turning the lights on changes another draw"
     );
     for t in &off {
         assert!(t.signals.is_empty());
         assert!(!t.events.iter().any(|e| matches!(e, Event::RedLight { .. })));
         assert!(t.ego.iter().all(|f| f.light.is_none()));
     }
+}
+
+#[test]
+fn pedestrians_at_signalised_crosswalks_start_only_on_walk_unless_drawn_to_violate() {
+    let (plan, traces) = run(
+        "specs/pedsynth_pp.yaml",
+        &["traffic.signals.enabled=true", "dataset.clips.count=4"],
+    );
+    let (mut heeding, mut violators, mut starts, mut against) = (0, 0, 0, 0);
+    for (clip, trace) in plan.clips.iter().zip(&traces) {
+        for (script, frames) in clip.pedestrians.iter().zip(&trace.pedestrians) {
+            if frames.iter().all(|f| f.walk_signal.is_none()) {
+                continue;
+            }
+            if script.red_light_violator {
+                violators += 1;
+            } else {
+                heeding += 1;
+            }
+            // Each step onto the road (a crossing state after a non-crossing one) and the signal then.
+            for w in frames.windows(2) {
+                if !w[0].state.is_crossing() && w[1].state.is_crossing() {
+                    starts += 1;
+                    let signal = w[0].walk_signal;
+                    if signal != Some(pedsynth::exec::trace::WalkSignal::Walk) {
+                        against += 1;
+                        assert!(
+                            script.red_light_violator,
+                            "{}: pedestrian {} ({:?}, group {:?}) stepped out on {signal:?}: {:?} -> {:?}",
+                            clip.clip_id, script.id, script.behaviour, script.group, w[0].state, w[1].state
+                        );
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{heeding} pedestrians heeding a crosswalk signal, {violators} drawn to cross against it; {starts} steps \
+         onto the road, {against} against the signal"
+    );
+    assert!(heeding >= 10, "{heeding} pedestrians at signalised crosswalks");
+    assert!(starts >= 10, "{starts} crossings at signalised crosswalks");
+
+    // Everyone drawn to violate: some step out against the signal, and the tables' label says so.
+    let mut overrides = vec!["traffic.signals.enabled=true", "dataset.clips.count=4"];
+    let all: Vec<String> = [
+        "business_person",
+        "casual_person",
+        "elderly_person",
+        "parent_with_child",
+        "young_person",
+    ]
+    .iter()
+    .map(|a| format!("pedestrians.archetypes.{a}.red_light_violation_probability=1"))
+    .collect();
+    overrides.extend(all.iter().map(String::as_str));
+    let (plan, traces) = run("specs/pedsynth_pp.yaml", &overrides);
+    let mut against = 0;
+    for (clip, trace) in plan.clips.iter().zip(&traces) {
+        for (script, frames) in clip.pedestrians.iter().zip(&trace.pedestrians) {
+            assert!(script.red_light_violator || frames.iter().all(|f| f.walk_signal.is_none()));
+            against += frames
+                .windows(2)
+                .filter(|w| {
+                    !w[0].state.is_crossing()
+                        && w[1].state.is_crossing()
+                        && w[0].walk_signal != Some(pedsynth::exec::trace::WalkSignal::Walk)
+                })
+                .count();
+        }
+    }
+    assert!(
+        against >= 3,
+        "{against} steps onto the road against the signal with every pedestrian violating"
+    );
 }

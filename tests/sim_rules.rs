@@ -142,6 +142,7 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
         curb_wait_s: None,
         identity: pedsynth::planner::identity::identities(1, id, "casual_person", Body::Adult).0,
         child: None,
+        red_light_violator: false,
     }
 }
 

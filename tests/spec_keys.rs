@@ -280,6 +280,10 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
             ("traffic.emergency.enabled", json!(true)),
             ("traffic.emergency.clip_share", json!(1.0)),
         ],
+        // Red-light violators exist only where lights run.
+        p if p.starts_with("pedestrians.archetypes.") && p.ends_with(".red_light_violation_probability") => {
+            vec![("traffic.signals.enabled", json!(true))]
+        }
         // The lights' timing shows only where they run.
         p if p.starts_with("traffic.signals.") && p != "traffic.signals.enabled" => {
             vec![("traffic.signals.enabled", json!(true))]

@@ -75,7 +75,8 @@ def recompute(root: Path) -> dict:
     ann = read_table(
         root,
         "annotations",
-        ["clip_id", "frame", "pedestrian", "state", "crossing", "look", "action", "gesture", "reaction"],
+        ["clip_id", "frame", "pedestrian", "state", "crossing", "look", "action", "gesture", "reaction",
+         "walk_signal", "against_signal", "on_crosswalk"],
     )
     events = read_table(root, "events", ["clip_id", "kind", "unavoidable"])
 
@@ -137,6 +138,13 @@ def recompute(root: Path) -> dict:
             pc.sum(pc.cast(read_table(root, "vehicles", ["yielding"])["yielding"], pa.int64())).as_py() or 0
         )
         + int(pc.sum(pc.cast(read_table(root, "frames", ["ego_yielding"])["ego_yielding"], pa.int64())).as_py() or 0),
+        "pedestrians_at_signals": len({
+            (c, p) for c, p, w in zip(
+                ann["clip_id"].to_pylist(), ann["pedestrian"].to_pylist(), ann["walk_signal"].to_pylist()
+            ) if w is not None
+        }),
+        "against_signal_samples": int(pc.sum(pc.cast(ann["against_signal"], pa.int64())).as_py() or 0),
+        "on_crosswalk_samples": int(pc.sum(pc.cast(ann["on_crosswalk"], pa.int64())).as_py() or 0),
         "red_lights_stopped_for": sum(1 for k in events["kind"].to_pylist() if k == "stopped_at_red_light"),
         "red_light_violations": sum(
             1 for k, u in zip(events["kind"].to_pylist(), events["unavoidable"].to_pylist())
@@ -182,7 +190,8 @@ def compare(mine: dict, stats: dict) -> Checker:
     c.equal("rejected", mine["rejected"], stats.get("rejected"))
     for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples",
                 "emergency_clips", "yielding_vehicle_frames", "red_lights_stopped_for", "red_light_violations",
-                "red_lights_run_unavoidably"]:
+                "red_lights_run_unavoidably", "pedestrians_at_signals", "against_signal_samples",
+                "on_crosswalk_samples"]:
         c.equal(key, mine[key], stats.get(key))
     their_counts = stats.get("state_samples")
     if their_counts is not None:

@@ -489,6 +489,10 @@ impl Validator<'_> {
                 "a waiting time in seconds",
             );
             self.probability(&format!("{base}.distraction_probability"), a.distraction_probability);
+            self.probability(
+                &format!("{base}.red_light_violation_probability"),
+                a.red_light_violation_probability,
+            );
         }
         let sp = &p.speed_profiles;
         self.mix(

@@ -7,7 +7,7 @@
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-pub use crate::exec::simulate::signals::LightState;
+pub use crate::exec::simulate::signals::{LightState, WalkSignal};
 
 use crate::world::LaneType;
 
@@ -126,6 +126,12 @@ pub struct PedFrame {
     pub gesture: Option<(Gesture, f64)>,
     /// The pedestrian's reaction to a vehicle, in JAAD's terms.
     pub reaction: Option<Reaction>,
+    /// The pedestrian signal of the signalised crosswalk its crossing runs along, where lights run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walk_signal: Option<WalkSignal>,
+    /// Whether it stands on a crosswalk.
+    #[serde(default)]
+    pub on_crosswalk: bool,
 }
 
 /// A gesture to the ego's driver (PIE's `gesture` labels; DATASET.md maps them to JAAD's).

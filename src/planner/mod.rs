@@ -901,6 +901,9 @@ const ROUTE_ATTEMPTS: usize = 8;
 /// Mid-road jaywalkers start at most this far ahead of the ego, metres: they cross at once, and farther away
 /// their whole crossing would be too small in the image to be annotated.
 const MIDROAD_MAX_AHEAD_M: f64 = 30.0;
+/// A crosser placed at a signalised crosswalk stands this far before the route's entry into the junction
+/// along the route, metres: the middle of the crosswalk at the road's mouth (0.5 to 3.5 m from its end).
+const SIGNALISED_CROSSWALK_BEFORE_ENTRY_M: f64 = 2.0;
 /// How far from the curb a crosser starts, metres.
 pub const CURB_STANDOFF_M: f64 = 0.3;
 /// Minimum distance between two pedestrians' spawn and curb points, metres (beyond the avoidance radius, so that
@@ -927,6 +930,14 @@ fn plan_pedestrians(
     let far_m = spec.annotations.visibility.max_distance_m.min(route.length_m() - 1.0);
     let mut scripts: Vec<PedestrianScript> = Vec::with_capacity(peds.len());
     let mut crosser_side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
+    // Traffic lights: the route's signalised junction entries and a stream of their own for the draws (none when
+    // lights do not run, so that turning them on shifts no other draw but the placements it changes).
+    let mut signal_draws = spec.traffic.signals.enabled.then(|| {
+        (
+            seeds::clip_rng(clip_seed, "plan/signals"),
+            crate::world::signals::signalised_entries(net, route),
+        )
+    });
     // Group ids are numbered by leader, in pedestrian order.
     let mut leaders: Vec<u32> = peds.iter().filter_map(|a| a.group).collect();
     leaders.sort_unstable();
@@ -997,7 +1008,20 @@ fn plan_pedestrians(
                         + COURTESY_SPEED_ESTIMATE_MPS * in_view_before_crossing_s.unwrap_or(0.0))
                     .clamp(lo, hi);
                     let approach_m = draw(rng, timeline.approach_m);
-                    let placed = place_crosser(net, route, lo, hi, crosser_side, approach_m, &scripts, rng);
+                    // Where lights run, a share of them waits at a signalised crosswalk on the ego's route (the
+                    // first one in range), across the ego's approach road at the junction's mouth.
+                    let at_signal = signal_draws.as_mut().and_then(|(sig_rng, entries)| {
+                        if !sig_rng.random_bool(spec.traffic.signals.crosswalk_share.clamp(0.0, 1.0)) {
+                            return None;
+                        }
+                        let s = entries
+                            .iter()
+                            .map(|&(s, _)| s - SIGNALISED_CROSSWALK_BEFORE_ENTRY_M)
+                            .find(|&s| s >= spawn_ahead.min() && s <= far_m)?;
+                        place_crosser(net, route, s, s, crosser_side, approach_m, &scripts, rng)
+                    });
+                    let placed = at_signal
+                        .or_else(|| place_crosser(net, route, lo, hi, crosser_side, approach_m, &scripts, rng));
                     crosser_side = if crosser_side == Side::Left {
                         Side::Right
                     } else {
@@ -1053,6 +1077,13 @@ fn plan_pedestrians(
             curb_wait_s,
             identity,
             child,
+            // A group crosses with its leader: followers share the leader's choice.
+            red_light_violator: match leader {
+                Some(l) => l.red_light_violator,
+                None => signal_draws
+                    .as_mut()
+                    .is_some_and(|(sig_rng, _)| sig_rng.random_bool(a.red_light_violation_probability.clamp(0.0, 1.0))),
+            },
         });
     }
     Ok(scripts)

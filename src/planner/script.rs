@@ -422,6 +422,10 @@ pub struct PedestrianScript {
     pub identity: Identity,
     /// The child walking beside a parent (`parent_with_child` bodies).
     pub child: Option<Identity>,
+    /// At a signalised crosswalk: whether it crosses against the signal (drawn from its archetype's
+    /// `red_light_violation_probability` where traffic lights run).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub red_light_violator: bool,
 }
 
 /// Age group of a person (for the renderer's body proportions and the PIE/JAAD attributes).

@@ -119,6 +119,21 @@ pub fn segment_hits_cylinder(from: DVec3, d: DVec3, t_max: f64, ground: DVec3, r
     z0.min(z1) <= height_m && z0.max(z1) >= 0.0
 }
 
+/// Whether `p` lies inside the polygon `poly` (plan view, even-odd rule; either winding, not closed).
+pub fn point_in_polygon(poly: &[DVec2], p: DVec2) -> bool {
+    let mut inside = false;
+    let n = poly.len();
+    let mut j = n.wrapping_sub(1);
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
 /// The axis-aligned bounding box `(lo, hi)` of `points`, or `None` when there are none.
 pub fn bounding_box(points: impl IntoIterator<Item = DVec2>) -> Option<(DVec2, DVec2)> {
     let mut points = points.into_iter();

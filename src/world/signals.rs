@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use super::opendrive::build::ref_at;
 use super::opendrive::parse::RawNetwork;
-use super::{LaneType, RoadNetwork};
+use super::{LaneType, RoadNetwork, Route, point_in_polygon};
 
 /// A vehicle stops this far before the end of its approach road: the crosswalks at junction mouths span 0.5 to
 /// 3.5 m from the road end, so the stop line is 1 m behind them, metres.
@@ -59,6 +59,50 @@ pub fn junction_phases(signals: &[Signal], junction: u32) -> u32 {
         .map(|s| s.phase + 1)
         .max()
         .unwrap_or(0)
+}
+
+/// Where `route` enters a signalised junction from an approach road with a light: the arc length of the first
+/// route point inside the junction and the light (index into [`RoadNetwork::signals`]), in route order.
+pub fn signalised_entries(net: &RoadNetwork, route: &Route) -> Vec<(f64, u32)> {
+    let mut out = Vec::new();
+    if net.signals.is_empty() {
+        return out;
+    }
+    for w in route.points.windows(2) {
+        let (Some(from), Some(to)) = (net.lanes.get(w[0].lane as usize), net.lanes.get(w[1].lane as usize)) else {
+            continue;
+        };
+        if from.in_junction || !to.in_junction {
+            continue;
+        }
+        let Some(junction_id) = net.roads[to.road as usize].junction.as_deref() else {
+            continue;
+        };
+        if let Some(signal) = net
+            .signals
+            .iter()
+            .position(|g| g.road == from.road && net.junctions[g.junction as usize].id == junction_id)
+        {
+            out.push((w[1].s_m, signal as u32));
+        }
+    }
+    out
+}
+
+/// The light of the signalised crosswalk under `p`: a crosswalk across an approach road with a light, the
+/// light of that road's end nearest the crosswalk (index into [`RoadNetwork::signals`]).
+pub fn crosswalk_signal(net: &RoadNetwork, p: DVec2) -> Option<u32> {
+    let cw = net.crosswalks.iter().find(|c| point_in_polygon(&c.polygon, p))?;
+    let centre = cw.polygon.iter().copied().sum::<DVec2>() / cw.polygon.len().max(1) as f64;
+    net.signals
+        .iter()
+        .enumerate()
+        .filter(|(_, g)| g.road == cw.road)
+        .min_by(|a, b| {
+            let d = |g: &Signal| g.position.truncate().distance_squared(centre);
+            d(a.1).total_cmp(&d(b.1))
+        })
+        .map(|(k, _)| k as u32)
 }
 
 /// One approach of a junction: road `road` meeting junction `junction` at its end or its start.

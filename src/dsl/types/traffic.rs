@@ -62,6 +62,12 @@ pub struct Signals {
     pub amber_s: f64,
     /// All-red time after each amber, seconds (CARLA's default red time: 2).
     pub all_red_s: f64,
+    /// Share of the crossers and hard negatives that start on a sidewalk placed at a signalised crosswalk: the
+    /// first one on the ego's route within their spawn range, across the ego's approach road at the junction's
+    /// mouth (where the route passes none, they are placed as usual). There they wait for "walk" (the ego's
+    /// light is then red), unless their archetype's `red_light_violation_probability` draws them to cross
+    /// against the signal.
+    pub crosswalk_share: f64,
 }
 
 impl Default for Signals {
@@ -71,6 +77,7 @@ impl Default for Signals {
             green_s: 10.0,
             amber_s: 3.0,
             all_red_s: 2.0,
+            crosswalk_share: 0.5,
         }
     }
 }

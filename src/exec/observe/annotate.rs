@@ -19,7 +19,7 @@ use super::rig::{Camera, CameraPose};
 use super::scene;
 use crate::dsl::types::{Annotations, BoxSize};
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
-use crate::exec::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction};
+use crate::exec::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction, WalkSignal};
 use crate::planner::ClipScript;
 use crate::world::{LaneType, RoadNetwork};
 
@@ -84,6 +84,12 @@ pub struct AnnotationRow {
     pub gesture: Option<Gesture>,
     /// Its reaction to a vehicle.
     pub reaction: Option<Reaction>,
+    /// Whether it stands on a crosswalk.
+    pub on_crosswalk: bool,
+    /// The pedestrian signal of its signalised crosswalk, where lights run.
+    pub walk_signal: Option<WalkSignal>,
+    /// Whether it is crossing (a crossing state) while its signal shows "don't walk".
+    pub against_signal: bool,
     /// The head's forward direction in the world (unit vector).
     pub gaze: [f32; 3],
 }
@@ -496,6 +502,9 @@ pub fn annotate(
                 walking: f.velocity.length() >= WALKING_MPS,
                 gesture: f.gesture.map(|g| g.0),
                 reaction: f.reaction,
+                on_crosswalk: f.on_crosswalk,
+                walk_signal: f.walk_signal,
+                against_signal: f.walk_signal == Some(WalkSignal::DontWalk) && f.state.is_crossing(),
                 gaze: pose.gaze.to_array().map(|x| x as f32),
             });
         }
@@ -535,6 +544,8 @@ mod tests {
             on_phone: false,
             gesture: None,
             reaction: None,
+            walk_signal: None,
+            on_crosswalk: false,
         }
     }
 

@@ -304,6 +304,8 @@ mod tests {
             on_phone: false,
             gesture: None,
             reaction: None,
+            walk_signal: None,
+            on_crosswalk: false,
         }
     }
 

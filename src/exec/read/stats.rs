@@ -114,6 +114,12 @@ pub struct DatasetStats {
     pub red_lights_run_unavoidably: u64,
     /// Signal compliance: stops at red / (stops at red + violations); `None` without either.
     pub signal_compliance: Option<f64>,
+    /// Pedestrians annotated at a signalised crosswalk (their crossing runs along one).
+    pub pedestrians_at_signals: u64,
+    /// Annotated samples of pedestrians crossing while their signal shows "don't walk".
+    pub against_signal_samples: u64,
+    /// Annotated samples on a crosswalk.
+    pub on_crosswalk_samples: u64,
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
@@ -233,6 +239,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
             }
         }
         let mut gestured = std::collections::BTreeSet::new();
+        let mut at_signals = std::collections::BTreeSet::new();
         for b in tables::read(
             &layout.table("annotations", &clip_id),
             &[
@@ -245,6 +252,9 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 "action",
                 "gesture",
                 "reaction",
+                "walk_signal",
+                "against_signal",
+                "on_crosswalk",
             ],
         )? {
             let ped = b.u32s("pedestrian")?;
@@ -253,6 +263,18 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
             let (vx, vy) = (b.f32s("vx_mps")?, b.f32s("vy_mps")?);
             let (look, action) = (b.bools("look")?, b.strings("action")?);
             let (gesture, reaction) = (b.strings("gesture")?, b.strings("reaction")?);
+            let (walk_signal, against, on_crosswalk) = (
+                b.strings("walk_signal")?,
+                b.bools("against_signal")?,
+                b.bools("on_crosswalk")?,
+            );
+            s.against_signal_samples += against.true_count() as u64;
+            s.on_crosswalk_samples += on_crosswalk.true_count() as u64;
+            for (i, w) in walk_signal.iter().enumerate() {
+                if !w.is_empty() {
+                    at_signals.insert(ped.value(i));
+                }
+            }
             for (i, state) in state.iter().enumerate() {
                 *states.entry((*state).to_owned()).or_default() += 1;
                 s.crossing_samples += u64::from(crossing.value(i));
@@ -278,6 +300,7 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
         for (g, _) in gestured {
             *s.gesturing_pedestrians.entry(g).or_default() += 1;
         }
+        s.pedestrians_at_signals += at_signals.len() as u64;
     }
     s.non_crossing = s.pedestrians - s.crossing;
     let ratio = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
@@ -423,6 +446,13 @@ impl std::fmt::Display for DatasetStats {
                 s.red_light_violations,
                 s.red_lights_run_unavoidably,
                 100.0 * c
+            )?;
+        }
+        if s.pedestrians_at_signals > 0 {
+            writeln!(
+                o,
+                "signalised crosswalks        {} pedestrians, {} samples crossing against the signal",
+                s.pedestrians_at_signals, s.against_signal_samples
             )?;
         }
         Ok(())

@@ -175,6 +175,18 @@ impl<'a> Sim<'a> {
             .filter(|_| !net.signals.is_empty())
             .map(|t| signals::SignalPlans::new(net, t, script.seed));
         if lights.is_some() {
+            // A pedestrian whose crossing runs along a signalised crosswalk heeds its signal.
+            for p in &mut peds {
+                p.traits.signal = p.traits.line.and_then(|l| {
+                    crate::world::signals::crosswalk_signal(net, l.near_curb + l.dir * (0.5 * l.width_m))
+                });
+            }
+            // A group crosses on its leader's signal.
+            for i in 0..peds.len() {
+                if let Some(l) = peds[i].leader() {
+                    peds[i].traits.signal = peds[l].traits.signal;
+                }
+            }
             vehicles[0].set_stop_lines(signals::stop_lines(&script.ego.route, net));
             for (v, s) in vehicles[1..].iter_mut().zip(&script.vehicles) {
                 v.set_stop_lines(signals::stop_lines(&s.route, net));
@@ -267,6 +279,8 @@ impl<'a> Sim<'a> {
                 on_phone: p.on_phone(),
                 gesture: p.gesture,
                 reaction: p.reaction(),
+                walk_signal: p.percept.walk,
+                on_crosswalk: on_crosswalk(self.net, b.pos),
             });
         }
     }
@@ -279,6 +293,12 @@ impl<'a> Sim<'a> {
             track.states.push(plans.state_at(g, time_s));
         }
         let idm = &self.params.idm;
+        for p in &mut self.peds {
+            p.percept.walk = p
+                .traits
+                .signal
+                .map(|k| plans.walk_at(&self.net.signals[k as usize], time_s));
+        }
         for v in &mut self.vehicles {
             v.light_ahead = v.stop_lines.get(v.next_stop).and_then(|l| {
                 let gap = l.s_m - (v.s_m + vehicle::HALF_LENGTH_M);
@@ -481,6 +501,13 @@ impl<'a> Sim<'a> {
             p.update_head(time_s, &self.vehicles);
         }
     }
+}
+
+/// Whether `p` lies on a crosswalk's carriageway part.
+fn on_crosswalk(net: &RoadNetwork, p: DVec2) -> bool {
+    net.crosswalks
+        .iter()
+        .any(|c| crate::world::point_in_polygon(&c.polygon, p))
 }
 
 /// Groups: followers point at their leader (by index), leaders list their followers. A follower whose own

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::dsl::types::Signals;
 use crate::planner::{RouteScript, seeds};
-use crate::world::signals::{STOP_LINE_SETBACK_M, junction_phases};
+use crate::world::signals::{STOP_LINE_SETBACK_M, junction_phases, signalised_entries};
 use crate::world::{RoadNetwork, Signal};
 
 /// The state of a traffic light.
@@ -32,6 +32,31 @@ impl LightState {
             LightState::Green => "green",
             LightState::Amber => "amber",
             LightState::Red => "red",
+        }
+    }
+}
+
+/// The pedestrian signal of a crosswalk across an approach road: "walk" while another phase of the junction
+/// is green (the approach's traffic has red), flashing while that phase's amber and all-red clear the junction,
+/// "don't walk" during the approach's own phase.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WalkSignal {
+    /// Cross.
+    Walk,
+    /// Finish crossing; do not start.
+    Flashing,
+    /// Do not cross.
+    DontWalk,
+}
+
+impl WalkSignal {
+    /// The state's name in the tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            WalkSignal::Walk => "walk",
+            WalkSignal::Flashing => "flashing",
+            WalkSignal::DontWalk => "dont_walk",
         }
     }
 }
@@ -72,6 +97,30 @@ impl SignalPlans {
             .copied()
             .unwrap_or((0, 0.0));
         phase_state(&self.timing, phases, signal.phase, time_s + offset)
+    }
+}
+
+impl SignalPlans {
+    /// The pedestrian signal of the crosswalk across `signal`'s approach road at clip time `time_s`.
+    pub fn walk_at(&self, signal: &Signal, time_s: f64) -> WalkSignal {
+        let (phases, offset) = self
+            .junctions
+            .get(signal.junction as usize)
+            .copied()
+            .unwrap_or((0, 0.0));
+        if phases == 0 {
+            return WalkSignal::Walk;
+        }
+        let slot = slot_s(&self.timing);
+        let u = (time_s + offset).rem_euclid(slot * f64::from(phases));
+        let current = ((u / slot) as u32).min(phases - 1);
+        if current == signal.phase {
+            WalkSignal::DontWalk
+        } else if u - f64::from(current) * slot < self.timing.green_s.max(0.1) {
+            WalkSignal::Walk
+        } else {
+            WalkSignal::Flashing
+        }
     }
 }
 
@@ -129,28 +178,13 @@ pub(crate) fn stop_lines(route: &RouteScript, net: &RoadNetwork) -> Vec<StopLine
     let Some(r) = net.route_through(&lanes) else {
         return Vec::new();
     };
-    let mut out = Vec::new();
-    for w in r.points.windows(2) {
-        let (from, to) = (&net.lanes[w[0].lane as usize], &net.lanes[w[1].lane as usize]);
-        if from.in_junction || !to.in_junction {
-            continue;
-        }
-        let Some(junction_id) = net.roads[to.road as usize].junction.as_deref() else {
-            continue;
-        };
-        let Some(signal) = net
-            .signals
-            .iter()
-            .position(|g| g.road == from.road && net.junctions[g.junction as usize].id == junction_id)
-        else {
-            continue;
-        };
-        out.push(StopLine {
-            s_m: (w[1].s_m - STOP_LINE_SETBACK_M).max(0.0),
-            signal: signal as u32,
-        });
-    }
-    out
+    signalised_entries(net, &r)
+        .into_iter()
+        .map(|(s_m, signal)| StopLine {
+            s_m: (s_m - STOP_LINE_SETBACK_M).max(0.0),
+            signal,
+        })
+        .collect()
 }
 
 /// Whether a vehicle `gap_m` before its stop line at `speed_mps` can still stop there braking at
@@ -170,6 +204,7 @@ mod tests {
             green_s: 10.0,
             amber_s: 3.0,
             all_red_s: 2.0,
+            crosswalk_share: 0.5,
         };
         // Three phases: a 45 s cycle; phase 1's slot is 15..30 s.
         let at = |phase, s| phase_state(&t, 3, phase, s);

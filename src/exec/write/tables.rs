@@ -21,7 +21,7 @@ use parquet::file::properties::WriterProperties;
 use crate::dsl::types::{Compression, Output, PoseFormat};
 use crate::error::{Error, code};
 use crate::exec::observe::annotate::ClipAnnotations;
-use crate::exec::trace::{ClipTrace, Event, LightState, PedestrianId, VehicleId};
+use crate::exec::trace::{ClipTrace, Event, LightState, PedestrianId, VehicleId, WalkSignal};
 use crate::planner::ClipScript;
 use crate::world::LaneType;
 
@@ -434,6 +434,9 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
             field("action", DataType::Utf8, false),
             field("gesture", DataType::Utf8, false),
             field("reaction", DataType::Utf8, false),
+            field("on_crosswalk", DataType::Boolean, false),
+            field("walk_signal", DataType::Utf8, true),
+            field("against_signal", DataType::Boolean, false),
             field("distance_to_ego_m", DataType::Float32, false),
             field("tte_frames", DataType::Int32, true),
             field("occlusion", DataType::Float32, false),
@@ -476,6 +479,11 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
             Arc::new(StringArray::from_iter_values(
                 rows.iter().map(|r| r.reaction.map_or("none", |g| g.name())),
             )),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.on_crosswalk)))),
+            Arc::new(StringArray::from_iter(
+                rows.iter().map(|r| r.walk_signal.map(WalkSignal::name)),
+            )),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.against_signal)))),
             f32c(|r| r.distance_m),
             Arc::new(Int32Array::from_iter(rows.iter().map(|r| r.tte_frames))),
             f32c(|r| r.occlusion),

@@ -19,6 +19,7 @@ use super::params::{
 use super::state::{Activity, AfterPhone, Attempt, CrossMode, Distraction, PauseCause};
 use super::walker::SidewalkWalker;
 use super::{Ped, StepCtx, motion};
+use crate::exec::simulate::signals::WalkSignal;
 use crate::exec::simulate::ttc;
 use crate::exec::trace::{Event, PedState, VehicleId};
 use crate::planner::{Behaviour, CrosserSource, Role, SimParams, SpeedProfile};
@@ -117,6 +118,10 @@ fn timeline_allows(p: &Ped, lead_s: f64) -> bool {
         // An emergency vehicle is coming: nobody steps out.
         return false;
     }
+    if percept.walk.is_some_and(|w| w != WalkSignal::Walk) && !p.traits.red_light_violator {
+        // A signalised crosswalk: wait for "walk" (those who cross against the signal go on their gap).
+        return false;
+    }
     // The ego drives on close by: a crosser seen at least briefly goes now rather than cross behind it, unseen.
     let cut_short = percept.ego_speed_mps > CUT_SHORT_EGO_SPEED_MPS
         && percept.ego_dist_m < CUT_SHORT_EGO_DISTANCE_M
@@ -135,10 +140,12 @@ fn ego_can_stop(p: &Ped) -> bool {
     v * v / (2.0 * COMFORTABLE_STOP_DECEL_MPS2) + STOP_MARGIN_M < p.percept.ego_dist_m
 }
 
-/// Whether a vehicle approaches a crosser on the road so fast that it runs, or an emergency vehicle's siren is
-/// near (it hurries across).
+/// Whether a vehicle approaches a crosser on the road so fast that it runs, an emergency vehicle's siren is
+/// near, or its crosswalk's signal flashes or shows "don't walk" (it hurries across).
 fn must_run(p: &Ped) -> bool {
-    p.percept.min_ttc_s < RUN_TTC_FRACTION * p.traits.ttc_threshold_s || p.percept.siren_near
+    p.percept.min_ttc_s < RUN_TTC_FRACTION * p.traits.ttc_threshold_s
+        || p.percept.siren_near
+        || p.percept.walk.is_some_and(|w| w != WalkSignal::Walk)
 }
 
 /// The behaviour machine of a pedestrian that decides for itself (a single or a group leader). `group_ready`

@@ -146,6 +146,11 @@ pub(crate) struct Traits {
     pub standing: bool,
     /// The planned crossing (crossers).
     pub line: Option<Line>,
+    /// The traffic light (index into the town's signals) of the signalised crosswalk its crossing runs along,
+    /// where lights run.
+    pub signal: Option<u32>,
+    /// Whether it crosses against the signal (on "don't walk") when it finds a gap.
+    pub red_light_violator: bool,
     /// Where the pedestrian stands along the ego's route, metres: "ahead of the ego" is decided along the route,
     /// which stays right where the route turns.
     pub route_s_m: f64,
@@ -269,6 +274,8 @@ impl Ped {
                 distraction_len_s,
                 standing,
                 line,
+                signal: None,
+                red_light_violator: script.red_light_violator,
                 route_s_m: script.ahead_of_ego_m,
                 height_m: script.identity.height_m,
                 in_view_before_crossing_s: script.in_view_before_crossing_s,

@@ -7,6 +7,7 @@ use super::Ped;
 use super::params::{BLOCKING_CLEARANCE_M, CONFLICT_MIN_VEHICLE_SPEED_MPS};
 use super::state::Activity;
 use crate::exec::observe::rig::CameraPose;
+use crate::exec::simulate::signals::WalkSignal;
 use crate::exec::simulate::vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, Vehicle};
 use crate::exec::simulate::view::ViewProxy;
 use crate::exec::simulate::{PED_RADIUS_M, ttc};
@@ -45,6 +46,8 @@ pub(crate) struct Percept {
     /// Whether an emergency vehicle's siren is near: closing in from nearer than [`SIREN_HOLD_M`], or passing
     /// within [`SIREN_PASSING_M`].
     pub siren_near: bool,
+    /// The pedestrian signal of its signalised crosswalk, if it has one (set by the simulation each step).
+    pub walk: Option<WalkSignal>,
 }
 
 impl Default for Percept {
@@ -60,6 +63,7 @@ impl Default for Percept {
             blocked_by_standing: false,
             in_view: false,
             siren_near: false,
+            walk: None,
         }
     }
 }
