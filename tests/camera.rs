@@ -308,6 +308,7 @@ fn static_scene(mesh: Mesh) -> StaticScene {
         pieces: Vec::new(),
         crosswalks: Vec::new(),
         lamps: Vec::new(),
+        signal_heads: Vec::new(),
         seed: 1,
         outfits: Vec::new(),
         car_paint: Vec::new(),

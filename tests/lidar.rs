@@ -50,6 +50,7 @@ fn scene_of(tris: Vec<Tri>) -> StaticScene {
         pieces: Vec::new(),
         crosswalks: Vec::new(),
         lamps: Vec::new(),
+        signal_heads: Vec::new(),
         seed: 1,
         outfits: Vec::new(),
         car_paint: Vec::new(),

@@ -290,6 +290,8 @@ pub struct StaticScene {
     pub crosswalks: Vec<Vec<Vec2>>,
     /// Street lamps.
     pub lamps: Vec<Lamp>,
+    /// The traffic lights drawn (indices into the trace's `signals`: those within the scene).
+    pub signal_heads: Vec<usize>,
     /// The clip's seed (textures, colours).
     pub seed: u64,
     /// What each pedestrian (and the child beside it) wears, by pedestrian index: worked out once per clip.
@@ -878,11 +880,13 @@ impl StaticScene {
         // Traffic lights (where they run): a post and a dark housing; the lamps are lit per frame.
         let post = flat(Material::Metal, tag::POLE, linear([60, 62, 64]), Vec3::Z, 0);
         let housing = flat(Material::Metal, tag::TRAFFIC_LIGHT, linear([28, 30, 26]), Vec3::Z, 0);
-        for g in &trace.signals {
+        let mut signal_heads = Vec::new();
+        for (k, g) in trace.signals.iter().enumerate() {
             let p = g.position.truncate();
             if p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y {
                 continue;
             }
+            signal_heads.push(k);
             let head = stat_rel(origin, g.position);
             let yaw = g.facing_rad as f32;
             let ground = head.z - crate::world::signals::SIGNAL_HEAD_HEIGHT_M as f32;
@@ -917,6 +921,7 @@ impl StaticScene {
             pieces,
             crosswalks,
             lamps,
+            signal_heads,
             seed,
             outfits: script
                 .pedestrians
@@ -1171,7 +1176,7 @@ impl FrameScene {
             );
         }
         // Traffic lights' lamps: red on top, amber, green at the bottom, the one of the frame's state lit.
-        for g in &trace.signals {
+        for g in stat.signal_heads.iter().filter_map(|&k| trace.signals.get(k)) {
             let Some(&state) = g.states.get(f0) else { continue };
             let head = stat.rel(g.position);
             let (s, c) = (g.facing_rad as f32).sin_cos();
