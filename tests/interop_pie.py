@@ -207,6 +207,11 @@ def main():
     imdb = PIE(data_path=out)  # the sequences below read the database cached just now
     seen = 0
     traffic = {}
+    light_frames = 0
+    lights = {}
+    if os.path.isdir(os.path.join(args.dataset, "tables", "traffic_lights")):
+        for r in table(args.dataset, "traffic_lights", ["clip_id", "frame", "signal", "state", "faces_ego"]):
+            lights.setdefault(r["clip_id"], []).append(r)
     first = db[video_of[next(iter(video_of))][0]][video_of[next(iter(video_of))][1]]
     width, height = first["width"], first["height"]
     for clip_id, (set_id, video) in video_of.items():
@@ -225,8 +230,18 @@ def main():
                 fail(f"{clip_id} frame {r['frame']}: yaw {obd['yaw']} for {r['ego_yaw_rad']} rad")
         # Traffic objects (vehicles, crosswalks): PIE's classes, our ids, boxes inside the image, frames in
         # the clip, each object's frames increasing.
+        light_ids = sorted({r["signal"] for r in lights.get(clip_id, [])})
         for oid, o in v["traffic_annotations"].items():
-            kind = {"v": "vehicle", "cw": "crosswalk"}[oid.rsplit("_", 1)[1].lstrip("0123456789")]
+            kind = {"v": "vehicle", "cw": "crosswalk", "tl": "traffic_light"}[oid.rsplit("_", 1)[1].lstrip("0123456789")]
+            if kind == "traffic_light":
+                # Its state in every frame is the table's (PIE: 1 red, 2 yellow, 3 green), for a light facing us.
+                signal = light_ids[int(oid.rsplit("_", 1)[1][:-2])]
+                ours = {r["frame"]: r for r in lights[clip_id] if r["signal"] == signal}
+                for f, st in zip(o["frames"], o["state"]):
+                    r = ours.get(f)
+                    if r is None or not r["faces_ego"] or st != {"red": 1, "amber": 2, "green": 3}[r["state"]]:
+                        fail(f"{clip_id}: traffic light {oid} ({signal}) frame {f}: state {st} vs {r}")
+                    light_frames += 1
             if o["obj_class"] != kind or not oid.startswith(prefix[clip_id] + "_"):
                 fail(f"{clip_id}: traffic object {oid} of class {o['obj_class']}")
             if o["frames"] != sorted(set(o["frames"])) or not all(0 <= f < clips[clip_id]["frame_count"] for f in o["frames"]):
@@ -256,7 +271,10 @@ def main():
                 fail(f"{pid}: age/gender differ")
             seen += 1
     print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames in "
-          f"{len(video_of)} videos equal the tables; traffic objects {traffic}")
+          f"{len(video_of)} videos equal the tables; traffic objects {traffic}; {light_frames} traffic-light "
+          f"states equal the tables")
+    if any(r["faces_ego"] for rows in lights.values() for r in rows) and not light_frames:
+        fail("the tables have traffic lights facing the ego but the export has no traffic_light state")
     if not traffic.get("vehicle") or not traffic.get("crosswalk"):
         fail(f"no vehicle or no crosswalk track in the whole export: {traffic}")
     report_behaviour("interop_pie")

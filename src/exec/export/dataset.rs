@@ -130,6 +130,23 @@ pub struct Clip {
     /// Every pedestrian's track, by pedestrian id, in frame order (empty for a dataset written before the
     /// `tracks` table existed).
     pub tracks: BTreeMap<u32, Vec<TrackFrame>>,
+    /// The `traffic_lights` rows, in (frame, light) order (empty without lights, or for a dataset written before
+    /// the table existed).
+    pub traffic_lights: Vec<LightFrame>,
+}
+
+/// A row of the `traffic_lights` table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightFrame {
+    pub frame: u32,
+    pub signal: String,
+    /// `green`, `amber` or `red`.
+    pub state: String,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub facing_rad: f64,
+    pub faces_ego: bool,
 }
 
 impl std::ops::Deref for Clip {
@@ -267,6 +284,7 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         pedestrians: BTreeMap::new(),
         vehicles: Vec::new(),
         tracks: BTreeMap::new(),
+        traffic_lights: Vec::new(),
     };
     let cols = [
         "frame",
@@ -433,6 +451,40 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         }
         for t in clip.tracks.values_mut() {
             t.sort_by_key(|f| f.frame);
+        }
+    }
+    let lights = file("traffic_lights");
+    if lights.is_file() {
+        let cols = [
+            "frame",
+            "signal",
+            "state",
+            "x_m",
+            "y_m",
+            "z_m",
+            "facing_rad",
+            "faces_ego",
+        ];
+        for b in tables::read(&lights, &cols)? {
+            let (frame, signal, state, faces) = (
+                b.u32s("frame")?,
+                b.strings("signal")?,
+                b.strings("state")?,
+                b.bools("faces_ego")?,
+            );
+            let v: Vec<_> = cols[3..7].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            for i in 0..b.rows() {
+                clip.traffic_lights.push(LightFrame {
+                    frame: frame.value(i),
+                    signal: signal[i].to_owned(),
+                    state: state[i].to_owned(),
+                    x_m: f64::from(v[0].value(i)),
+                    y_m: f64::from(v[1].value(i)),
+                    z_m: f64::from(v[2].value(i)),
+                    facing_rad: f64::from(v[3].value(i)),
+                    faces_ego: faces.value(i),
+                });
+            }
         }
     }
     Ok(clip)

@@ -254,6 +254,37 @@ fn vehicle_box(cam: &crate::exec::observe::rig::CameraPose, pos: DVec3, yaw_rad:
     (b[2] - b[0] >= 2.0 && b[3] - b[1] >= 2.0).then_some(b)
 }
 
+/// A traffic light's projected box in a frame: the 8 corners of its housing around the head's centre `pos`,
+/// all 0.5–80 m in front of the camera, the box clipped to the image; `None` when nothing of it is in the image.
+fn light_box(cam: &crate::exec::observe::rig::CameraPose, pos: DVec3, facing_rad: f64) -> Option<[f64; 4]> {
+    let (s, c) = facing_rad.sin_cos();
+    let (mut lo, mut hi) = (glam::DVec2::splat(f64::INFINITY), glam::DVec2::splat(f64::NEG_INFINITY));
+    for (fx, fy, fz) in [
+        (1.0, 1.0, 1.0),
+        (1.0, -1.0, 1.0),
+        (-1.0, 1.0, 1.0),
+        (-1.0, -1.0, 1.0),
+        (1.0, 1.0, -1.0),
+        (1.0, -1.0, -1.0),
+        (-1.0, 1.0, -1.0),
+        (-1.0, -1.0, -1.0),
+    ] {
+        let (lx, ly) = (
+            fx * crate::exec::observe::scene::SIGNAL_HOUSING_HALF_DEPTH_M as f64,
+            fy * crate::exec::observe::scene::SIGNAL_HOUSING_HALF_WIDTH_M as f64,
+        );
+        let z = fz * crate::exec::observe::scene::SIGNAL_HOUSING_HALF_HEIGHT_M as f64;
+        let p = cam.project(pos + DVec3::new(c * lx - s * ly, s * lx + c * ly, z));
+        if p.depth_m < 0.5 || p.depth_m > 80.0 {
+            return None;
+        }
+        (lo, hi) = (lo.min(p.px), hi.max(p.px));
+    }
+    let (w, h) = (f64::from(cam.camera.width_px), f64::from(cam.camera.height_px));
+    let b = [lo.x.max(0.0), lo.y.max(0.0), hi.x.min(w), hi.y.min(h)];
+    (b[2] - b[0] >= 1.0 && b[3] - b[1] >= 1.0).then_some(b)
+}
+
 /// A ground polygon's projected box in a frame: every corner 0.5–80 m in front of the camera, the box clipped to
 /// the image; `None` when nothing of it is in the image.
 fn ground_box(cam: &crate::exec::observe::rig::CameraPose, polygon: &[glam::DVec2], z_m: f64) -> Option<[f64; 4]> {
@@ -383,6 +414,36 @@ fn write_video(
             if !boxes.is_empty() {
                 let _ = write!(x, "  <track label=\"crosswalk\">\n{boxes}  </track>\n");
             }
+        }
+    }
+    // Traffic lights facing the ego: PIE's `traffic_light` tracks (type `regular`, state red / yellow / green),
+    // the head's housing projected like the vehicles. Ids number the clip's lights in id order.
+    let mut light_ids: Vec<&str> = clip.traffic_lights.iter().map(|l| l.signal.as_str()).collect();
+    light_ids.sort_unstable();
+    light_ids.dedup();
+    for (k, id) in light_ids.iter().enumerate() {
+        let mut boxes = String::new();
+        for l in clip.traffic_lights.iter().filter(|l| l.signal == *id && l.faces_ego) {
+            let Some(cam) = cameras.get(l.frame as usize) else {
+                continue;
+            };
+            let Some(b) = light_box(cam, DVec3::new(l.x_m, l.y_m, l.z_m), l.facing_rad) else {
+                continue;
+            };
+            let state = match l.state.as_str() {
+                "amber" => "yellow",
+                s => s,
+            };
+            let _ = writeln!(
+                boxes,
+                "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
+                 xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{prefix}_{k}tl</attribute>\n      \
+                 <attribute name=\"type\">regular</attribute>\n      <attribute name=\"state\">{state}</attribute>\n    </box>",
+                l.frame, b[0], b[1], b[2], b[3],
+            );
+        }
+        if !boxes.is_empty() {
+            let _ = write!(x, "  <track label=\"traffic_light\">\n{boxes}  </track>\n");
         }
     }
     x.push_str("</annotations>\n");

@@ -613,11 +613,11 @@ pub fn clip_lamp_posts(trace: &ClipTrace, town: &RoadNetwork) -> Vec<LampPost> {
 /// Half the width of a traffic light's post, metres.
 const SIGNAL_POST_HALF_WIDTH_M: f32 = 0.06;
 /// Half the height of a traffic light's housing (three lamps above each other), metres.
-const SIGNAL_HOUSING_HALF_HEIGHT_M: f32 = 0.45;
+pub const SIGNAL_HOUSING_HALF_HEIGHT_M: f32 = 0.45;
 /// Half the width of a traffic light's housing, metres.
-const SIGNAL_HOUSING_HALF_WIDTH_M: f32 = 0.17;
+pub const SIGNAL_HOUSING_HALF_WIDTH_M: f32 = 0.17;
 /// Half the depth of a traffic light's housing (along its facing), metres.
-const SIGNAL_HOUSING_HALF_DEPTH_M: f32 = 0.12;
+pub const SIGNAL_HOUSING_HALF_DEPTH_M: f32 = 0.12;
 /// Half the side of a traffic light's lamp, metres.
 const SIGNAL_LAMP_HALF_M: f32 = 0.11;
 
