@@ -102,6 +102,30 @@ fn round_trip(name: &str) {
             assert!(p.distance(*q) < 1e-9, "{name}: crosswalk corner {p} read back as {q}");
         }
     }
+    // Traffic lights come back from the file's signals and controllers: same ids, junctions, approaches and
+    // phases, at the same place, facing the same way.
+    assert_eq!(original.signals.len(), back.signals.len(), "{name}: traffic lights");
+    for (g, h) in original.signals.iter().zip(&back.signals) {
+        assert!(g.synthesized && !h.synthesized);
+        assert_eq!(
+            (&g.id, g.junction, g.road, g.at_road_end, g.phase),
+            (&h.id, h.junction, h.road, h.at_road_end, h.phase),
+            "{name}: traffic light {}",
+            g.id
+        );
+        assert!(
+            g.position.distance(h.position) < 1e-3,
+            "{name}: traffic light {} at {} read back at {}",
+            g.id,
+            g.position,
+            h.position
+        );
+        assert!(
+            (g.facing_rad - h.facing_rad).abs() < 1e-9,
+            "{name}: traffic light {} facing",
+            g.id
+        );
+    }
     // Buildings come back from the file's objects instead of being synthesised (grouped by the road they are
     // written on, so compared in a canonical order).
     assert_eq!(original.obstacles.len(), back.obstacles.len(), "{name}: buildings");

@@ -8,7 +8,9 @@
 //! camera paints: solid yellow between directions, dashed white between lanes of one direction, solid white
 //! at the carriageway's edge), sidewalk heights (the curb) and, on connecting roads, lane links; crosswalks
 //! as `<object type="crosswalk">` with their outline in road coordinates; buildings as
-//! `<object type="building">` boxes on the nearest road; junctions with their connections and lane links.
+//! `<object type="building">` boxes on the nearest road; traffic lights as dynamic `<signal>`s (type 1000001,
+//! as CARLA's maps) on their approach roads with one `<controller>` per junction phase, in sequence order;
+//! junctions with their connections, lane links and controllers.
 //! No date and no absolute path: the same town gives the same bytes. Floats are written in Rust's shortest
 //! round-trip form, so a reading gives back the very numbers the generator produced.
 
@@ -92,6 +94,22 @@ fn write(
         object_id += 1;
     }
 
+    // Traffic lights on their approach roads, as CARLA writes them: a dynamic three-light signal, valid for the
+    // traffic entering the junction (`+` at the road's end, `-` at its start); one controller per phase of each
+    // junction, in sequence order.
+    let mut signals: Vec<Vec<String>> = vec![Vec::new(); raw.roads.len()];
+    for g in &net.signals {
+        let road = &raw.roads[g.road as usize];
+        let (s, t) = road_coords(road, g.position.truncate());
+        let z_offset = g.position.z - super::geometry::eval_piecewise(&road.elevations, s);
+        signals[g.road as usize].push(format!(
+            "<signal s=\"{s}\" t=\"{t}\" id=\"{}\" name=\"Signal_3Light_Post01\" dynamic=\"yes\" orientation=\"{}\" zOffset=\"{z_offset}\" country=\"OpenDRIVE\" type=\"1000001\" subtype=\"-1\" value=\"-1\" height=\"0.9\" width=\"0.34\" hOffset=\"0\" pitch=\"0\" roll=\"0\"/>\n",
+            xml_escape(&g.id),
+            if g.at_road_end { "+" } else { "-" }
+        ));
+    }
+    let controller_id = |j: &str, phase: u32| format!("c{j}_{phase}");
+
     let (lo, hi) = net.bounds;
     let mut x = String::with_capacity(4 << 20);
     let _ = write!(
@@ -106,7 +124,25 @@ fn write(
         lo.x
     );
     for (ri, road) in raw.roads.iter().enumerate() {
-        write_road(&mut x, road, &objects[ri]);
+        write_road(&mut x, road, &objects[ri], &signals[ri]);
+    }
+    for (ji, j) in net.junctions.iter().enumerate() {
+        for phase in 0..crate::world::signals::junction_phases(&net.signals, ji as u32) {
+            let _ = writeln!(
+                x,
+                "<controller id=\"{}\" name=\"{}\" sequence=\"{phase}\">",
+                xml_escape(&controller_id(&j.id, phase)),
+                xml_escape(&format!("junction {} phase {phase}", j.id))
+            );
+            for g in net
+                .signals
+                .iter()
+                .filter(|g| g.junction == ji as u32 && g.phase == phase)
+            {
+                let _ = writeln!(x, "<control signalId=\"{}\" type=\"0\"/>", xml_escape(&g.id));
+            }
+            x.push_str("</controller>\n");
+        }
     }
     for j in &raw.junctions {
         let _ = writeln!(
@@ -127,6 +163,15 @@ fn write(
                 let _ = writeln!(x, "<laneLink from=\"{from}\" to=\"{to}\"/>");
             }
             x.push_str("</connection>\n");
+        }
+        if let Some(ji) = net.junctions.iter().position(|k| k.id == j.id) {
+            for phase in 0..crate::world::signals::junction_phases(&net.signals, ji as u32) {
+                let _ = writeln!(
+                    x,
+                    "<controller id=\"{}\" type=\"0\" sequence=\"{phase}\"/>",
+                    xml_escape(&controller_id(&j.id, phase))
+                );
+            }
         }
         x.push_str("</junction>\n");
     }
@@ -155,7 +200,30 @@ fn poly(x: &mut String, tag: &str, s_attr: &str, p: &Poly3At) {
     );
 }
 
-fn write_road(x: &mut String, road: &RawRoad, objects: &[String]) {
+/// Road coordinates `(s, t)` of plan-view point `p` on `road`'s reference line: the nearest station (sampled
+/// every 0.5 m, then refined by bisection) and the signed offset to the left.
+fn road_coords(road: &RawRoad, p: DVec2) -> (f64, f64) {
+    let d2 = |s: f64| ref_at(road, s).0.distance_squared(p);
+    let n = (road.length / 0.5).ceil().max(1.0) as usize;
+    let best = (0..=n)
+        .map(|k| (k as f64 * 0.5).min(road.length))
+        .min_by(|a, b| d2(*a).total_cmp(&d2(*b)))
+        .unwrap_or(0.0);
+    let (mut a, mut b) = ((best - 0.5).max(0.0), (best + 0.5).min(road.length));
+    for _ in 0..40 {
+        let (m1, m2) = (a + (b - a) / 3.0, b - (b - a) / 3.0);
+        if d2(m1) <= d2(m2) {
+            b = m2;
+        } else {
+            a = m1;
+        }
+    }
+    let s = 0.5 * (a + b);
+    let (q, h) = ref_at(road, s);
+    (s, (p - q).dot(DVec2::from_angle(h).perp()))
+}
+
+fn write_road(x: &mut String, road: &RawRoad, objects: &[String], signals: &[String]) {
     let _ = writeln!(
         x,
         "<road name=\"{}\" length=\"{}\" id=\"{}\" junction=\"{}\" rule=\"{}\">",
@@ -276,6 +344,13 @@ fn write_road(x: &mut String, road: &RawRoad, objects: &[String]) {
             x.push_str(o);
         }
         x.push_str("</objects>\n");
+    }
+    if !signals.is_empty() {
+        x.push_str("<signals>\n");
+        for g in signals {
+            x.push_str(g);
+        }
+        x.push_str("</signals>\n");
     }
     x.push_str("</road>\n");
 }
