@@ -146,6 +146,18 @@ pub struct RouteScript {
     pub start_heading_rad: f64,
 }
 
+impl RouteScript {
+    /// The route's lanes that exist in `net` (a plan made for another version of a map is refused before this;
+    /// skipping keeps a hand-made script from indexing out of range).
+    pub fn lanes_in(&self, net: &crate::world::RoadNetwork) -> Vec<u32> {
+        self.lanes
+            .iter()
+            .copied()
+            .filter(|&l| (l as usize) < net.lanes.len())
+            .collect()
+    }
+}
+
 /// The ego vehicle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EgoScript {

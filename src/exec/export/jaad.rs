@@ -12,7 +12,7 @@ use glam::DVec2;
 use serde::Serialize;
 
 use super::dataset::{Clip, ClipInfo, Dataset, EgoFrame};
-use super::pie::{Labels, Place, inside, occlusion_class, place_at, wrap_pi, xml_escape};
+use super::pie::{Labels, Place, occlusion_class, place_at, wrap_pi, xml_escape};
 use super::{LinkMode, RgbFiles, link_frames, write_file};
 use crate::world::RoadNetwork;
 
@@ -124,7 +124,7 @@ fn crosswalk_ahead(crosswalks: &[(&[DVec2], DVec2)], e: &EgoFrame) -> bool {
     let (p, fwd) = (DVec2::new(e.x_m, e.y_m), DVec2::from_angle(e.yaw_rad));
     crosswalks.iter().any(|&(polygon, centre)| {
         let d = centre - p;
-        inside(polygon, p) || (d.length() < 40.0 && d.dot(fwd) > 0.7 * d.length())
+        crate::world::point_in_polygon(polygon, p) || (d.length() < 40.0 && d.dot(fwd) > 0.7 * d.length())
     })
 }
 
@@ -192,7 +192,10 @@ fn write_video(
         let at = crossing_point
             .and_then(|c| p.frames.iter().find(|f| f.frame == c))
             .unwrap_or(&p.frames[p.frames.len() - 1]);
-        let place = net.map_or(Place::UNKNOWN, |n| place_at(n, f64::from(at.x_m), f64::from(at.y_m)));
+        let lights_run = !clip.traffic_lights.is_empty();
+        let place = net.map_or(Place::UNKNOWN, |n| {
+            place_at(n, f64::from(at.x_m), f64::from(at.y_m), lights_run)
+        });
         let on_crosswalk = place.on_crosswalk;
         let _ = writeln!(
             a,

@@ -169,8 +169,8 @@ impl Place {
 }
 
 /// The road at a point: its driving lanes in the lane section there, their directions, a junction, a
-/// crosswalk.
-pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64) -> Place {
+/// crosswalk and (where traffic lights ran, `lights_run`) whether that crosswalk is signalised.
+pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64, lights_run: bool) -> Place {
     let p = glam::DVec2::new(x_m, y_m);
     let hit = net
         .lane_at(p)
@@ -203,26 +203,25 @@ pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64) -> Place {
         }
         None => "midblock",
     };
-    let on_crosswalk = net.crosswalks.iter().any(|c| inside(&c.polygon, p));
+    let on_crosswalk = net
+        .crosswalks
+        .iter()
+        .any(|c| crate::world::point_in_polygon(&c.polygon, p));
     Place {
         intersection,
         num_lanes: driving.len() as u32,
-        signalized: if on_crosswalk { "C" } else { "n/a" },
+        // PIE's values: `C` a crosswalk, `CS` a crosswalk with a pedestrian signal.
+        signalized: match (
+            on_crosswalk,
+            lights_run && crate::world::signals::crosswalk_signal(net, p).is_some(),
+        ) {
+            (true, true) => "CS",
+            (true, false) => "C",
+            (false, _) => "n/a",
+        },
         traffic_direction: if forward && backward { "TW" } else { "OW" },
         on_crosswalk,
     }
-}
-
-pub(crate) fn inside(polygon: &[glam::DVec2], p: glam::DVec2) -> bool {
-    let mut inside = false;
-    let n = polygon.len();
-    for i in 0..n {
-        let (a, b) = (polygon[i], polygon[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
 }
 
 /// A vehicle's projected box in a frame: the 8 corners of its 3D box, all in front of the camera, the box
@@ -461,7 +460,10 @@ fn write_video(
         let event_idx = p.frames.iter().position(|f| f.frame == event).unwrap_or(0);
         let critical = p.frames[event_idx.saturating_sub(1)].frame;
         let at = &p.frames[event_idx];
-        let place = net.map_or(Place::UNKNOWN, |n| place_at(n, f64::from(at.x_m), f64::from(at.y_m)));
+        let lights_run = !clip.traffic_lights.is_empty();
+        let place = net.map_or(Place::UNKNOWN, |n| {
+            place_at(n, f64::from(at.x_m), f64::from(at.y_m), lights_run)
+        });
         let _ = writeln!(
             a,
             "  <pedestrian age=\"{}\" critical_point=\"{critical}\" crossing=\"{}\" crossing_point=\"{event}\" \

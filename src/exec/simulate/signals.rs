@@ -91,37 +91,40 @@ impl SignalPlans {
 
     /// The state of `signal` at clip time `time_s`.
     pub fn state_at(&self, signal: &Signal, time_s: f64) -> LightState {
-        let (phases, offset) = self
-            .junctions
+        let (phases, offset) = self.plan_of(signal);
+        phase_state(&self.timing, phases, signal.phase, time_s + offset)
+    }
+
+    /// The pedestrian signal of the crosswalk across `signal`'s approach road at clip time `time_s`.
+    pub fn walk_at(&self, signal: &Signal, time_s: f64) -> WalkSignal {
+        let (phases, offset) = self.plan_of(signal);
+        match slot_at(&self.timing, phases, time_s + offset) {
+            None => WalkSignal::Walk,
+            Some((current, _)) if current == signal.phase => WalkSignal::DontWalk,
+            Some((_, w)) if w < self.timing.green_s.max(0.1) => WalkSignal::Walk,
+            Some(_) => WalkSignal::Flashing,
+        }
+    }
+
+    /// (phases, offset) of `signal`'s junction.
+    fn plan_of(&self, signal: &Signal) -> (u32, f64) {
+        self.junctions
             .get(signal.junction as usize)
             .copied()
-            .unwrap_or((0, 0.0));
-        phase_state(&self.timing, phases, signal.phase, time_s + offset)
+            .unwrap_or((0, 0.0))
     }
 }
 
-impl SignalPlans {
-    /// The pedestrian signal of the crosswalk across `signal`'s approach road at clip time `time_s`.
-    pub fn walk_at(&self, signal: &Signal, time_s: f64) -> WalkSignal {
-        let (phases, offset) = self
-            .junctions
-            .get(signal.junction as usize)
-            .copied()
-            .unwrap_or((0, 0.0));
-        if phases == 0 {
-            return WalkSignal::Walk;
-        }
-        let slot = slot_s(&self.timing);
-        let u = (time_s + offset).rem_euclid(slot * f64::from(phases));
-        let current = ((u / slot) as u32).min(phases - 1);
-        if current == signal.phase {
-            WalkSignal::DontWalk
-        } else if u - f64::from(current) * slot < self.timing.green_s.max(0.1) {
-            WalkSignal::Walk
-        } else {
-            WalkSignal::Flashing
-        }
+/// The phase whose slot cycle time `t_s` falls in and the time into that slot, for a plan of `phases` phases
+/// (`None` without phases).
+fn slot_at(timing: &Signals, phases: u32, t_s: f64) -> Option<(u32, f64)> {
+    if phases == 0 {
+        return None;
     }
+    let slot = slot_s(timing);
+    let u = t_s.rem_euclid(slot * f64::from(phases));
+    let current = ((u / slot) as u32).min(phases - 1);
+    Some((current, u - f64::from(current) * slot))
 }
 
 /// Length of one phase's slot (green, amber, all red), seconds.
@@ -129,24 +132,14 @@ fn slot_s(t: &Signals) -> f64 {
     t.green_s.max(0.1) + t.amber_s.max(0.0) + t.all_red_s.max(0.0)
 }
 
-/// The state of phase `phase` of a plan of `phases` phases at cycle time `t_s`.
+/// The state of phase `phase` of a plan of `phases` phases at cycle time `t_s` (green without phases).
 pub fn phase_state(timing: &Signals, phases: u32, phase: u32, t_s: f64) -> LightState {
-    if phases == 0 {
-        return LightState::Green;
-    }
-    let slot = slot_s(timing);
-    let u = t_s.rem_euclid(slot * f64::from(phases));
-    let current = ((u / slot) as u32).min(phases - 1);
-    if current != phase {
-        return LightState::Red;
-    }
-    let w = u - f64::from(current) * slot;
-    if w < timing.green_s.max(0.1) {
-        LightState::Green
-    } else if w < timing.green_s.max(0.1) + timing.amber_s.max(0.0) {
-        LightState::Amber
-    } else {
-        LightState::Red
+    match slot_at(timing, phases, t_s) {
+        None => LightState::Green,
+        Some((current, _)) if current != phase => LightState::Red,
+        Some((_, w)) if w < timing.green_s.max(0.1) => LightState::Green,
+        Some((_, w)) if w < timing.green_s.max(0.1) + timing.amber_s.max(0.0) => LightState::Amber,
+        Some(_) => LightState::Red,
     }
 }
 
@@ -169,13 +162,7 @@ pub(crate) fn stop_lines(route: &RouteScript, net: &RoadNetwork) -> Vec<StopLine
     if net.signals.is_empty() {
         return Vec::new();
     }
-    let lanes: Vec<u32> = route
-        .lanes
-        .iter()
-        .copied()
-        .filter(|&l| (l as usize) < net.lanes.len())
-        .collect();
-    let Some(r) = net.route_through(&lanes) else {
+    let Some(r) = net.route_through(&route.lanes_in(net)) else {
         return Vec::new();
     };
     signalised_entries(net, &r)

@@ -94,12 +94,7 @@ impl VehiclePath {
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
     pub fn from_route(route: &RouteScript, net: &RoadNetwork) -> VehiclePath {
         // The world joins lanes into a polyline (the same one the planner measured the route on).
-        let lanes: Vec<u32> = route
-            .lanes
-            .iter()
-            .copied()
-            .filter(|&l| (l as usize) < net.lanes.len())
-            .collect();
+        let lanes = route.lanes_in(net);
         let mut raw: Vec<(DVec2, f64, f64, f64)> = net // pos, z, limit, s
             .route_through(&lanes)
             .map(|r| {
