@@ -243,9 +243,10 @@ pub enum Event {
         signal: u32,
         /// Whether it ran the red light (else it stopped for it).
         ran: bool,
-        /// For a light run by a vehicle that heeds lights: it could not stop when it first saw the light amber
-        /// or red (the dilemma zone, or placed too close to a red light at the clip's start). A light run by a
-        /// vehicle drawn to ignore lights, or by an emergency vehicle, is not.
+        /// It heeds lights but had committed to the line: it could not stop when it first saw the light amber or
+        /// red (the dilemma zone, or placed too close to a red light at the clip's start). A light run by a
+        /// vehicle drawn to ignore lights, or by an emergency vehicle, never is; nor one run by a vehicle that
+        /// could have stopped (none should be: tests/signals.rs).
         unavoidable: bool,
     },
     /// A vehicle touched a pedestrian or another vehicle (recorded, never hidden).

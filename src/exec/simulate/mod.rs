@@ -341,7 +341,7 @@ impl<'a> Sim<'a> {
                         vehicle: v.id,
                         signal: line.signal,
                         ran: true,
-                        unavoidable: v.heeds_lights(),
+                        unavoidable: v.committed == Some(v.next_stop),
                     });
                 }
                 v.next_stop += 1;
