@@ -15,7 +15,7 @@ use pedsynth::dsl::types::{Rgb, WeatherPreset};
 use pedsynth::exec::observe::camera::{CameraImages, Renderer, SKY_DEPTH_M, light::Lighting, luminance};
 use pedsynth::exec::observe::rig::{Camera, Rig};
 use pedsynth::exec::observe::scene::{
-    self, Cluster, FrameScene, Material, Mesh, Prim, StaticScene, pedestrian_instance, tag,
+    self, CYCLIST_INSTANCE_BASE, Cluster, FrameScene, Material, Mesh, Prim, StaticScene, pedestrian_instance, tag,
 };
 use pedsynth::exec::observe::{self, annotate::ClipAnnotations};
 use pedsynth::exec::simulate;
@@ -44,9 +44,14 @@ struct Clip {
 
 /// The first clip of a spec, simulated and annotated.
 fn clip(spec_path: &Path, overrides: &[&str]) -> Clip {
+    clip_at(spec_path, overrides, 0)
+}
+
+/// Clip `index` of a spec, simulated and annotated.
+fn clip_at(spec_path: &Path, overrides: &[&str], index: usize) -> Clip {
     let (_, towns, plan) =
         commands::plan_spec_file(spec_path, &options(overrides)).unwrap_or_else(|e| panic!("{}", e.render()));
-    let script = plan.clips[0].clone();
+    let script = plan.clips[index].clone();
     let net = &towns[&script.town].network;
     let trace = simulate::simulate(&script, &plan.sim, net);
     let rig = Rig::from_spec(&plan.spec.sensors);
@@ -311,6 +316,7 @@ fn static_scene(mesh: Mesh) -> StaticScene {
         signal_heads: Vec::new(),
         seed: 1,
         outfits: Vec::new(),
+        riders: Vec::new(),
         car_paint: Vec::new(),
     }
 }
@@ -909,5 +915,108 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
     assert!(
         checked >= 3,
         "only {checked} frames with a pole in front of a pedestrian"
+    );
+}
+
+/// Cyclists are drawn where the `cyclists` table puts them: for every annotated cyclist (every frame of
+/// the first quickstart clip with cyclists near the ego) that nothing nearer covers, its instance pixels (rider
+/// and bicycle) lie in its box and their box has IoU ≥ 0.8 with it, they carry CARLA's `Rider` and `Bicycle`
+/// tags, and the rider's visible keypoints fall on its pixels.
+#[test]
+fn cyclists_are_drawn_in_their_boxes_as_rider_and_bicycle() {
+    let overrides = [
+        "sensors.rgb.width_px=640",
+        "sensors.rgb.height_px=360",
+        "sensors.dvs.enabled=false",
+        "traffic.cyclists.per_clip=[3, 3]",
+    ];
+    let candidates = |c: &Clip| {
+        c.ann
+            .cyclists
+            .iter()
+            .filter(|r| r.annotated && !r.truncated && r.occlusion == 0.0)
+            .count()
+    };
+    let c = (0..2)
+        .map(|k| clip_at(&spec("quickstart.yaml"), &overrides, k))
+        .find(|c| candidates(c) >= 20)
+        .expect("a quickstart clip with cyclists near the ego");
+    let (mut compared, mut hidden, mut keypoints, mut on_body) = (0usize, 0usize, 0usize, 0usize);
+    let (mut worst_share, mut worst_iou) = (1.0f64, 1.0f64);
+    let mut tags = std::collections::BTreeSet::new();
+    for frame in 0..c.trace.frame_count {
+        let rows: Vec<_> = c
+            .ann
+            .cyclists
+            .iter()
+            .filter(|r| r.frame == frame && r.annotated && !r.truncated && r.occlusion == 0.0)
+            .collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let img = c.render(frame);
+        let w = img.width;
+        for r in rows {
+            let id = CYCLIST_INSTANCE_BASE + r.cyclist as u16;
+            let b = r.bbox_px;
+            let pixels: Vec<usize> = (0..img.instance.len()).filter(|&i| img.instance[i] == id).collect();
+            assert!(!pixels.is_empty(), "frame {frame}: cyclist {} not drawn", r.cyclist);
+            let nearest_m = pixels.iter().map(|&i| img.depth_m[i]).fold(f32::MAX, f32::min);
+            let covered = (b[1] as usize..(b[3].ceil() as usize).min(img.height)).any(|y| {
+                (b[0] as usize..(b[2].ceil() as usize).min(w)).any(|x| {
+                    let i = y * w + x;
+                    (img.instance[i] != 0 || img.semantic[i] == tag::POLE)
+                        && img.instance[i] != id
+                        && img.depth_m[i] < nearest_m - 0.05
+                })
+            });
+            if covered {
+                hidden += 1;
+                continue;
+            }
+            let (mut inside, mut lo, mut hi) = (0usize, (f32::MAX, f32::MAX), (f32::MIN, f32::MIN));
+            for &i in &pixels {
+                let (x, y) = ((i % w) as f32 + 0.25, (i / w) as f32 + 0.25);
+                inside += usize::from(x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3]);
+                lo = (lo.0.min(x), lo.1.min(y));
+                hi = (hi.0.max(x), hi.1.max(y));
+                tags.insert(img.semantic[i]);
+            }
+            let share = inside as f64 / pixels.len() as f64;
+            let pix = [lo.0 - 0.5, lo.1 - 0.5, hi.0 + 0.5, hi.1 + 0.5];
+            let iw = (pix[2].min(b[2]) - pix[0].max(b[0])).max(0.0);
+            let ih = (pix[3].min(b[3]) - pix[1].max(b[1])).max(0.0);
+            let inter = iw * ih;
+            let union = (pix[2] - pix[0]) * (pix[3] - pix[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter;
+            let iou = f64::from(inter / union);
+            assert!(
+                share >= 0.95 && iou >= 0.8,
+                "frame {frame}, cyclist {}: {share:.3} of its pixels in its box {b:?}, IoU {iou:.3} with {pix:?}",
+                r.cyclist
+            );
+            worst_share = worst_share.min(share);
+            worst_iou = worst_iou.min(iou);
+            compared += 1;
+            for k in (0..17).filter(|k| r.keypoints[3 * k + 2] == 2.0) {
+                keypoints += 1;
+                on_body += usize::from(near_pixel(&img, r.keypoints[3 * k], r.keypoints[3 * k + 1], |i| {
+                    img.instance[i] == id
+                }));
+            }
+        }
+    }
+    eprintln!(
+        "{compared} cyclist-frames compared ({hidden} covered): worst in-box share {worst_share:.3}, worst IoU \
+         {worst_iou:.3}; {on_body} of {keypoints} visible keypoints on the cyclist; tags {tags:?}"
+    );
+    assert!(compared >= 20, "only {compared} cyclist-frames compared");
+    assert_eq!(
+        tags,
+        [tag::RIDER, tag::BICYCLE].into_iter().collect(),
+        "a cyclist's pixels are Rider and Bicycle"
+    );
+    assert!(
+        on_body as f64 >= 0.95 * keypoints as f64,
+        "{on_body} of {keypoints} keypoints on the cyclist"
     );
 }

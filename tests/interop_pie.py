@@ -209,6 +209,12 @@ def main():
     traffic = {}
     light_frames = 0
     lights = {}
+    cyclist_boxes = {}
+    if os.path.isdir(os.path.join(args.dataset, "tables", "cyclists")):
+        for r in table(args.dataset, "cyclists", ["clip_id", "frame", "cyclist", "in_view", "x1", "y1", "x2", "y2"]):
+            if r["in_view"]:
+                cyclist_boxes[(r["clip_id"], r["cyclist"], r["frame"])] = [r["x1"], r["y1"], r["x2"], r["y2"]]
+    bicycle_boxes = 0
     if os.path.isdir(os.path.join(args.dataset, "tables", "traffic_lights")):
         for r in table(args.dataset, "traffic_lights", ["clip_id", "frame", "signal", "state", "faces_ego"]):
             lights.setdefault(r["clip_id"], []).append(r)
@@ -232,7 +238,18 @@ def main():
         # the clip, each object's frames increasing.
         light_ids = sorted({r["signal"] for r in lights.get(clip_id, [])})
         for oid, o in v["traffic_annotations"].items():
-            kind = {"v": "vehicle", "cw": "crosswalk", "tl": "traffic_light"}[oid.rsplit("_", 1)[1].lstrip("0123456789")]
+            suffix = oid.rsplit("_", 1)[1].lstrip("0123456789")
+            kind = {"v": "vehicle", "b": "vehicle", "cw": "crosswalk", "tl": "traffic_light"}[suffix]
+            if suffix == "b":
+                # A cyclist: PIE's vehicle type `bicycle` (4), with the cyclists table's box in every frame in view.
+                cid = int(oid.rsplit("_", 1)[1][:-1])
+                want = sorted(f for (c, k, f) in cyclist_boxes if c == clip_id and k == cid)
+                if o["obj_type"] != 4 or o["frames"] != want:
+                    fail(f"{clip_id}: cyclist {oid} type {o['obj_type']} frames {o['frames'][:5]} vs {want[:5]}")
+                for f, b in zip(o["frames"], o["bbox"]):
+                    if max(abs(x - y) for x, y in zip(b, cyclist_boxes[(clip_id, cid, f)])) > 0.006:
+                        fail(f"{clip_id}: cyclist {oid} frame {f}: box {b} vs {cyclist_boxes[(clip_id, cid, f)]}")
+                    bicycle_boxes += 1
             if kind == "traffic_light":
                 # Its state in every frame is the table's (PIE: 1 red, 2 yellow, 3 green), for a light facing us.
                 signal = light_ids[int(oid.rsplit("_", 1)[1][:-2])]
@@ -272,7 +289,9 @@ def main():
             seen += 1
     print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames in "
           f"{len(video_of)} videos equal the tables; traffic objects {traffic}; {light_frames} traffic-light "
-          f"states equal the tables")
+          f"states equal the tables; {bicycle_boxes} cyclist (bicycle) boxes equal the tables")
+    if cyclist_boxes and not bicycle_boxes:
+        fail("the tables have cyclists in view but the export has no bicycle")
     if any(r["faces_ego"] for rows in lights.values() for r in rows) and not light_frames:
         fail("the tables have traffic lights facing the ego but the export has no traffic_light state")
     if not traffic.get("vehicle") or not traffic.get("crosswalk"):

@@ -53,6 +53,7 @@ fn scene_of(tris: Vec<Tri>) -> StaticScene {
         signal_heads: Vec::new(),
         seed: 1,
         outfits: Vec::new(),
+        riders: Vec::new(),
         car_paint: Vec::new(),
     }
 }

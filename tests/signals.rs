@@ -34,6 +34,7 @@ fn ignores_lights(clip: &ClipScript, v: VehicleId) -> bool {
             .vehicles
             .get(n as usize)
             .is_some_and(|s| s.ignores_lights || s.emergency.is_some()),
+        VehicleId::Cyclist(n) => clip.cyclists.get(n as usize).is_some_and(|c| c.ignores_lights),
     }
 }
 
@@ -41,6 +42,7 @@ fn frames_of(trace: &ClipTrace, v: VehicleId) -> &[pedsynth::exec::trace::Vehicl
     match v {
         VehicleId::Ego => &trace.ego,
         VehicleId::Traffic(n) => &trace.vehicles[n as usize],
+        VehicleId::Cyclist(_) => panic!("these specs have no cyclists"),
     }
 }
 

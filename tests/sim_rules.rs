@@ -1,15 +1,16 @@
 //! Rule tests of the simulation on a hand-built straight road (two driving lanes, a sidewalk on each side) with
 //! hand-built clip scripts: gap acceptance waits and crosses, non-closing vehicles do not block, the lookahead
 //! stops a crosser before a vehicle, groups cross together, patience expiry leads to a sudden crossing or to
-//! abandoning, the ego brakes for a crosser, and nothing interpenetrates.
+//! abandoning, the ego brakes for a crosser, and nothing interpenetrates; cyclists make crossers wait like cars,
+//! brake for walkers, and are overtaken with the clearance only when the oncoming lane is clear.
 
 use glam::DVec2;
 use pedsynth::dsl::types::{Body, Spec, WeatherParams};
 use pedsynth::exec::simulate::{self, PED_RADIUS_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, ttc};
 use pedsynth::exec::trace::{ClipTrace, Event, PedState, PedestrianId, VehicleId};
 use pedsynth::planner::{
-    Behaviour, ClipScript, CrosserSource, CrossingScript, DrivingProfileKind, EgoScript, GroupRef, PedestrianScript,
-    Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
+    Behaviour, ClipScript, CrosserSource, CrossingScript, CyclistScript, DrivingProfileKind, EgoScript, GroupRef,
+    PedestrianScript, Role, RouteScript, SimParams, SpawnPlace, SpeedProfile, VehicleScript,
 };
 use pedsynth::world::{LaneType, RoadNetwork};
 
@@ -169,6 +170,7 @@ fn clip(
         ego,
         vehicles,
         pedestrians,
+        cyclists: Vec::new(),
         timeline_extension_s: 0.0,
     }
 }
@@ -931,4 +933,196 @@ fn pedestrians_hold_at_the_curb_for_a_siren_and_cross_after_it_passes() {
         "with a siren it waits until it has passed: decided at {held}, passed at {passed}"
     );
     assert_no_interpenetration(&with_siren);
+}
+
+/// Simulation parameters with cyclists on (`traffic.cyclists.per_clip` above 0).
+fn cycling_params() -> SimParams {
+    let mut spec = Spec::default();
+    spec.traffic.cyclists.per_clip = pedsynth::dsl::types::CountRange(1, 1);
+    SimParams::from_spec(&spec)
+}
+
+fn cyclist(net: &RoadNetwork, id: u32, towards_plus_x: bool, x: f64, speed_mps: f64) -> CyclistScript {
+    CyclistScript {
+        id,
+        route: route(net, towards_plus_x, x),
+        speed_mps,
+        edge_offset_m: 0.8,
+        ignores_lights: false,
+        rider: pedsynth::planner::identity::rider_identity(1, id),
+        bike_rgb: [200, 30, 30],
+    }
+}
+
+/// The distance between two footprints (centre, yaw, half extents), metres: the nearest points include a
+/// corner of one of the boxes.
+fn footprint_gap_m(a: (DVec2, f64, DVec2), b: (DVec2, f64, DVec2)) -> f64 {
+    let corners = |(c, yaw, h): (DVec2, f64, DVec2)| {
+        let (f, l) = (DVec2::from_angle(yaw) * h.x, DVec2::from_angle(yaw).perp() * h.y);
+        [c + f + l, c + f - l, c - f + l, c - f - l]
+    };
+    let to = |p: DVec2, (c, yaw, h): (DVec2, f64, DVec2)| ttc::distance_to_box_m(p, c, yaw, h.x, h.y);
+    let ab = corners(a).into_iter().map(|p| to(p, b)).fold(f64::INFINITY, f64::min);
+    let ba = corners(b).into_iter().map(|p| to(p, a)).fold(f64::INFINITY, f64::min);
+    ab.min(ba)
+}
+
+const CAR_HALF: DVec2 = DVec2::new(VEHICLE_LENGTH_M / 2.0, VEHICLE_WIDTH_M / 2.0);
+const BIKE_HALF: DVec2 = DVec2::new(0.875, 0.325);
+
+/// A pedestrian checks a cyclist as it checks a car: one closing at 5.5 m/s from 35 m (TTC ≈ 6.4 s, below the
+/// threshold of ≈ 10.3 s) keeps it at the curb; it crosses once the cyclist has passed. Without the cyclist the
+/// same crosser steps out seconds earlier.
+#[test]
+fn a_crosser_waits_for_a_closing_cyclist_as_for_a_car() {
+    let net = road();
+    let base = clip(
+        ego_at(&net, 160.0, 0.0),
+        Vec::new(),
+        vec![crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated)],
+        20,
+    );
+    let alone = simulate::simulate(&base, &cycling_params(), &net);
+    let entered_alone = first_in_road(&alone, 0).expect("crosses without the cyclist");
+    let mut script = base.clone();
+    script.cyclists = vec![cyclist(&net, 0, false, 185.0, 5.5)];
+    let trace = simulate::simulate(&script, &cycling_params(), &net);
+    assert_events_match_trace(&trace);
+    let entered = first_in_road(&trace, 0).expect("crosses after the cyclist");
+    let passed = trace.cyclists[0]
+        .iter()
+        .position(|f| f.pos.x < 150.0 - 0.3)
+        .expect("the cyclist passes the crossing");
+    assert!(
+        entered > passed && entered > entered_alone + 30,
+        "entered at frame {entered} (alone: {entered_alone}); the cyclist passed at frame {passed}"
+    );
+    let min_gap = trace.pedestrians[0]
+        .iter()
+        .zip(&trace.cyclists[0])
+        .map(|(p, c)| ttc::distance_to_box_m(p.pos.truncate(), c.pos.truncate(), c.yaw_rad, 0.875, 0.325))
+        .fold(f64::INFINITY, f64::min);
+    assert!(min_gap > PED_RADIUS_M, "the two kept apart: {min_gap} m");
+}
+
+/// A cyclist rides near its lane's right edge at its own speed, and brakes for a pedestrian stepping into its
+/// path without touching it (and the braking is recorded).
+#[test]
+fn a_cyclist_rides_at_the_lane_edge_and_brakes_for_a_sudden_crosser() {
+    let net = road();
+    let mut script = clip(
+        ego_at(&net, 200.0, 0.0),
+        Vec::new(),
+        vec![crosser(&net, 0, 150.0, Behaviour::Sudden, CrosserSource::Allocated)],
+        12,
+    );
+    script.cyclists = vec![cyclist(&net, 0, true, 138.0, 5.0)];
+    let trace = simulate::simulate(&script, &cycling_params(), &net);
+    assert_events_match_trace(&trace);
+    let first = trace.cyclists[0][0];
+    // Lane −1 spans y ∈ [−3.5, 0]; 0.8 m from its right edge is y = −2.7.
+    assert!(
+        (first.pos.y + 2.7).abs() < 1e-6 && (first.speed_mps - 5.0).abs() < 1e-9,
+        "{first:?}"
+    );
+    assert!(first_in_road(&trace, 0).is_some(), "the crosser crosses");
+    let slowest = trace.cyclists[0]
+        .iter()
+        .map(|f| f.speed_mps)
+        .fold(f64::INFINITY, f64::min);
+    assert!(slowest < 2.5, "the cyclist slowed to {slowest} m/s for the crosser");
+    assert!(
+        trace.events.iter().any(|e| matches!(
+            e,
+            Event::CyclistYielded {
+                cyclist: 0,
+                pedestrian: PedestrianId(0),
+                swerved: false,
+                ..
+            }
+        )),
+        "{:?}",
+        trace.events
+    );
+    assert!(!trace.events.iter().any(|e| matches!(e, Event::Contact { .. })));
+}
+
+/// The ego catches up with a slower cyclist: with the oncoming lane clear it moves out and passes with the
+/// spec's clearance (1.5 m side to side, measured on the trace's footprints); with a car coming the other way
+/// it stays behind the cyclist until that car has passed.
+#[test]
+fn vehicles_overtake_a_cyclist_with_clearance_only_when_the_oncoming_lane_is_clear() {
+    let net = road();
+    let clearance = Spec::default().traffic.cyclists.overtaking_clearance_m;
+    let mut script = clip(ego_at(&net, 0.0, 0.0), Vec::new(), Vec::new(), 20);
+    script.cyclists = vec![cyclist(&net, 0, true, 30.0, 3.0)];
+    let trace = simulate::simulate(&script, &cycling_params(), &net);
+    let gap = |f: usize| {
+        let (e, c) = (&trace.ego[f], &trace.cyclists[0][f]);
+        footprint_gap_m(
+            (e.pos.truncate(), e.yaw_rad, CAR_HALF),
+            (c.pos.truncate(), c.yaw_rad, BIKE_HALF),
+        )
+    };
+    let passed = (0..trace.ego.len())
+        .find(|&f| trace.ego[f].pos.x - VEHICLE_LENGTH_M / 2.0 > trace.cyclists[0][f].pos.x + 0.875)
+        .expect("the ego passes the cyclist");
+    let min_gap = (0..trace.ego.len()).map(gap).fold(f64::INFINITY, f64::min);
+    assert!(min_gap >= clearance - 1e-6, "closest approach {min_gap} m");
+    let overtakes: Vec<f64> = trace
+        .events
+        .iter()
+        .filter_map(|e| match e {
+            Event::OvertookCyclist {
+                vehicle: VehicleId::Ego,
+                cyclist: 0,
+                min_clearance_m,
+                ..
+            } => Some(*min_clearance_m),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(overtakes.len(), 1, "{:?}", trace.events);
+    assert!(
+        (overtakes[0] - clearance).abs() < 0.05,
+        "recorded clearance {}",
+        overtakes[0]
+    );
+    // The ego is back in its lane's centre (y = −1.75) some seconds after passing.
+    let end = trace.ego.last().expect("frames");
+    assert!(
+        (end.pos.y + 1.75).abs() < 0.05 && passed < trace.ego.len() - 60,
+        "{end:?}"
+    );
+
+    // The same with a car coming the other way: the ego stays in its lane until that car has passed it.
+    let mut script = clip(
+        ego_at(&net, 0.0, 0.0),
+        vec![vehicle(&net, 0, false, 110.0, 0.0, false)],
+        Vec::new(),
+        20,
+    );
+    script.cyclists = vec![cyclist(&net, 0, true, 30.0, 3.0)];
+    let trace = simulate::simulate(&script, &cycling_params(), &net);
+    let moved_out = (0..trace.ego.len())
+        .find(|&f| trace.ego[f].pos.y > -1.75 + 0.05)
+        .expect("the ego overtakes after the car has passed");
+    assert!(
+        trace.vehicles[0][moved_out].pos.x < trace.ego[moved_out].pos.x,
+        "moved out at frame {moved_out} before the oncoming car passed"
+    );
+    let min_gap = (0..trace.ego.len())
+        .map(|f| {
+            let (e, c) = (&trace.ego[f], &trace.cyclists[0][f]);
+            footprint_gap_m(
+                (e.pos.truncate(), e.yaw_rad, CAR_HALF),
+                (c.pos.truncate(), c.yaw_rad, BIKE_HALF),
+            )
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        min_gap > 1.0,
+        "the ego kept its distance behind the cyclist: {min_gap} m"
+    );
+    assert!(!trace.events.iter().any(|e| matches!(e, Event::Contact { .. })));
 }

@@ -288,6 +288,10 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         p if p.starts_with("traffic.signals.") && p != "traffic.signals.enabled" => {
             vec![("traffic.signals.enabled", json!(true))]
         }
+        // Cyclists exist only with a count above 0; overtakes and swerves show with several per clip.
+        p if p.starts_with("traffic.cyclists.") && p != "traffic.cyclists.per_clip" => {
+            vec![("traffic.cyclists.per_clip", json!([5, 5]))]
+        }
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }

@@ -78,7 +78,14 @@ def recompute(root: Path) -> dict:
         ["clip_id", "frame", "pedestrian", "state", "crossing", "look", "action", "gesture", "reaction",
          "walk_signal", "against_signal", "on_crosswalk"],
     )
-    events = read_table(root, "events", ["clip_id", "kind", "unavoidable"])
+    events = read_table(root, "events", ["clip_id", "kind", "unavoidable", "cyclist", "min_clearance_m", "swerved"])
+    cyclists = read_table(root, "cyclists", ["clip_id", "cyclist", "in_view", "annotated"])
+    # Red-light events of cyclists are counted apart from the motor vehicles'.
+    ev = list(zip(
+        events["kind"].to_pylist(), events["unavoidable"].to_pylist(), events["cyclist"].to_pylist(),
+        events["min_clearance_m"].to_pylist(), events["swerved"].to_pylist(),
+    ))
+    clearances = [c for k, _, _, c, _ in ev if k == "overtook_cyclist"]
 
     split_of = clips.select(["clip_id", "split"])
     n_peds = peds.num_rows
@@ -145,15 +152,22 @@ def recompute(root: Path) -> dict:
         }),
         "against_signal_samples": int(pc.sum(pc.cast(ann["against_signal"], pa.int64())).as_py() or 0),
         "on_crosswalk_samples": int(pc.sum(pc.cast(ann["on_crosswalk"], pa.int64())).as_py() or 0),
-        "red_lights_stopped_for": sum(1 for k in events["kind"].to_pylist() if k == "stopped_at_red_light"),
-        "red_light_violations": sum(
-            1 for k, u in zip(events["kind"].to_pylist(), events["unavoidable"].to_pylist())
-            if k == "ran_red_light" and not u
+        "red_lights_stopped_for": sum(1 for k, _, c, _, _ in ev if k == "stopped_at_red_light" and c is None),
+        "red_light_violations": sum(1 for k, u, c, _, _ in ev if k == "ran_red_light" and not u and c is None),
+        "red_lights_run_unavoidably": sum(1 for k, u, c, _, _ in ev if k == "ran_red_light" and u and c is None),
+        "cyclist_red_lights_stopped_for": sum(
+            1 for k, _, c, _, _ in ev if k == "stopped_at_red_light" and c is not None
         ),
-        "red_lights_run_unavoidably": sum(
-            1 for k, u in zip(events["kind"].to_pylist(), events["unavoidable"].to_pylist())
-            if k == "ran_red_light" and u
-        ),
+        "cyclist_red_light_runs": sum(1 for k, _, c, _, _ in ev if k == "ran_red_light" and c is not None),
+        "cyclists": len(set(zip(cyclists["clip_id"].to_pylist(), cyclists["cyclist"].to_pylist()))),
+        "cyclist_frames_in_view": int(pc.sum(pc.cast(cyclists["in_view"], pa.int64())).as_py() or 0),
+        "cyclist_samples": int(pc.sum(pc.cast(cyclists["annotated"], pa.int64())).as_py() or 0),
+        "cyclist_overtakes": len(clearances),
+        "min_overtaking_clearance_m": min(clearances) if clearances else None,
+        "cyclist_swerves": sum(1 for k, _, _, _, s in ev if k == "cyclist_yielded" and s),
+        "cyclist_brakes_for_pedestrians": sum(1 for k, _, _, _, s in ev if k == "cyclist_yielded" and not s),
+        "pedestrian_cyclist_conflicts": sum(1 for k, _, c, _, _ in ev if k == "conflict" and c is not None),
+        "cyclist_contacts": sum(1 for k, _, c, _, _ in ev if k == "contact" and c is not None),
     }
 
 
@@ -191,8 +205,16 @@ def compare(mine: dict, stats: dict) -> Checker:
     for key in ["looking_samples", "walking_samples", "gesture_samples", "gesturing_pedestrians", "reaction_samples",
                 "emergency_clips", "yielding_vehicle_frames", "red_lights_stopped_for", "red_light_violations",
                 "red_lights_run_unavoidably", "pedestrians_at_signals", "against_signal_samples",
-                "on_crosswalk_samples"]:
+                "on_crosswalk_samples", "cyclists", "cyclist_frames_in_view", "cyclist_samples", "cyclist_overtakes",
+                "cyclist_swerves", "cyclist_brakes_for_pedestrians", "pedestrian_cyclist_conflicts", "cyclist_contacts",
+                "cyclist_red_lights_stopped_for", "cyclist_red_light_runs"]:
         c.equal(key, mine[key], stats.get(key))
+    if mine["min_overtaking_clearance_m"] is None:
+        c.equal("min_overtaking_clearance_m", None, stats.get("min_overtaking_clearance_m"))
+    else:
+        # The events table stores the clearance as float32.
+        c.close("min_overtaking_clearance_m", mine["min_overtaking_clearance_m"],
+                stats.get("min_overtaking_clearance_m"), tol=1e-9)
     their_counts = stats.get("state_samples")
     if their_counts is not None:
         c.equal("states with samples", sorted(mine["state_samples"]), sorted(their_counts))

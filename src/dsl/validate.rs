@@ -848,8 +848,8 @@ impl Validator<'_> {
             120.0,
             "a waiting time in seconds",
         );
-        self.probability("traffic.emergency.clip_share", t.emergency.clip_share);
         let g = &t.signals;
+        self.probability("traffic.signals.crosswalk_share", g.crosswalk_share);
         self.positive("traffic.signals.green_s", g.green_s, 300.0, "a green time in seconds");
         self.num(
             "traffic.signals.amber_s",
@@ -864,6 +864,40 @@ impl Validator<'_> {
             0.0,
             60.0,
             "an all-red time in seconds",
+        );
+        let c = &t.cyclists;
+        self.count_range(
+            "traffic.cyclists.per_clip",
+            c.per_clip,
+            0,
+            50,
+            "a number of cyclists per clip",
+        );
+        self.range("traffic.cyclists.speed_mps", c.speed_mps, 0.5, 15.0, "a speed in m/s");
+        self.num(
+            "traffic.cyclists.edge_offset_m",
+            c.edge_offset_m,
+            0.3,
+            3.0,
+            "a distance from the lane's right edge in metres",
+        );
+        self.num(
+            "traffic.cyclists.overtaking_clearance_m",
+            c.overtaking_clearance_m,
+            0.5,
+            3.0,
+            "a passing clearance in metres",
+        );
+        self.num(
+            "traffic.cyclists.swerve_m",
+            c.swerve_m,
+            0.0,
+            2.0,
+            "a distance in metres",
+        );
+        self.probability(
+            "traffic.cyclists.ignore_lights_probability",
+            c.ignore_lights_probability,
         );
     }
 

@@ -103,6 +103,28 @@ pub struct VehicleFrame {
     pub light: Option<LightState>,
 }
 
+/// A cyclist (bicycle and rider) in one frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CyclistFrame {
+    /// Ground point under the middle of the bicycle (between the wheels' contact points).
+    pub pos: DVec3,
+    /// Heading.
+    pub yaw_rad: f64,
+    /// Speed along the heading, m/s.
+    pub speed_mps: f64,
+    /// Longitudinal acceleration, m/s².
+    pub accel_mps2: f64,
+    /// Crank angle in [0, 1) turns (advances with distance ridden; the wheels turn with it).
+    pub crank_phase: f64,
+    /// Distance ridden since the clip's start, metres (the wheels' rotation).
+    pub ridden_m: f64,
+    /// Whether it is swerving around a pedestrian.
+    pub swerving: bool,
+    /// The state of the traffic light at the next stop line on its path, if one is within 80 m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<LightState>,
+}
+
 /// A pedestrian in one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PedFrame {
@@ -249,6 +271,30 @@ pub enum Event {
         /// could have stopped (none should be: tests/signals.rs).
         unavoidable: bool,
     },
+    /// A vehicle finished overtaking a cyclist: its rear passed the bicycle's front.
+    OvertookCyclist {
+        /// Frame: the first whose recorded state is past the cyclist.
+        frame: u32,
+        /// The vehicle (the ego or traffic).
+        vehicle: VehicleId,
+        /// The cyclist.
+        cyclist: u32,
+        /// The smallest side-to-side distance between the vehicle's footprint and the bicycle's while they
+        /// were alongside, metres.
+        min_clearance_m: f64,
+    },
+    /// A cyclist reacted to a pedestrian in its path: it swerved around it or braked for it (once per
+    /// cyclist, pedestrian and kind).
+    CyclistYielded {
+        /// Frame: the first whose recorded state reflects the reaction.
+        frame: u32,
+        /// The cyclist.
+        cyclist: u32,
+        /// The pedestrian.
+        pedestrian: PedestrianId,
+        /// Whether it swerved (else it braked).
+        swerved: bool,
+    },
     /// A vehicle touched a pedestrian or another vehicle (recorded, never hidden).
     Contact {
         /// Frame.
@@ -272,14 +318,24 @@ pub enum VehicleId {
     Ego,
     /// A traffic vehicle, by its id in the clip script.
     Traffic(u32),
+    /// A cyclist, by its id in the clip script (`ClipScript::cyclists`).
+    Cyclist(u32),
 }
 
 impl VehicleId {
     /// The traffic vehicle's id, `None` for the ego (the tables' nullable `vehicle` column).
     pub fn traffic(self) -> Option<u32> {
         match self {
-            VehicleId::Ego => None,
             VehicleId::Traffic(n) => Some(n),
+            VehicleId::Ego | VehicleId::Cyclist(_) => None,
+        }
+    }
+
+    /// The cyclist's id, `None` for motor vehicles (the tables' nullable `cyclist` column).
+    pub fn cyclist(self) -> Option<u32> {
+        match self {
+            VehicleId::Cyclist(n) => Some(n),
+            VehicleId::Ego | VehicleId::Traffic(_) => None,
         }
     }
 }
@@ -311,6 +367,9 @@ pub struct ClipTrace {
     pub vehicles: Vec<Vec<VehicleFrame>>,
     /// Pedestrians, `[pedestrian][frame]`.
     pub pedestrians: Vec<Vec<PedFrame>>,
+    /// Cyclists, `[cyclist][frame]` (empty without cyclists).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cyclists: Vec<Vec<CyclistFrame>>,
     /// Events in frame order.
     pub events: Vec<Event>,
     /// The town's traffic lights and their state per frame (empty where lights do not run).

@@ -103,6 +103,18 @@ pub fn identities(clip_seed: u64, id: u32, archetype: &str, body: Body) -> (Iden
     (main, child)
 }
 
+/// The identity of cyclist `id`'s rider (an adult or young adult), from the stream `cyclist/<id>/identity`.
+pub fn rider_identity(clip_seed: u64, id: u32) -> Identity {
+    let mut rng = seeds::clip_rng(clip_seed, &format!("cyclist/{id}/identity"));
+    let height_m = ADULT_HEIGHT_M.0 + ADULT_HEIGHT_M.1 * rng.random_range(0.0..1.0);
+    let age = if rng.random_bool(0.4) {
+        AgeGroup::Young
+    } else {
+        AgeGroup::Adult
+    };
+    looks(&mut rng, height_m, age)
+}
+
 /// An adult's and a child's height for pedestrian `id`, metres.
 fn heights_m(clip_seed: u64, id: u32) -> (f64, f64) {
     let h = blake3::hash(&[clip_seed.to_le_bytes(), u64::from(id).to_le_bytes()].concat());

@@ -803,6 +803,7 @@ fn plan_clip(
             basics.seed,
         )?);
     }
+    let cyclists = plan_cyclists(spec, town, &ego.route, &pedestrians, &vehicles, needed_m, basics.seed);
     // The clip lasts at least as long as its crossers' timelines, up to a cap.
     let cruise_mps = ego_cruise_mps(net, &ego);
     let needed_s = pedestrians
@@ -828,6 +829,7 @@ fn plan_clip(
         ego,
         vehicles,
         pedestrians,
+        cyclists,
         timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
     })
 }
@@ -1496,6 +1498,92 @@ fn plan_emergency(
         }
     }
     Err("cannot place the emergency vehicle on a free driving lane within 150 m of the ego".to_owned())
+}
+
+/// Bicycle frame colours (sRGB).
+const BIKE_COLOURS: [[u8; 3]; 8] = [
+    [200, 30, 30],
+    [20, 20, 22],
+    [230, 230, 225],
+    [30, 80, 170],
+    [40, 130, 60],
+    [240, 170, 20],
+    [120, 120, 125],
+    [0, 150, 160],
+];
+/// Cyclists start at least this far from the ego and from every vehicle's start, metres.
+const CYCLIST_SPACING_M: f64 = 8.0;
+
+/// The clip's cyclists (`traffic.cyclists.per_clip`), all from the stream `cyclists` (and their riders' looks
+/// from `cyclist/<id>/identity`), so that adding cyclists changes no other draw of the plan. Every other one
+/// starts ahead of the ego in its direction (15–80 m: the ego catches up and overtakes it), the others anywhere
+/// 15–120 m away; clear of the vehicles' starts and of pedestrians on the road. A cyclist that finds no free
+/// lane is left out (cyclists are optional scenery; `pedsynth stats` counts those placed).
+fn plan_cyclists(
+    spec: &Spec,
+    town: &TownContext,
+    ego_route: &RouteScript,
+    peds: &[PedestrianScript],
+    vehicles: &[VehicleScript],
+    needed_m: f64,
+    clip_seed: u64,
+) -> Vec<CyclistScript> {
+    let c = &spec.traffic.cyclists;
+    if c.per_clip.max() == 0 {
+        return Vec::new();
+    }
+    let net = &town.network;
+    let mut rng = seeds::clip_rng(clip_seed, "cyclists");
+    let count = rng.random_range(c.per_clip.min()..=c.per_clip.max().max(c.per_clip.min()));
+    let ego_start = ego_route.start;
+    let ego_dir = DVec2::from_angle(ego_route.start_heading_rad);
+    let mut taken: Vec<DVec2> = vehicles.iter().map(|v| v.route.start).collect();
+    taken.push(ego_start);
+    let mut out = Vec::with_capacity(count as usize);
+    for k in 0..count {
+        let candidates_for = |same_way: bool, taken: &[DVec2]| -> Vec<&SpawnPoint> {
+            town.spawn_points
+                .iter()
+                .filter(|sp| {
+                    let d = sp.pos - ego_start;
+                    let ahead =
+                        d.dot(ego_dir) > 0.7 * d.length() && DVec2::from_angle(sp.heading_rad).dot(ego_dir) > 0.7;
+                    let range = if same_way { 15.0..80.0 } else { 15.0..120.0 };
+                    range.contains(&d.length())
+                        && (!same_way || ahead)
+                        && clear_of_road_pedestrians(sp, peds)
+                        && taken.iter().all(|t| t.distance(sp.pos) >= CYCLIST_SPACING_M)
+                })
+                .collect()
+        };
+        let mut candidates = if k % 2 == 0 {
+            candidates_for(true, &taken)
+        } else {
+            Vec::new()
+        };
+        if candidates.is_empty() {
+            candidates = candidates_for(false, &taken);
+        }
+        for _ in 0..PLACEMENT_ATTEMPTS.min(candidates.len() * 2) {
+            let sp = candidates[rng.random_range(0..candidates.len())];
+            let Some(route) = route_from_spawn(net, sp, needed_m, &mut rng) else {
+                continue;
+            };
+            taken.push(sp.pos);
+            let id = out.len() as u32;
+            out.push(CyclistScript {
+                id,
+                route,
+                speed_mps: draw(&mut rng, c.speed_mps),
+                edge_offset_m: c.edge_offset_m,
+                ignores_lights: rng.random_bool(c.ignore_lights_probability.clamp(0.0, 1.0)),
+                rider: identity::rider_identity(clip_seed, id),
+                bike_rgb: BIKE_COLOURS[rng.random_range(0..BIKE_COLOURS.len())],
+            });
+            break;
+        }
+    }
+    out
 }
 
 fn wrap_angle(a: f64) -> f64 {

@@ -8,8 +8,8 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::dsl::types::{
-    Body, GapAcceptance, Gestures, Idm, Lookahead, Patience, Range, Retreat, Rgb, Signals, Spec, SpeedProfiles, Split,
-    Visibility, WeatherParams,
+    Body, Cyclists, GapAcceptance, Gestures, Idm, Lookahead, Patience, Range, Retreat, Rgb, Signals, Spec,
+    SpeedProfiles, Split, Visibility, WeatherParams,
 };
 
 /// Version of the plan format.
@@ -73,6 +73,10 @@ pub struct SimParams {
     /// Traffic lights (absent when they do not run, and then absent from the plan file).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub signals: Option<Signals>,
+    /// Cyclists' riding and overtaking parameters (absent when no clip has cyclists, and then absent from the
+    /// plan file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cyclists: Option<Cyclists>,
 }
 
 impl SimParams {
@@ -90,6 +94,7 @@ impl SimParams {
             visibility: spec.annotations.visibility.clone(),
             gestures: spec.pedestrians.gestures.clone(),
             signals: spec.traffic.signals.enabled.then(|| spec.traffic.signals.clone()),
+            cyclists: (spec.traffic.cyclists.per_clip.max() > 0).then(|| spec.traffic.cyclists.clone()),
         }
     }
 }
@@ -119,6 +124,9 @@ pub struct ClipScript {
     pub vehicles: Vec<VehicleScript>,
     /// Pedestrians.
     pub pedestrians: Vec<PedestrianScript>,
+    /// Cyclists (`traffic.cyclists`; absent from the plan file when there are none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cyclists: Vec<CyclistScript>,
     /// How much the clip was lengthened beyond its drawn duration so that its crossers' timelines fit, seconds.
     pub timeline_extension_s: f64,
 }
@@ -255,6 +263,25 @@ pub struct VehicleScript {
     /// An emergency vehicle with lights and siren on (`traffic.emergency`): others stop for it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub emergency: Option<EmergencyKind>,
+}
+
+/// One cyclist: a bicycle and its rider.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CyclistScript {
+    /// Cyclist id within the clip.
+    pub id: u32,
+    /// Route (along driving lanes; the cyclist rides `edge_offset_m` from the lane's right edge).
+    pub route: RouteScript,
+    /// Cruising speed, m/s.
+    pub speed_mps: f64,
+    /// Distance from the right edge of the lane to the bicycle's centre line, metres.
+    pub edge_offset_m: f64,
+    /// Whether it rides through red lights.
+    pub ignores_lights: bool,
+    /// The rider.
+    pub rider: Identity,
+    /// Colour of the bicycle's frame (sRGB).
+    pub bike_rgb: [u8; 3],
 }
 
 /// Role of a pedestrian.

@@ -120,6 +120,10 @@ pub struct SizeEstimate {
     pub total: u64,
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// Dry-run statistics of a plan.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PlanStats {
@@ -172,6 +176,9 @@ pub struct PlanStats {
     /// Clips with an emergency vehicle, per kind (`traffic.emergency`).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub emergency_clips: BTreeMap<String, usize>,
+    /// Cyclists (`traffic.cyclists`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub cyclists: usize,
     /// Pedestrian-frames (every pedestrian in every frame).
     pub pedestrian_frames: u64,
     /// Estimated annotated samples (pedestrian-frames that pass the visibility gate).
@@ -244,6 +251,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
             .map(|p| (p.name().to_owned(), 0))
             .collect(),
         emergency_clips: BTreeMap::new(),
+        cyclists: 0,
         pedestrian_frames: 0,
         estimated_annotated_samples: 0,
         estimated_bytes: SizeEstimate::default(),
@@ -305,6 +313,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
                 None => *stats.driving_profiles.entry(v.profile.name().to_owned()).or_default() += 1,
             }
         }
+        stats.cyclists += clip.cyclists.len();
         in_view.extend(clip.pedestrians.iter().filter_map(|p| p.in_view_before_crossing_s));
         if clip.timeline_extension_s > 0.0 {
             stats.timeline.lengthened_clips += 1;
@@ -530,6 +539,9 @@ impl std::fmt::Display for PlanStats {
                 stats.emergency_clips.values().sum::<usize>(),
                 kinds.join(", ")
             )?;
+        }
+        if stats.cyclists > 0 {
+            writeln!(out, "cyclists              {}", stats.cyclists)?;
         }
         writeln!(
             out,

@@ -24,6 +24,8 @@ pub struct Traffic {
     pub emergency: Emergency,
     /// Traffic lights at the town's signalised junctions.
     pub signals: Signals,
+    /// Cyclists: a third class of road user, riding at the right edge of the driving lanes.
+    pub cyclists: Cyclists,
 }
 
 impl Default for Traffic {
@@ -40,6 +42,48 @@ impl Default for Traffic {
             ego: Ego::default(),
             emergency: Emergency::default(),
             signals: Signals::default(),
+            cyclists: Cyclists::default(),
+        }
+    }
+}
+
+/// Cyclists: a bicycle with its rider, riding on the driving lanes near their right edge through junctions like
+/// the vehicles (Intelligent Driver Model following, stopping at red lights where they run), braking for
+/// pedestrians in their path and swerving around one at the lane's edge. Vehicles follow a cyclist and overtake
+/// it with `overtaking_clearance_m` when the oncoming side is clear; pedestrians check cyclists in their gap
+/// acceptance as they check cars. None by default (the paper's set-up has none).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Cyclists {
+    /// Cyclists per clip, `[min, max]`. Default `[0, 0]`.
+    pub per_clip: CountRange,
+    /// Cruising speed, m/s `[min, max]` drawn per cyclist. Default 3.5–6.5 m/s (12.6–23.4 km/h: pedsynth's
+    /// choice around the 15–20 km/h typical of urban commuting cyclists).
+    pub speed_mps: Range,
+    /// Distance from the right edge of the lane to the bicycle's centre line, metres. Default 0.8 (pedsynth's
+    /// choice: clear of the curb, inside a 3 m lane).
+    pub edge_offset_m: f64,
+    /// Lateral clearance a vehicle keeps when it overtakes a cyclist, metres, side to side. Default 1.5 (the
+    /// minimum passing distance in built-up areas in Germany's StVO § 5 (4) since 2020, France, Spain, ...).
+    pub overtaking_clearance_m: f64,
+    /// How far a cyclist swerves to the left around a pedestrian in its path at the lane's edge, metres (it
+    /// brakes when that is not enough). Default 1.0.
+    pub swerve_m: f64,
+    /// Probability that a cyclist rides through red lights (where traffic lights run). Default 0.07 (Johnson et
+    /// al. 2011, Accident Analysis & Prevention 43(1): 6.9 % of cyclists facing a red light in Melbourne rode
+    /// through it).
+    pub ignore_lights_probability: f64,
+}
+
+impl Default for Cyclists {
+    fn default() -> Self {
+        Cyclists {
+            per_clip: CountRange(0, 0),
+            speed_mps: Range(3.5, 6.5),
+            edge_offset_m: 0.8,
+            overtaking_clearance_m: 1.5,
+            swerve_m: 1.0,
+            ignore_lights_probability: 0.07,
         }
     }
 }

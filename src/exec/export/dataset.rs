@@ -98,6 +98,15 @@ pub struct VehicleFrame {
     pub yaw_rad: f64,
 }
 
+/// A cyclist in view of the camera in one frame: its box of rider and bicycle.
+#[derive(Clone, Copy, Debug)]
+pub struct CyclistBox {
+    pub frame: u32,
+    pub cyclist: u32,
+    /// `[x1, y1, x2, y2]`, pixels.
+    pub bbox: [f64; 4],
+}
+
 /// A clip's row of the `clips` table.
 #[derive(Clone, Debug)]
 pub struct ClipInfo {
@@ -127,6 +136,9 @@ pub struct Clip {
     pub pedestrians: BTreeMap<u32, Pedestrian>,
     /// Sorted by (vehicle, frame).
     pub vehicles: Vec<VehicleFrame>,
+    /// The cyclists' boxes where in view, sorted by (cyclist, frame) (empty without cyclists, or for a dataset
+    /// written before the `cyclists` table existed).
+    pub cyclists: Vec<CyclistBox>,
     /// Every pedestrian's track, by pedestrian id, in frame order (empty for a dataset written before the
     /// `tracks` table existed).
     pub tracks: BTreeMap<u32, Vec<TrackFrame>>,
@@ -283,6 +295,7 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         ego: Vec::new(),
         pedestrians: BTreeMap::new(),
         vehicles: Vec::new(),
+        cyclists: Vec::new(),
         tracks: BTreeMap::new(),
         traffic_lights: Vec::new(),
     };
@@ -433,6 +446,24 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
         }
     }
     clip.vehicles.sort_by_key(|v| (v.vehicle, v.frame));
+    let cyclists = file("cyclists");
+    if cyclists.is_file() {
+        let cols = ["frame", "cyclist", "in_view", "x1", "y1", "x2", "y2"];
+        for b in tables::read(&cyclists, &cols)? {
+            let (frame, cyclist, in_view) = (b.u32s("frame")?, b.u32s("cyclist")?, b.bools("in_view")?);
+            let xy: Vec<_> = cols[3..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            for i in 0..b.rows() {
+                if in_view.value(i) {
+                    clip.cyclists.push(CyclistBox {
+                        frame: frame.value(i),
+                        cyclist: cyclist.value(i),
+                        bbox: std::array::from_fn(|k| f64::from(xy[k].value(i))),
+                    });
+                }
+            }
+        }
+        clip.cyclists.sort_by_key(|c| (c.cyclist, c.frame));
+    }
     let tracks = file("tracks");
     if tracks.is_file() {
         let cols = ["frame", "pedestrian", "x_m", "y_m", "z_m", "yaw_rad"];

@@ -384,6 +384,23 @@ fn write_video(
             let _ = write!(x, "  <track label=\"vehicle\">\n{boxes}  </track>\n");
         }
     }
+    // Cyclists as PIE vehicles of type `bicycle`, with the `cyclists` table's box of rider and bicycle.
+    for track in clip.cyclists.chunk_by(|a, b| a.cyclist == b.cyclist) {
+        let cid = track[0].cyclist;
+        let mut boxes = String::new();
+        for c in track {
+            let b = c.bbox;
+            let _ = writeln!(
+                boxes,
+                "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
+                 xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{prefix}_{cid}b</attribute>\n      \
+                 <attribute name=\"type\">bicycle</attribute>\n    </box>",
+                c.frame, b[0], b[1], b[2], b[3],
+            );
+        }
+        vehicle_tracks += 1;
+        let _ = write!(x, "  <track label=\"vehicle\">\n{boxes}  </track>\n");
+    }
     // Crosswalks of the town near the ego's path, projected like the vehicles: the polygon on the ground.
     if let Some(net) = net {
         for (k, cw) in net.crosswalks.iter().enumerate() {

@@ -14,7 +14,8 @@
 
 use glam::{DVec2, DVec3};
 
-use super::body::{self, BodyPose, CHILD_OFFSET_M};
+use super::body::{self, BodyPose, CHILD_OFFSET_M, Capsule};
+use super::cyclist;
 use super::rig::{Camera, CameraPose};
 use super::scene;
 use crate::dsl::types::{Annotations, BoxSize};
@@ -128,7 +129,39 @@ pub struct ClipAnnotations {
     pub rejections: Rejections,
     /// Crossing label C of every pedestrian (by id) in every frame, annotated or not.
     pub crossing: Vec<Vec<bool>>,
+    /// Every cyclist-frame in front of the camera whose box reaches into the image, ordered by (frame,
+    /// cyclist).
+    pub cyclists: Vec<CyclistRow>,
 }
+
+/// A cyclist seen by the camera in one frame: the box of rider and bicycle, the rider's keypoints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CyclistRow {
+    /// Frame index.
+    pub frame: u32,
+    /// Cyclist id.
+    pub cyclist: u32,
+    /// 2D box of the rider and the bicycle, `[x_min, y_min, x_max, y_max]`, pixels, clipped to the image.
+    pub bbox_px: [f32; 4],
+    /// Whether the box was cut by the image's border.
+    pub truncated: bool,
+    /// Ground distance from the ego vehicle, metres.
+    pub distance_m: f32,
+    /// Share of the rider's sample points (17 joints, 5 body samples) hidden from the camera.
+    pub occlusion: f32,
+    /// Whether it passes the pedestrians' visibility gate (distance, minimum box size, inside the image when
+    /// required, occlusion).
+    pub annotated: bool,
+    /// The rider's COCO-17 keypoints `(u, v, flag)` (flag 2 visible, 1 occluded, 0 outside the image).
+    pub keypoints: [f32; 51],
+    /// The rider's joints in the world, `(x, y, z)` metres.
+    pub keypoints_3d: [f32; 51],
+}
+
+/// Occluder owner ids of cyclists' riders start here (pedestrians own their ids).
+const RIDER_OWNER_BASE: u32 = 1 << 31;
+/// Radius of the cylinder standing in for a cyclist when testing occlusion, metres.
+const RIDER_OCCLUDER_RADIUS_M: f64 = 0.3;
 
 /// Per-frame crossing labels of one pedestrian: raw (state ∧ driving lane), then smoothed.
 pub fn crossing_labels(frames: &[PedFrame], smoothing_frames: u32) -> Vec<bool> {
@@ -243,11 +276,16 @@ fn sphere_interval(lateral: f64, depth: f64, r: f64, focal: f64, principal: f64)
 /// of the projections, so the box is the union of the end spheres' exact image intervals.
 /// Returns None if any part of the body is within 5 cm of the camera plane or behind it.
 pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
+    project_capsules_box(&pose.capsules, cam)
+}
+
+/// [`project_box`] of any set of capsules (a cyclist: its rider and its bicycle).
+pub fn project_capsules_box<'a>(capsules: impl IntoIterator<Item = &'a Capsule>, cam: &CameraPose) -> Option<[f64; 4]> {
     let c = &cam.camera;
     let (cx, cy) = (f64::from(c.width_px) * 0.5, f64::from(c.height_px) * 0.5);
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
-    for cap in &pose.capsules {
+    for cap in capsules {
         for centre in [cap.a, cap.b] {
             let p = cam.optical_from_world.transform_point3(centre);
             if p.z - cap.radius_m <= 0.05 {
@@ -317,6 +355,9 @@ pub fn annotate(
         .chain(std::iter::repeat((1.75, None)))
         .take(n_peds)
         .collect();
+    let rider_heights: Vec<f64> = (0..trace.cyclists.len())
+        .map(|k| script.cyclists.get(k).map_or(1.75, |c| c.rider.height_m))
+        .collect();
     let labels: Vec<Vec<bool>> = trace
         .pedestrians
         .iter()
@@ -331,6 +372,7 @@ pub fn annotate(
         pedestrians: vec![PedestrianLabels::default(); n_peds],
         rejections: Rejections::default(),
         crossing: Vec::new(),
+        cyclists: Vec::new(),
     };
     for (i, p) in out.pedestrians.iter_mut().enumerate() {
         p.first_crossing_frame = first_crossing[i];
@@ -379,6 +421,91 @@ pub fn annotate(
                     owner: u32::MAX,
                 });
             }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            if let Some(f) = frames.get(frame) {
+                occluders.push(Occluder::Person {
+                    ground: f.pos,
+                    radius_m: RIDER_OCCLUDER_RADIUS_M,
+                    height_m: rider_heights[ci],
+                    owner: RIDER_OWNER_BASE + ci as u32,
+                });
+            }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            let Some(f) = frames.get(frame) else { continue };
+            let distance = (f.pos - ego.pos).truncate().length();
+            if (f.pos - cam.centre).dot(cam.forward) <= 0.0 {
+                continue;
+            }
+            let rider = cyclist::rider_pose(f, rider_heights[ci]);
+            let bike = cyclist::bicycle(f, rider_heights[ci]);
+            let Some(bbox) = project_capsules_box(rider.capsules.iter().chain(&bike), &cam) else {
+                continue;
+            };
+            let clipped = [
+                bbox[0].clamp(0.0, width),
+                bbox[1].clamp(0.0, height),
+                bbox[2].clamp(0.0, width),
+                bbox[3].clamp(0.0, height),
+            ];
+            if clipped[2] <= clipped[0] || clipped[3] <= clipped[1] {
+                continue;
+            }
+            let truncated = clipped != bbox;
+            let ground = f.pos.truncate();
+            near.clear();
+            near.extend(occluders.iter().filter(|occ| {
+                !matches!(occ, Occluder::Person { owner, .. } if *owner == RIDER_OWNER_BASE + ci as u32)
+                    && may_block(occ, cam.centre.truncate(), ground, 1.5)
+            }));
+            let samples = [
+                rider.capsules[0].a,
+                rider.capsules[0].b,
+                rider.capsules[2].a,
+                (rider.capsules[7].a + rider.capsules[7].b) * 0.5,
+                (rider.capsules[8].a + rider.capsules[8].b) * 0.5,
+            ];
+            let mut keypoints = [0f32; 51];
+            let mut keypoints_3d = [0f32; 51];
+            let mut hidden = 0u32;
+            for (k, joint) in rider.joints.iter().enumerate() {
+                let p = cam.project(*joint);
+                let flag = if p.depth_m <= 0.05 || !cam.in_image(p.px) {
+                    0.0
+                } else if occluded(town, &near, cam.centre, *joint) {
+                    hidden += 1;
+                    1.0
+                } else {
+                    2.0
+                };
+                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
+                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
+            }
+            for sample in samples {
+                hidden += u32::from(occluded(town, &near, cam.centre, sample));
+            }
+            let occlusion = f64::from(hidden) / (rider.joints.len() + samples.len()) as f64;
+            let min = if distance > gate.far_distance_m {
+                gate.min_box_far_px
+            } else {
+                gate.min_box_px
+            };
+            let annotated = distance <= gate.max_distance_m
+                && !too_small(bbox[2] - bbox[0], bbox[3] - bbox[1], min)
+                && !(gate.require_inside_image && truncated)
+                && occlusion <= gate.max_occlusion;
+            out.cyclists.push(CyclistRow {
+                frame: frame as u32,
+                cyclist: ci as u32,
+                bbox_px: clipped.map(|x| x as f32),
+                truncated,
+                distance_m: distance as f32,
+                occlusion: occlusion as f32,
+                annotated,
+                keypoints,
+                keypoints_3d,
+            });
         }
         for (id, ped) in trace.pedestrians.iter().enumerate() {
             let f = &ped[frame];

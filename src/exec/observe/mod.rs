@@ -2,6 +2,7 @@
 //!
 //! - [`rig`] — the ego's sensor rig: mounts and intrinsics from the spec (the pinhole camera).
 //! - [`body`] — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
+//! - [`cyclist`] — a cyclist's rider (riding pose, same joints) and bicycle.
 //! - [`annotate`] — visibility gate, boxes, keypoints, occlusion and crossing labels.
 //! - [`scene`] — the renderable geometry of a frame (one source for cameras and LiDAR).
 //! - [`camera`] — RGB, depth, semantic, instance and DVS, rendered on the CPU.
@@ -13,6 +14,7 @@
 pub mod annotate;
 pub mod body;
 pub mod camera;
+pub mod cyclist;
 pub mod lidar;
 pub mod rig;
 pub mod scene;

@@ -20,6 +20,7 @@ use std::ops::Range;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::body::{self, CAPSULES, CHILD_OFFSET_M};
+use super::cyclist;
 use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::{ClipTrace, LightState, PedFrame, VehicleFrame};
 use crate::mix::splitmix64;
@@ -48,6 +49,10 @@ pub mod tag {
     pub const SKY: u8 = 11;
     /// Pedestrians.
     pub const PEDESTRIAN: u8 = 12;
+    /// A cyclist's rider.
+    pub const RIDER: u8 = 13;
+    /// Bicycles.
+    pub const BICYCLE: u8 = 19;
     /// Cars.
     pub const CAR: u8 = 14;
     /// Lane markings and crosswalk stripes.
@@ -122,10 +127,13 @@ pub mod tag {
 
 /// Instance ids of the `instance` stream (16-bit): 0 for static scenery and sky, `1 + pedestrian` for a
 /// pedestrian (its id in the tables), [`CHILD_INSTANCE_BASE`]` + parent` for the child walking beside a parent,
-/// [`VEHICLE_INSTANCE_BASE`]` + vehicle` for a traffic vehicle (its id in the `vehicles` table).
+/// [`VEHICLE_INSTANCE_BASE`]` + vehicle` for a traffic vehicle (its id in the `vehicles` table),
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist.
 pub const CHILD_INSTANCE_BASE: u16 = 16_384;
 /// See [`CHILD_INSTANCE_BASE`].
 pub const VEHICLE_INSTANCE_BASE: u16 = 32_768;
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist (rider and bicycle; its id in the `cyclists` table).
+pub const CYCLIST_INSTANCE_BASE: u16 = 49_152;
 
 /// The instance id of pedestrian `id`.
 pub fn pedestrian_instance(id: u32) -> u16 {
@@ -133,11 +141,12 @@ pub fn pedestrian_instance(id: u32) -> u16 {
 }
 
 /// The actor an instance id belongs to, as the tables number it: the pedestrian id (for a pedestrian and the
-/// child walking with it) or the vehicle id; `None` for the static scene. Undoes [`pedestrian_instance`],
-/// [`CHILD_INSTANCE_BASE`] and [`VEHICLE_INSTANCE_BASE`].
+/// child walking with it), the vehicle id or the cyclist id; `None` for the static scene. Undoes
+/// [`pedestrian_instance`], [`CHILD_INSTANCE_BASE`], [`VEHICLE_INSTANCE_BASE`] and [`CYCLIST_INSTANCE_BASE`].
 pub fn actor_of_instance(instance: u16) -> Option<u32> {
     match instance {
         0 => None,
+        i if i >= CYCLIST_INSTANCE_BASE => Some(u32::from(i - CYCLIST_INSTANCE_BASE)),
         i if i >= VEHICLE_INSTANCE_BASE => Some(u32::from(i - VEHICLE_INSTANCE_BASE)),
         i if i >= CHILD_INSTANCE_BASE => Some(u32::from(i - CHILD_INSTANCE_BASE)),
         i => Some(u32::from(i) - 1),
@@ -296,6 +305,8 @@ pub struct StaticScene {
     pub seed: u64,
     /// What each pedestrian (and the child beside it) wears, by pedestrian index: worked out once per clip.
     pub outfits: Vec<(Outfit, Option<Outfit>)>,
+    /// Per cyclist: its rider's outfit and its bicycle's frame colour (linear RGB).
+    pub riders: Vec<(Outfit, Vec3)>,
     /// Each traffic vehicle's paint (linear RGB), by vehicle index.
     pub car_paint: Vec<Vec3>,
 }
@@ -923,6 +934,16 @@ impl StaticScene {
             lamps,
             signal_heads,
             seed,
+            riders: script
+                .cyclists
+                .iter()
+                .map(|c| {
+                    (
+                        Outfit::of(&c.rider, seed, u64::from(c.id) | 1 << 41),
+                        linear(c.bike_rgb),
+                    )
+                })
+                .collect(),
             outfits: script
                 .pedestrians
                 .iter()
@@ -1052,8 +1073,13 @@ pub struct FrameScene {
 
 /// Linear interpolation of two vehicle frames (the DVS's sub-frame renders).
 fn lerp_vehicle(a: &VehicleFrame, b: &VehicleFrame, t: f64) -> (DVec3, f64) {
-    let dyaw = (b.yaw_rad - a.yaw_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    (a.pos.lerp(b.pos, t), a.yaw_rad + dyaw * t)
+    lerp_pose(a.pos, a.yaw_rad, b.pos, b.yaw_rad, t)
+}
+
+/// Linear interpolation of two poses (position, yaw the short way round).
+fn lerp_pose(a: DVec3, a_yaw: f64, b: DVec3, b_yaw: f64, t: f64) -> (DVec3, f64) {
+    let dyaw = (b_yaw - a_yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    (a.lerp(b, t), a_yaw + dyaw * t)
 }
 
 /// Linear interpolation of two pedestrian frames (state and flags of the nearer one).
@@ -1221,12 +1247,63 @@ impl FrameScene {
                 continue;
             };
             let pose = body::pose(&frame, ps.identity.height_m, DVec3::ZERO);
-            self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id));
+            self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id), tag::PEDESTRIAN);
             if let (Some(child), Some(child_outfit)) = (&ps.child, child_outfit) {
                 let child_frame = PedFrame { gesture: None, ..frame };
                 let pose = body::pose(&child_frame, child.height_m, CHILD_OFFSET_M);
                 let inst = CHILD_INSTANCE_BASE.saturating_add(ps.id.min(16_383) as u16);
-                self.push_body(stat, &pose, child_outfit, inst);
+                self.push_body(stat, &pose, child_outfit, inst, tag::PEDESTRIAN);
+            }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            let (Some(a), Some(cs), Some((outfit, paint))) =
+                (frames.get(f0), script.cyclists.get(ci), stat.riders.get(ci))
+            else {
+                continue;
+            };
+            let b = frames.get(f0 + 1).unwrap_or(a);
+            let mut frame = *a;
+            if t.alpha > 0.0 {
+                let (pos, yaw) = lerp_pose(a.pos, a.yaw_rad, b.pos, b.yaw_rad, t.alpha);
+                frame.pos = pos;
+                frame.yaw_rad = yaw;
+                frame.ridden_m = a.ridden_m + (b.ridden_m - a.ridden_m) * t.alpha;
+                let mut dp = b.crank_phase - a.crank_phase;
+                dp -= dp.round();
+                frame.crank_phase = (a.crank_phase + dp * t.alpha).rem_euclid(1.0);
+            }
+            let instance = CYCLIST_INSTANCE_BASE.saturating_add(cs.id.min(16_383) as u16);
+            let rider = cyclist::rider_pose(&frame, cs.rider.height_m);
+            self.push_body(stat, &rider, outfit, instance, tag::RIDER);
+            let tyre = linear([22, 22, 22]);
+            let metal = linear([150, 150, 152]);
+            let forward = {
+                let (s, c) = (frame.yaw_rad as f32).sin_cos();
+                Vec3::new(c, s, 0.0)
+            };
+            for (k, cap) in cyclist::bicycle(&frame, cs.rider.height_m).iter().enumerate() {
+                // Frame tubes in the bicycle's colour; handlebar, saddle and cranks dark metal; wheels black.
+                let albedo = match k {
+                    0..=6 => *paint,
+                    7 | 9 | 10 => metal * 0.4,
+                    _ => tyre,
+                };
+                let sc = SceneCapsule {
+                    a: stat.rel(cap.a),
+                    b: stat.rel(cap.b),
+                    radius_m: cap.radius_m as f32,
+                };
+                self.capsules.push(sc);
+                let prim = self.mesh.prim(Prim {
+                    material: Material::Body,
+                    tag: tag::BICYCLE,
+                    instance,
+                    albedo,
+                    albedo2: albedo,
+                    normal: forward,
+                    aux: (self.capsules.len() - 1) as u32,
+                });
+                self.mesh.capsule(&sc, prim);
             }
         }
     }
@@ -1311,7 +1388,7 @@ impl FrameScene {
         ));
     }
 
-    fn push_body(&mut self, stat: &StaticScene, pose: &body::BodyPose, outfit: &Outfit, instance: u16) {
+    fn push_body(&mut self, stat: &StaticScene, pose: &body::BodyPose, outfit: &Outfit, instance: u16, tag: u8) {
         let forward = {
             let (s, c) = (pose.yaw_rad as f32).sin_cos();
             Vec3::new(c, s, 0.0)
@@ -1325,7 +1402,7 @@ impl FrameScene {
             self.capsules.push(sc);
             let prim = self.mesh.prim(Prim {
                 material,
-                tag: tag::PEDESTRIAN,
+                tag,
                 instance,
                 albedo,
                 albedo2: outfit.hair,
@@ -1354,6 +1431,7 @@ mod tests {
         assert_eq!(actor_of_instance(pedestrian_instance(7)), Some(7));
         assert_eq!(actor_of_instance(CHILD_INSTANCE_BASE + 7), Some(7));
         assert_eq!(actor_of_instance(VEHICLE_INSTANCE_BASE + 3), Some(3));
+        assert_eq!(actor_of_instance(CYCLIST_INSTANCE_BASE + 2), Some(2));
     }
 
     #[test]

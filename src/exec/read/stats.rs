@@ -120,6 +120,28 @@ pub struct DatasetStats {
     pub against_signal_samples: u64,
     /// Annotated samples on a crosswalk.
     pub on_crosswalk_samples: u64,
+    /// Cyclists (over all clips).
+    pub cyclists: u64,
+    /// Cyclist-frames whose box reaches into the image.
+    pub cyclist_frames_in_view: u64,
+    /// Cyclist-frames passing the visibility gate.
+    pub cyclist_samples: u64,
+    /// Overtakes of a cyclist by a vehicle (the ego or traffic).
+    pub cyclist_overtakes: u64,
+    /// The smallest side-to-side clearance of any overtake, metres (`None` without overtakes).
+    pub min_overtaking_clearance_m: Option<f64>,
+    /// Cyclists swerving around a pedestrian (per cyclist and pedestrian).
+    pub cyclist_swerves: u64,
+    /// Cyclists braking for a pedestrian (per cyclist and pedestrian).
+    pub cyclist_brakes_for_pedestrians: u64,
+    /// In-road conflicts of crossing pedestrians with a cyclist.
+    pub pedestrian_cyclist_conflicts: u64,
+    /// Contacts involving a cyclist.
+    pub cyclist_contacts: u64,
+    /// Red lights cyclists stopped for.
+    pub cyclist_red_lights_stopped_for: u64,
+    /// Red lights cyclists rode through.
+    pub cyclist_red_light_runs: u64,
 }
 
 /// Computes the statistics of the dataset in `dir` from its tables.
@@ -227,17 +249,44 @@ pub fn compute(dir: &Path) -> Result<DatasetStats, Error> {
                 }
             }
         }
-        for b in tables::read(&layout.table("events", &clip_id), &["kind", "unavoidable"])? {
+        for b in tables::read(
+            &layout.table("events", &clip_id),
+            &["kind", "unavoidable", "cyclist", "min_clearance_m", "swerved"],
+        )? {
             let (kind, unavoidable) = (b.strings("kind")?, b.bools("unavoidable")?);
+            let (cyclist, clearance, swerved) = (b.u32s("cyclist")?, b.f32s("min_clearance_m")?, b.bools("swerved")?);
             for (i, kind) in kind.iter().enumerate() {
+                let by_cyclist = arrow_array::Array::is_valid(cyclist, i);
                 match *kind {
+                    "stopped_at_red_light" if by_cyclist => s.cyclist_red_lights_stopped_for += 1,
+                    "ran_red_light" if by_cyclist => s.cyclist_red_light_runs += 1,
                     "stopped_at_red_light" => s.red_lights_stopped_for += 1,
                     "ran_red_light" if unavoidable.value(i) => s.red_lights_run_unavoidably += 1,
                     "ran_red_light" => s.red_light_violations += 1,
+                    "overtook_cyclist" => {
+                        s.cyclist_overtakes += 1;
+                        let c = f64::from(clearance.value(i));
+                        s.min_overtaking_clearance_m = Some(s.min_overtaking_clearance_m.map_or(c, |m| m.min(c)));
+                    }
+                    "cyclist_yielded" if swerved.value(i) => s.cyclist_swerves += 1,
+                    "cyclist_yielded" => s.cyclist_brakes_for_pedestrians += 1,
+                    "conflict" if by_cyclist => s.pedestrian_cyclist_conflicts += 1,
+                    "contact" if by_cyclist => s.cyclist_contacts += 1,
                     _ => {}
                 }
             }
         }
+        let mut cyclist_ids = std::collections::BTreeSet::new();
+        for b in tables::read(
+            &layout.table("cyclists", &clip_id),
+            &["cyclist", "in_view", "annotated"],
+        )? {
+            let (ids, in_view, annotated) = (b.u32s("cyclist")?, b.bools("in_view")?, b.bools("annotated")?);
+            cyclist_ids.extend(ids.values().iter().copied());
+            s.cyclist_frames_in_view += in_view.true_count() as u64;
+            s.cyclist_samples += annotated.true_count() as u64;
+        }
+        s.cyclists += cyclist_ids.len() as u64;
         let mut gestured = std::collections::BTreeSet::new();
         let mut at_signals = std::collections::BTreeSet::new();
         for b in tables::read(
@@ -446,6 +495,27 @@ impl std::fmt::Display for DatasetStats {
                 s.red_light_violations,
                 s.red_lights_run_unavoidably,
                 100.0 * c
+            )?;
+        }
+        if s.cyclists > 0 {
+            writeln!(
+                o,
+                "cyclists                     {} ({} frames in view, {} samples passing the gate)",
+                s.cyclists, s.cyclist_frames_in_view, s.cyclist_samples
+            )?;
+            let clearance = s
+                .min_overtaking_clearance_m
+                .map_or_else(String::new, |c| format!(", smallest clearance {c:.2} m"));
+            writeln!(o, "  overtaken by vehicles      {}{clearance}", s.cyclist_overtakes)?;
+            writeln!(
+                o,
+                "  yielding to pedestrians    {} swerves, {} brakings; {} pedestrian conflicts with cyclists",
+                s.cyclist_swerves, s.cyclist_brakes_for_pedestrians, s.pedestrian_cyclist_conflicts
+            )?;
+            writeln!(
+                o,
+                "  contacts, red lights       {} contacts; {} red lights stopped for, {} ridden through",
+                s.cyclist_contacts, s.cyclist_red_lights_stopped_for, s.cyclist_red_light_runs
             )?;
         }
         if s.pedestrians_at_signals > 0 {

@@ -6,8 +6,10 @@
 use glam::DVec2;
 
 use super::pedestrian::Ped;
-use super::vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, Vehicle};
-use super::{PED_RADIUS_M, VEHICLE_LENGTH_M, ttc};
+use super::vehicle::Vehicle;
+#[cfg(test)]
+use super::vehicle::{HALF_LENGTH_M, HALF_WIDTH_M};
+use super::{PED_RADIUS_M, ttc};
 use crate::exec::trace::Event;
 
 /// Cheap pre-check: a pedestrian farther than this from a vehicle centre beyond half its length and the
@@ -49,10 +51,15 @@ impl Contacts {
         let (np, nv) = (self.pedestrians, self.vehicles);
         for (vi, v) in vehicles.iter_mut().enumerate() {
             for (pi, p) in peds.iter_mut().enumerate() {
-                let reach = HALF_LENGTH_M + PED_RADIUS_M + PED_PRECHECK_MARGIN_M;
+                let reach = v.half_length_m + PED_RADIUS_M + PED_PRECHECK_MARGIN_M;
                 let touching = v.pose.pos.distance_squared(p.body.pos) < reach.powi(2)
-                    && ttc::distance_to_box_m(p.body.pos, v.pose.pos, v.pose.heading_rad, HALF_LENGTH_M, HALF_WIDTH_M)
-                        < PED_RADIUS_M;
+                    && ttc::distance_to_box_m(
+                        p.body.pos,
+                        v.pose.pos,
+                        v.pose.heading_rad,
+                        v.half_length_m,
+                        v.half_width_m,
+                    ) < PED_RADIUS_M;
                 let flag = &mut self.ped_vehicle[vi * np + pi];
                 if touching {
                     if !*flag {
@@ -63,7 +70,7 @@ impl Contacts {
                             other_vehicle: None,
                         });
                     }
-                    p.body.pos = push_out_of_box(p.body.pos, v.pose.pos, v.pose.heading_rad);
+                    p.body.pos = push_out_of_box(p.body.pos, v.pose.pos, v.pose.heading_rad, v.half_extents());
                     v.speed_mps = 0.0;
                 }
                 *flag = touching;
@@ -72,9 +79,12 @@ impl Contacts {
         for a in 0..nv {
             for b in a + 1..nv {
                 let (va, vb) = (&vehicles[a], &vehicles[b]);
-                let reach = VEHICLE_LENGTH_M + VEHICLE_PRECHECK_MARGIN_M;
+                let reach = (va.half_length_m + vb.half_length_m) + VEHICLE_PRECHECK_MARGIN_M;
                 let touching = va.pose.pos.distance_squared(vb.pose.pos) < reach.powi(2)
-                    && boxes_overlap(va.pose.pos, va.pose.dir, vb.pose.pos, vb.pose.dir);
+                    && boxes_overlap(
+                        (va.pose.pos, va.pose.dir, va.half_extents()),
+                        (vb.pose.pos, vb.pose.dir, vb.half_extents()),
+                    );
                 let flag = &mut self.vehicle_vehicle[a * nv + b];
                 if touching {
                     if !*flag {
@@ -88,11 +98,12 @@ impl Contacts {
                     // The one behind (the other is ahead along its heading) backs off and stops.
                     let a_behind = (vb.pose.pos - va.pose.pos).dot(va.pose.dir) > 0.0;
                     let (back, other) = if a_behind { (a, b) } else { (b, a) };
-                    let (op, oh) = (vehicles[other].pose.pos, vehicles[other].pose.dir);
+                    let o = &vehicles[other];
+                    let fixed = (o.pose.pos, o.pose.dir, o.half_extents());
                     for _ in 0..BACK_OFF_MAX_STEPS {
                         let v = &mut vehicles[back];
                         v.back_off_and_stop(BACK_OFF_STEP_M);
-                        if !boxes_overlap(v.pose.pos, v.pose.dir, op, oh) || v.s_m <= 0.0 {
+                        if !boxes_overlap((v.pose.pos, v.pose.dir, v.half_extents()), fixed) || v.s_m <= 0.0 {
                             break;
                         }
                     }
@@ -103,39 +114,40 @@ impl Contacts {
     }
 }
 
-/// Moves a pedestrian disc at `p` out of a vehicle footprint, to just beyond its radius.
-fn push_out_of_box(p: DVec2, centre: DVec2, heading_rad: f64) -> DVec2 {
+/// Moves a pedestrian disc at `p` out of a vehicle footprint (half extents `half`: along, across), to just
+/// beyond its radius.
+fn push_out_of_box(p: DVec2, centre: DVec2, heading_rad: f64, half: DVec2) -> DVec2 {
     let (s, c) = heading_rad.sin_cos();
     let d = p - centre;
     let local = DVec2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
     let r = PED_RADIUS_M + PUSH_OUT_CLEARANCE_M;
-    let clamped = DVec2::new(
-        local.x.clamp(-HALF_LENGTH_M, HALF_LENGTH_M),
-        local.y.clamp(-HALF_WIDTH_M, HALF_WIDTH_M),
-    );
+    let clamped = DVec2::new(local.x.clamp(-half.x, half.x), local.y.clamp(-half.y, half.y));
     let out = if clamped != local {
         // Outside the box but within the radius: push along the normal.
         clamped + (local - clamped).normalize_or(DVec2::Y) * r
     } else {
         // Inside: leave through the nearest side.
-        let dx = HALF_LENGTH_M - local.x.abs();
-        let dy = HALF_WIDTH_M - local.y.abs();
+        let dx = half.x - local.x.abs();
+        let dy = half.y - local.y.abs();
         if dy <= dx {
-            DVec2::new(local.x, local.y.signum() * (HALF_WIDTH_M + r))
+            DVec2::new(local.x, local.y.signum() * (half.y + r))
         } else {
-            DVec2::new(local.x.signum() * (HALF_LENGTH_M + r), local.y)
+            DVec2::new(local.x.signum() * (half.x + r), local.y)
         }
     };
     centre + DVec2::new(out.x * c - out.y * s, out.x * s + out.y * c)
 }
 
-/// Whether two vehicle footprints (centre, unit heading) overlap (separating axis test).
-pub(crate) fn boxes_overlap(ca: DVec2, ua: DVec2, cb: DVec2, ub: DVec2) -> bool {
+/// A vehicle footprint: centre, unit heading, half extents (along, across).
+type Footprint = (DVec2, DVec2, DVec2);
+
+/// Whether two vehicle footprints overlap (separating axis test).
+pub(crate) fn boxes_overlap((ca, ua, ha): Footprint, (cb, ub, hb): Footprint) -> bool {
     let axes = [ua, ua.perp(), ub, ub.perp()];
     let d = cb - ca;
     axes.iter().all(|&ax| {
-        let ra = HALF_LENGTH_M * ua.dot(ax).abs() + HALF_WIDTH_M * ua.perp().dot(ax).abs();
-        let rb = HALF_LENGTH_M * ub.dot(ax).abs() + HALF_WIDTH_M * ub.perp().dot(ax).abs();
+        let ra = ha.x * ua.dot(ax).abs() + ha.y * ua.perp().dot(ax).abs();
+        let rb = hb.x * ub.dot(ax).abs() + hb.y * ub.perp().dot(ax).abs();
         d.dot(ax).abs() <= ra + rb
     })
 }
@@ -146,17 +158,21 @@ mod tests {
 
     #[test]
     fn box_overlap_and_push_out() {
-        assert!(boxes_overlap(DVec2::ZERO, DVec2::X, DVec2::new(4.0, 0.0), DVec2::X));
-        assert!(!boxes_overlap(DVec2::ZERO, DVec2::X, DVec2::new(4.7, 0.0), DVec2::X));
-        assert!(boxes_overlap(
-            DVec2::ZERO,
-            DVec2::X,
-            DVec2::new(3.0, 0.0),
-            DVec2::from_angle(std::f64::consts::FRAC_PI_2)
-        ));
-        let p = push_out_of_box(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0);
+        let car = DVec2::new(HALF_LENGTH_M, HALF_WIDTH_M);
+        let at = |x: f64, angle: f64| (DVec2::new(x, 0.0), DVec2::from_angle(angle), car);
+        assert!(boxes_overlap(at(0.0, 0.0), at(4.0, 0.0)));
+        assert!(!boxes_overlap(at(0.0, 0.0), at(4.7, 0.0)));
+        assert!(boxes_overlap(at(0.0, 0.0), at(3.0, std::f64::consts::FRAC_PI_2)));
+        // A bicycle (1.75 × 0.65 m) beside a car: apart at 1.3 m centre to centre, touching at 1.2 m.
+        let bike = DVec2::new(0.875, 0.325);
+        let beside = |y: f64| (DVec2::new(0.0, y), DVec2::X, bike);
+        assert!(!boxes_overlap(at(0.0, 0.0), beside(1.3)));
+        assert!(boxes_overlap(at(0.0, 0.0), beside(1.2)));
+        let p = push_out_of_box(DVec2::new(1.0, 0.5), DVec2::ZERO, 0.0, car);
         assert!(ttc::distance_to_box_m(p, DVec2::ZERO, 0.0, HALF_LENGTH_M, HALF_WIDTH_M) >= PED_RADIUS_M);
-        let p = push_out_of_box(DVec2::new(2.5, 0.0), DVec2::ZERO, 1.0);
+        let p = push_out_of_box(DVec2::new(2.5, 0.0), DVec2::ZERO, 1.0, car);
         assert!(ttc::distance_to_box_m(p, DVec2::ZERO, 1.0, HALF_LENGTH_M, HALF_WIDTH_M) >= PED_RADIUS_M);
+        let p = push_out_of_box(DVec2::new(0.2, 0.1), DVec2::ZERO, 0.0, bike);
+        assert!(ttc::distance_to_box_m(p, DVec2::ZERO, 0.0, bike.x, bike.y) >= PED_RADIUS_M);
     }
 }

@@ -32,6 +32,7 @@
 //! runs clips in parallel with rayon and returns them in plan order, identical for any thread count.
 
 mod contacts;
+mod cycling;
 pub(crate) mod pedestrian;
 pub mod signals;
 pub mod ttc;
@@ -43,7 +44,7 @@ use std::collections::BTreeMap;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use crate::exec::trace::{ClipTrace, Event, PedFrame, SignalTrack, VehicleFrame};
+use crate::exec::trace::{ClipTrace, CyclistFrame, Event, PedFrame, SignalTrack, VehicleFrame, VehicleId};
 use crate::planner::{ClipScript, Plan, SimParams, TownContext, seeds};
 use crate::world::RoadNetwork;
 use contacts::Contacts;
@@ -62,6 +63,8 @@ pub const VEHICLE_WIDTH_M: f64 = 1.9;
 pub const VEHICLE_HEIGHT_M: f64 = 1.5;
 /// Radius of a pedestrian's ground disc, metres.
 pub const PED_RADIUS_M: f64 = 0.3;
+/// Crank turns per metre ridden: a 2.1 m wheel circumference and a 2.6 gear ratio (a city bike's middle gear).
+pub const CRANK_TURNS_PER_M: f64 = 1.0 / (2.1 * 2.6);
 
 /// Why a plan could not be simulated.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -110,8 +113,12 @@ struct Sim<'a> {
     /// The traffic lights' plans, where lights run.
     lights: Option<signals::SignalPlans>,
     dt_s: f64,
-    /// The ego first (`VehicleId::Ego`), then traffic in script order.
+    /// The ego first (`VehicleId::Ego`), then traffic in script order, then the cyclists in script order.
     vehicles: Vec<Vehicle>,
+    /// Cyclists' riding and overtaking parameters (where the clip has cyclists).
+    cycling: Option<&'a crate::dsl::types::Cyclists>,
+    /// Which (cyclist, pedestrian, swerved) reactions have been recorded.
+    cyclist_reactions: Vec<(u32, u32, bool)>,
     peds: Vec<Ped>,
     /// Singles and leaders (decide and move first), then followers.
     order: Vec<usize>,
@@ -137,6 +144,7 @@ impl<'a> Sim<'a> {
         let mut vehicles = Vec::with_capacity(script.vehicles.len() + 1);
         vehicles.push(Vehicle::ego(&script.ego, net));
         vehicles.extend(script.vehicles.iter().map(|v| Vehicle::traffic(v, net)));
+        vehicles.extend(script.cyclists.iter().map(|c| Vehicle::cyclist(c, net)));
         let ego_start_s_m = vehicles[0].s_m;
         let mut peds: Vec<Ped> = script
             .pedestrians
@@ -188,8 +196,12 @@ impl<'a> Sim<'a> {
                 }
             }
             vehicles[0].set_stop_lines(signals::stop_lines(&script.ego.route, net));
-            for (v, s) in vehicles[1..].iter_mut().zip(&script.vehicles) {
-                v.set_stop_lines(signals::stop_lines(&s.route, net));
+            let routes = script.vehicles.iter().map(|v| &v.route);
+            for (v, route) in vehicles[1..]
+                .iter_mut()
+                .zip(routes.chain(script.cyclists.iter().map(|c| &c.route)))
+            {
+                v.set_stop_lines(signals::stop_lines(route, net));
             }
         }
         let signal_tracks = if lights.is_some() {
@@ -214,12 +226,16 @@ impl<'a> Sim<'a> {
             ego: Vec::with_capacity(frames),
             vehicles: (0..script.vehicles.len()).map(|_| Vec::with_capacity(frames)).collect(),
             pedestrians: (0..np).map(|_| Vec::with_capacity(frames)).collect(),
+            cyclists: (0..script.cyclists.len()).map(|_| Vec::with_capacity(frames)).collect(),
             events,
             signals: signal_tracks,
         };
+        let cycling = params.cyclists.as_ref().filter(|_| !script.cyclists.is_empty());
         Sim {
             params,
             net,
+            cycling,
+            cyclist_reactions: Vec::new(),
             sirens,
             lights,
             dt_s: 1.0 / f64::from(fps),
@@ -251,7 +267,23 @@ impl<'a> Sim<'a> {
     }
 
     fn record(&mut self) {
+        for v in &self.vehicles {
+            let VehicleId::Cyclist(n) = v.id else { continue };
+            self.trace.cyclists[n as usize].push(CyclistFrame {
+                pos: DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m),
+                yaw_rad: v.pose.heading_rad,
+                speed_mps: v.speed_mps,
+                accel_mps2: v.accel_mps2,
+                crank_phase: (v.odometer_m * CRANK_TURNS_PER_M).fract(),
+                ridden_m: v.odometer_m,
+                swerving: v.swerving_for.is_some(),
+                light: v.light_ahead.map(|(_, state)| state),
+            });
+        }
         for (k, v) in self.vehicles.iter().enumerate() {
+            if v.is_cyclist() {
+                continue;
+            }
             let frame = VehicleFrame {
                 pos: DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m),
                 yaw_rad: v.pose.heading_rad,
@@ -301,7 +333,7 @@ impl<'a> Sim<'a> {
         }
         for v in &mut self.vehicles {
             v.light_ahead = v.stop_lines.get(v.next_stop).and_then(|l| {
-                let gap = l.s_m - (v.s_m + vehicle::HALF_LENGTH_M);
+                let gap = l.s_m - (v.s_m + v.half_length_m);
                 (gap <= vehicle::LIGHT_RANGE_M)
                     .then(|| (gap, plans.state_at(&self.net.signals[l.signal as usize], time_s)))
             });
@@ -334,7 +366,7 @@ impl<'a> Sim<'a> {
                 continue;
             };
             let red = matches!(v.light_ahead, Some((_, signals::LightState::Red)));
-            if v.s_m + vehicle::HALF_LENGTH_M >= line.s_m {
+            if v.s_m + v.half_length_m >= line.s_m {
                 if red {
                     self.trace.events.push(Event::RedLight {
                         frame,
@@ -348,7 +380,7 @@ impl<'a> Sim<'a> {
             } else if red
                 && v.bound_by_light()
                 && v.speed_mps < 0.1
-                && line.s_m - (v.s_m + vehicle::HALF_LENGTH_M) < signals::STOPPED_AT_LINE_M
+                && line.s_m - (v.s_m + v.half_length_m) < signals::STOPPED_AT_LINE_M
                 && v.stopped_at != Some(v.next_stop)
             {
                 v.stopped_at = Some(v.next_stop);
@@ -474,6 +506,9 @@ impl<'a> Sim<'a> {
                 self.vehicles[i].yielding = yielding;
             }
         }
+        if let Some(c) = self.cycling {
+            cycling::decide(&mut self.vehicles, &self.views, c, &self.params.idm);
+        }
         self.accels.clear();
         for i in 0..self.vehicles.len() {
             self.accels.push(vehicle::accel_for(
@@ -491,6 +526,16 @@ impl<'a> Sim<'a> {
             v.integrate(a, self.dt_s);
         }
         self.pass_stop_lines(f + 1);
+        if self.cycling.is_some() {
+            cycling::record(
+                f + 1,
+                &mut self.vehicles,
+                &self.accels,
+                &self.views,
+                &mut self.cyclist_reactions,
+                &mut self.trace.events,
+            );
+        }
         // 7. Contacts.
         self.contacts
             .resolve(f + 1, &mut self.vehicles, &mut self.peds, &mut self.trace.events);

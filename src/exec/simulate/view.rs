@@ -8,6 +8,7 @@
 use glam::DVec3;
 
 use super::vehicle::Vehicle;
+use super::vehicle::{BICYCLE_HEIGHT_M, BICYCLE_LENGTH_M, BICYCLE_WIDTH_M};
 use super::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::dsl::types::Visibility;
 use crate::exec::observe::annotate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px};
@@ -98,9 +99,11 @@ impl ViewProxy {
         }
         let chest = ground + DVec3::Z * (CHEST_SHARE * height_m);
         let d = chest - cam.centre;
-        let half = DVec3::new(VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, VEHICLE_HEIGHT_M) * 0.5;
+        let car = DVec3::new(VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, VEHICLE_HEIGHT_M) * 0.5;
+        let bike = DVec3::new(BICYCLE_LENGTH_M, BICYCLE_WIDTH_M, BICYCLE_HEIGHT_M) * 0.5;
         let blocked_by_vehicle = || {
             vehicles.iter().skip(1).any(|v| {
+                let half = if v.is_cyclist() { bike } else { car };
                 let centre = DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m + half.z);
                 segment_hits_box(cam.centre, d, 1.0, centre, v.pose.heading_rad.sin_cos(), half)
             })

@@ -148,6 +148,10 @@ impl DatasetWriter {
             ),
             ("tracks", tables::tracks_batch(script, trace, ann)),
             ("vehicles", tables::vehicles_batch(script, trace)),
+            (
+                "cyclists",
+                tables::cyclists_batch(script, trace, ann, plan.spec.annotations.pose_format),
+            ),
             ("events", tables::events_batch(script, trace)),
             ("traffic_lights", tables::traffic_lights_batch(script, trace)),
             (

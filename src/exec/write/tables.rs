@@ -26,15 +26,16 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 7;
+pub const SCHEMA_VERSION: u32 = 8;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 10] = [
+pub const TABLES: [&str; 11] = [
     "frames",
     "pedestrians",
     "annotations",
     "tracks",
     "vehicles",
+    "cyclists",
     "events",
     "traffic_lights",
     "sensor_poses",
@@ -655,6 +656,9 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         other: Option<u32>,
         signal: Option<u32>,
         unavoidable: Option<bool>,
+        cyclist: Option<u32>,
+        clearance: Option<f32>,
+        swerved: Option<bool>,
     }
     let rows: Vec<Row> = trace
         .events
@@ -690,6 +694,7 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 kind: "conflict",
                 pedestrian: Some(pedestrian),
                 vehicle: vehicle.traffic(),
+                cyclist: vehicle.cyclist(),
                 in_window: Some(in_retreat_window),
                 retreated: Some(retreated),
                 ..Row::default()
@@ -716,6 +721,7 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 pedestrian,
                 vehicle: vehicle.traffic(),
                 other: other_vehicle.and_then(VehicleId::traffic),
+                cyclist: vehicle.cyclist().or(other_vehicle.and_then(VehicleId::cyclist)),
                 ..Row::default()
             },
             Event::RedLight {
@@ -730,6 +736,33 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                 vehicle: vehicle.traffic(),
                 signal: Some(signal),
                 unavoidable: ran.then_some(unavoidable),
+                cyclist: vehicle.cyclist(),
+                ..Row::default()
+            },
+            Event::OvertookCyclist {
+                frame,
+                vehicle,
+                cyclist,
+                min_clearance_m,
+            } => Row {
+                frame,
+                kind: "overtook_cyclist",
+                vehicle: vehicle.traffic(),
+                cyclist: Some(cyclist),
+                clearance: Some(min_clearance_m as f32),
+                ..Row::default()
+            },
+            Event::CyclistYielded {
+                frame,
+                cyclist,
+                pedestrian,
+                swerved,
+            } => Row {
+                frame,
+                kind: "cyclist_yielded",
+                pedestrian: Some(pedestrian),
+                cyclist: Some(cyclist),
+                swerved: Some(swerved),
                 ..Row::default()
             },
         })
@@ -751,6 +784,9 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             field("other_vehicle", DataType::UInt32, true),
             field("signal", DataType::Utf8, true),
             field("unavoidable", DataType::Boolean, true),
+            field("cyclist", DataType::UInt32, true),
+            field("min_clearance_m", DataType::Float32, true),
+            field("swerved", DataType::Boolean, true),
         ],
         vec![
             utf8(n, &script.clip_id),
@@ -773,6 +809,9 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                     } | Event::RedLight {
                         vehicle: VehicleId::Ego,
                         ..
+                    } | Event::OvertookCyclist {
+                        vehicle: VehicleId::Ego,
+                        ..
                     }
                 ))
             }))),
@@ -788,6 +827,135 @@ pub fn events_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
                     .map(|g| g.id.as_str())
             }))),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.unavoidable))),
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.cyclist))),
+            Arc::new(Float32Array::from_iter(rows.iter().map(|r| r.clearance))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| r.swerved))),
+        ],
+    )
+}
+
+/// The `cyclists` table: one row per cyclist and frame (the 3D state), with the box of rider and bicycle and
+/// the rider's keypoints where the camera sees it (null otherwise).
+pub fn cyclists_batch(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    ann: &ClipAnnotations,
+    format: PoseFormat,
+) -> RecordBatch {
+    let rows: Vec<(u32, u32, &crate::exec::trace::CyclistFrame)> = (0..trace.ego.len())
+        .flat_map(|f| {
+            trace
+                .cyclists
+                .iter()
+                .enumerate()
+                .filter_map(move |(c, frames)| frames.get(f).map(|x| (f as u32, c as u32, x)))
+        })
+        .collect();
+    // Both ordered by (frame, cyclist): walk the seen rows alongside.
+    let mut seen_iter = ann.cyclists.iter().peekable();
+    let seen: Vec<Option<&crate::exec::observe::annotate::CyclistRow>> = rows
+        .iter()
+        .map(|r| {
+            while seen_iter.peek().is_some_and(|s| (s.frame, s.cyclist) < (r.0, r.1)) {
+                seen_iter.next();
+            }
+            seen_iter.next_if(|s| (s.frame, s.cyclist) == (r.0, r.1))
+        })
+        .collect();
+    let n = rows.len();
+    let f32c = |get: fn(&crate::exec::trace::CyclistFrame) -> f64| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(rows.iter().map(|r| get(r.2) as f32)))
+    };
+    let boxc =
+        |k: usize| -> ArrayRef { Arc::new(Float32Array::from_iter(seen.iter().map(|s| s.map(|s| s.bbox_px[k])))) };
+    let script_of = |c: u32| script.cyclists.get(c as usize);
+    let width = 3 * crate::exec::observe::body::joint_count(format);
+    let keypoints = |three_d: bool| -> ArrayRef {
+        let mut builder =
+            FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(n * width), width as i32, n)
+                .with_field(Field::new("item", DataType::Float32, false));
+        let mut buf = Vec::with_capacity(width);
+        for s in &seen {
+            buf.clear();
+            match s {
+                Some(s) => {
+                    let src = if three_d { &s.keypoints_3d } else { &s.keypoints };
+                    crate::exec::observe::body::push_keypoints(src, format, !three_d, &mut buf);
+                }
+                None => buf.resize(width, 0.0),
+            }
+            builder.values().append_slice(&buf);
+            builder.append(s.is_some());
+        }
+        Arc::new(builder.finish())
+    };
+    let kp_type = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), width as i32);
+    batch(
+        vec![
+            field("clip_id", DataType::Utf8, false),
+            field("frame", DataType::UInt32, false),
+            field("cyclist", DataType::UInt32, false),
+            field("class", DataType::Utf8, false),
+            field("x_m", DataType::Float32, false),
+            field("y_m", DataType::Float32, false),
+            field("z_m", DataType::Float32, false),
+            field("yaw_rad", DataType::Float32, false),
+            field("speed_mps", DataType::Float32, false),
+            field("accel_mps2", DataType::Float32, false),
+            field("crank_phase", DataType::Float32, false),
+            field("swerving", DataType::Boolean, false),
+            field("ignores_lights", DataType::Boolean, false),
+            field("light_state", DataType::Utf8, true),
+            field("rider_height_m", DataType::Float32, false),
+            field("in_view", DataType::Boolean, false),
+            field("annotated", DataType::Boolean, false),
+            field("x1", DataType::Float32, true),
+            field("y1", DataType::Float32, true),
+            field("x2", DataType::Float32, true),
+            field("y2", DataType::Float32, true),
+            field("truncated", DataType::Boolean, true),
+            field("distance_m", DataType::Float32, true),
+            field("occlusion", DataType::Float32, true),
+            field("keypoints", kp_type.clone(), true),
+            field("keypoints_3d", kp_type, true),
+        ],
+        vec![
+            utf8(n, &script.clip_id),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.0))),
+            Arc::new(UInt32Array::from_iter_values(rows.iter().map(|r| r.1))),
+            utf8(n, "cyclist"),
+            f32c(|f| f.pos.x),
+            f32c(|f| f.pos.y),
+            f32c(|f| f.pos.z),
+            f32c(|f| f.yaw_rad),
+            f32c(|f| f.speed_mps),
+            f32c(|f| f.accel_mps2),
+            f32c(|f| f.crank_phase),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.2.swerving)))),
+            Arc::new(BooleanArray::from_iter(
+                rows.iter()
+                    .map(|r| Some(script_of(r.1).is_some_and(|c| c.ignores_lights))),
+            )),
+            Arc::new(StringArray::from_iter(
+                rows.iter().map(|r| r.2.light.map(LightState::name)),
+            )),
+            Arc::new(Float32Array::from_iter_values(
+                rows.iter()
+                    .map(|r| script_of(r.1).map_or(0.0, |c| c.rider.height_m) as f32),
+            )),
+            Arc::new(BooleanArray::from_iter(seen.iter().map(|s| Some(s.is_some())))),
+            Arc::new(BooleanArray::from_iter(
+                seen.iter().map(|s| Some(s.is_some_and(|s| s.annotated))),
+            )),
+            boxc(0),
+            boxc(1),
+            boxc(2),
+            boxc(3),
+            Arc::new(BooleanArray::from_iter(seen.iter().map(|s| s.map(|s| s.truncated)))),
+            Arc::new(Float32Array::from_iter(seen.iter().map(|s| s.map(|s| s.distance_m)))),
+            Arc::new(Float32Array::from_iter(seen.iter().map(|s| s.map(|s| s.occlusion)))),
+            keypoints(false),
+            keypoints(true),
         ],
     )
 }

@@ -151,7 +151,7 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings,
         if v.speed_mps < CONFLICT_MIN_VEHICLE_SPEED_MPS {
             // A standing vehicle only matters when it physically blocks the next step.
             let next = pos + dir * params.lookahead.points_m.first().copied().unwrap_or(0.5);
-            if ttc::distance_to_box_m(next, v.pose.pos, v.pose.heading_rad, HALF_LENGTH_M, HALF_WIDTH_M)
+            if ttc::distance_to_box_m(next, v.pose.pos, v.pose.heading_rad, v.half_length_m, v.half_width_m)
                 < PED_RADIUS_M + BLOCKING_CLEARANCE_M
             {
                 percept.conflict_vehicle = Some(v.id);
@@ -163,7 +163,14 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings,
         if v.pose.pos.distance_squared(pos) > reach_m * reach_m {
             continue;
         }
-        if ttc::probes_hit_box(probes, v.pose.pos, v.pose.heading_rad, HALF_LENGTH_M, HALF_WIDTH_M, r) {
+        if ttc::probes_hit_box(
+            probes,
+            v.pose.pos,
+            v.pose.heading_rad,
+            v.half_length_m,
+            v.half_width_m,
+            r,
+        ) {
             percept.conflict_vehicle = Some(v.id);
             break;
         }

@@ -3,7 +3,7 @@
 
 use glam::DVec2;
 
-use super::{HALF_LENGTH_M, Vehicle};
+use super::Vehicle;
 use crate::exec::simulate::VEHICLE_LENGTH_M;
 use crate::world::bounding_box;
 use crate::world::grid::CellGrid;
@@ -144,9 +144,9 @@ fn zones_from_pairs(n: usize, mut pairs: Vec<Vec<(f64, f64)>>) -> Vec<Vec<Confli
 /// the ego, then lower ids). Both vehicles evaluate the same rule, so exactly one of them yields.
 pub(super) fn zone_yield_gap_m(me: &Vehicle, vehicles: &[Vehicle], zone: &ConflictZone, look: f64) -> Option<f64> {
     let other = &vehicles[zone.other];
-    let my_front = me.s_m + HALF_LENGTH_M;
-    let other_front = other.s_m + HALF_LENGTH_M;
-    if me.s_m - HALF_LENGTH_M > zone.me_m.1 || other.s_m - HALF_LENGTH_M > zone.other_m.1 {
+    let my_front = me.s_m + me.half_length_m;
+    let other_front = other.s_m + other.half_length_m;
+    if me.s_m - me.half_length_m > zone.me_m.1 || other.s_m - other.half_length_m > zone.other_m.1 {
         return None; // one of us has passed
     }
     let dist_me = zone.me_m.0 - my_front;

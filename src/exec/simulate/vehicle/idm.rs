@@ -3,14 +3,15 @@
 
 use super::super::signals::LightState;
 use super::conflict_zones::{ConflictZone, zone_yield_gap_m};
-use super::{HALF_LENGTH_M, HALF_WIDTH_M, PedView, Vehicle};
+use super::{PedView, Vehicle};
 use crate::dsl::types::Idm;
-use crate::exec::simulate::{PED_RADIUS_M, VEHICLE_LENGTH_M};
+use crate::exec::simulate::PED_RADIUS_M;
 
 /// Lateral margin of the vehicle corridor beyond half the vehicle width, metres.
 const VEHICLE_CORRIDOR_MARGIN_M: f64 = 0.4;
 /// Lateral margin of the corridor for pedestrians, metres.
 const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
+
 /// The ego stops at least this many metres short of a waiting pedestrian per metre it stands to the side (1.4:
 /// about 35° off the heading, inside the camera's 45° half field of view).
 const COURTESY_STOP_PER_LATERAL: f64 = 1.4;
@@ -82,7 +83,7 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
     }
 
     // End of route: a standing obstacle.
-    let end_gap = me.path.length_m() - me.s_m - HALF_LENGTH_M;
+    let end_gap = me.path.length_m() - me.s_m - me.half_length_m;
     if end_gap < look {
         accel = accel.min(idm_to(end_gap + me.min_gap_m, 0.0));
     }
@@ -92,10 +93,17 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             continue;
         }
         let d = other.pose.pos - me.pose.pos;
-        if d.length_squared() > (look + VEHICLE_LENGTH_M).powi(2) || d.dot(fwd) <= 0.0 {
+        if d.length_squared() > (look + (me.half_length_m + other.half_length_m)).powi(2) || d.dot(fwd) <= 0.0 {
             continue;
         }
-        let Some((gap, lead_speed)) = vehicle_in_path(me, other, look) else {
+        // Moving out to overtake a cyclist: behind it until far enough out to pass with the clearance.
+        let passing = me.overtaking.is_some_and(|(c, _)| c == j);
+        let in_path = if passing && (me.lane_offset_m - me.target_offset_m).abs() > 0.05 {
+            vehicle_in_path_unshifted(me, other, look)
+        } else {
+            vehicle_in_path(me, other, look)
+        };
+        let Some((gap, lead_speed)) = in_path else {
             continue;
         };
         // Mutual intrusion (both in each other's path, e.g. at a junction): the lower id goes first, the ego
@@ -113,12 +121,17 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
     }
 
     let emergency_gap = v * v / (2.0 * idm.max_decel_mps2.max(0.5)) + me.min_gap_m;
+    let ped_margin = if me.is_cyclist() {
+        super::CYCLIST_PED_MARGIN_M
+    } else {
+        PED_CORRIDOR_MARGIN_M
+    };
     for p in peds {
         let d = p.pos - me.pose.pos;
-        if d.length_squared() > (look + HALF_LENGTH_M).powi(2) || d.dot(fwd) <= 0.0 {
+        if d.length_squared() > (look + me.half_length_m).powi(2) || d.dot(fwd) <= 0.0 {
             continue;
         }
-        let mut corridor = HALF_WIDTH_M + PED_RADIUS_M + PED_CORRIDOR_MARGIN_M;
+        let mut corridor = me.half_width_m + PED_RADIUS_M + ped_margin;
         if p.crossing {
             // A crosser walking towards the path counts a second early.
             corridor += p.velocity.length();
@@ -128,13 +141,19 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             Some((_, side)) if p.crossing => corridor.max(side),
             _ => corridor,
         };
-        let Some((s_p, lateral, _)) = me.path.project(p.pos, me.s_m, me.s_m + look + HALF_LENGTH_M, reach) else {
+        let Some((s_p, lateral, _)) = me.path.project(
+            p.pos,
+            me.s_m,
+            me.s_m + look + me.half_length_m,
+            reach + me.lane_offset_m.abs(),
+        ) else {
             continue;
         };
         if s_p <= me.s_m {
             continue;
         }
-        let gap = s_p - me.s_m - HALF_LENGTH_M - PED_RADIUS_M;
+        let lateral = me.corridor_lateral_m(p.pos, s_p, lateral);
+        let gap = s_p - me.s_m - me.half_length_m - PED_RADIUS_M;
         let in_path = lateral < corridor;
         let ego_rule = me
             .ego_brake_m
@@ -170,7 +189,7 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             if p.waiting_at_curb && !c.patience_spent() {
                 // Far enough back that the pedestrian stays in the driver's (and the camera's) view.
                 let stop_short = c.stop_short_m.max(COURTESY_STOP_PER_LATERAL * lateral);
-                let gap = s_p - me.s_m - HALF_LENGTH_M - stop_short;
+                let gap = s_p - me.s_m - me.half_length_m - stop_short;
                 accel = accel.min(idm_to(gap.max(0.0), 0.0));
             }
         }
@@ -186,22 +205,44 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
 /// If `other`'s footprint intrudes on the corridor of `me`'s path ahead within `look` metres: the gap from
 /// `me`'s front bumper to it along the path and its speed along the path.
 fn vehicle_in_path(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64)> {
+    in_corridor(me, other, look, true)
+}
+
+/// [`vehicle_in_path`] with `me`'s corridor on its path's centre line (a cyclist rides there: a vehicle about
+/// to overtake one stays behind it until it has moved out).
+pub(crate) fn vehicle_in_path_unshifted(me: &Vehicle, other: &Vehicle, look: f64) -> Option<(f64, f64)> {
+    in_corridor(me, other, look, false)
+}
+
+fn in_corridor(me: &Vehicle, other: &Vehicle, look: f64, shifted: bool) -> Option<(f64, f64)> {
     // The footprint's lateral extent is at most its half diagonal, so a centre farther than this is clear.
-    let reach = HALF_WIDTH_M + VEHICLE_CORRIDOR_MARGIN_M + HALF_LENGTH_M.hypot(HALF_WIDTH_M) + 1e-6;
-    let (s_o, lateral, path_heading) =
-        me.path
-            .project(other.pose.pos, me.s_m, me.s_m + look + VEHICLE_LENGTH_M, reach)?;
+    let reach = me.half_width_m
+        + VEHICLE_CORRIDOR_MARGIN_M
+        + other.half_length_m.hypot(other.half_width_m)
+        + me.lane_offset_m.abs()
+        + 1e-6;
+    let (s_o, lateral, path_heading) = me.path.project(
+        other.pose.pos,
+        me.s_m,
+        me.s_m + look + (me.half_length_m + other.half_length_m),
+        reach,
+    )?;
     if s_o <= me.s_m {
         return None;
     }
+    let lateral = if shifted {
+        me.corridor_lateral_m(other.pose.pos, s_o, lateral)
+    } else {
+        lateral
+    };
     let delta = other.pose.heading_rad - path_heading;
     let (sd, cd) = (delta.sin().abs(), delta.cos().abs());
-    let extent_lat = HALF_LENGTH_M * sd + HALF_WIDTH_M * cd;
-    let extent_long = HALF_LENGTH_M * cd + HALF_WIDTH_M * sd;
-    if lateral - extent_lat >= HALF_WIDTH_M + VEHICLE_CORRIDOR_MARGIN_M {
+    let extent_lat = other.half_length_m * sd + other.half_width_m * cd;
+    let extent_long = other.half_length_m * cd + other.half_width_m * sd;
+    if lateral - extent_lat >= me.half_width_m + VEHICLE_CORRIDOR_MARGIN_M {
         return None;
     }
-    let gap = s_o - me.s_m - HALF_LENGTH_M - extent_long;
+    let gap = s_o - me.s_m - me.half_length_m - extent_long;
     Some((gap, (other.speed_mps * delta.cos()).max(0.0)))
 }
 

@@ -12,16 +12,16 @@
 
 mod conflict_zones;
 mod idm;
-mod path;
+pub(crate) mod path;
 
 use glam::DVec2;
 
 use super::{VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::exec::trace::VehicleId;
-use crate::planner::{EgoScript, EmergencyKind, VehicleScript};
+use crate::planner::{CyclistScript, EgoScript, EmergencyKind, VehicleScript};
 use crate::world::RoadNetwork;
 pub(crate) use conflict_zones::{ConflictZone, conflict_zones};
-pub(crate) use idm::accel_for;
+pub(crate) use idm::{accel_for, vehicle_in_path_unshifted};
 use path::{PathPose, VehiclePath};
 
 /// The ego's IDM time headway (the ego script has none), seconds.
@@ -40,11 +40,45 @@ pub(crate) const PULL_RIGHT_M: f64 = 0.5;
 /// Sideways metres per metre driven while pulling over or back.
 pub(crate) const PULL_RIGHT_PER_M: f64 = 0.15;
 
-/// A simulated vehicle (the ego or traffic).
+/// Length of a bicycle with its rider, metres (a city bike: 1.05 m wheelbase, 0.68 m wheels).
+pub const BICYCLE_LENGTH_M: f64 = 1.75;
+/// Width of a bicycle with its rider (handlebar and elbows), metres.
+pub const BICYCLE_WIDTH_M: f64 = 0.65;
+/// Height of a bicycle with its rider (for occlusion), metres.
+pub const BICYCLE_HEIGHT_M: f64 = 1.7;
+/// Lateral margin of a cyclist's corridor for pedestrians beyond the bicycle and the pedestrian, metres (a
+/// bicycle passes a walker closer than a car does).
+pub(crate) const CYCLIST_PED_MARGIN_M: f64 = 0.3;
+/// Sideways metres per metre ridden while a cyclist swerves or returns.
+const SWERVE_PER_M: f64 = 0.3;
+/// Sideways metres per metre driven while a vehicle moves out to overtake a cyclist or back in.
+const OVERTAKE_SHIFT_PER_M: f64 = 0.15;
+
+/// A simulated vehicle (the ego, traffic, or a cyclist: a bicycle is a narrow, slow vehicle that rides near its
+/// lane's right edge).
 #[derive(Clone, Debug)]
 pub(crate) struct Vehicle {
     /// Which vehicle this is.
     pub id: VehicleId,
+    /// Half its footprint's length and width, metres.
+    pub half_length_m: f64,
+    pub half_width_m: f64,
+    /// A cyclist's cruising speed, m/s (motor vehicles: `None`, their speed follows the limit).
+    pub cruise_mps: Option<f64>,
+    /// A cyclist rides this far right of its path (the lane's centre line), metres.
+    pub ride_offset_m: f64,
+    /// Where it is across its lane: metres to the right of the path (a cyclist's ride offset, less a swerve;
+    /// negative for a vehicle moved out to overtake). Its corridor is centred here.
+    pub lane_offset_m: f64,
+    /// Where `lane_offset_m` heads this step.
+    pub target_offset_m: f64,
+    /// The cyclist (index into the simulation's vehicles) it is overtaking, with the smallest side-to-side
+    /// clearance so far, metres.
+    pub overtaking: Option<(usize, f64)>,
+    /// A cyclist swerving around the pedestrian (index) in its path.
+    pub swerving_for: Option<usize>,
+    /// Distance ridden or driven since the start, metres.
+    pub odometer_m: f64,
     pub path: VehiclePath,
     pub s_m: f64,
     pub speed_mps: f64,
@@ -131,6 +165,59 @@ impl Vehicle {
         .with_ignores_lights(script.ignores_lights)
     }
 
+    /// A cyclist, at its route start, at its cruising speed, `edge_offset_m` from its lane's right edge.
+    pub fn cyclist(script: &CyclistScript, net: &RoadNetwork) -> Vehicle {
+        let path = VehiclePath::from_route(&script.route, net);
+        let lane_width_m = script
+            .route
+            .lanes
+            .first()
+            .and_then(|&l| net.lanes.get(l as usize))
+            .and_then(|l| net.pieces.get(l.pieces.start as usize))
+            .map_or(3.0, |p| f64::from(p.width_m[0]));
+        let ride_offset_m = (0.5 * lane_width_m - script.edge_offset_m).max(0.0);
+        let mut v = Self::new(
+            VehicleId::Cyclist(script.id),
+            path,
+            script.route.start_s_m,
+            1.0,
+            1.0,
+            1.0,
+            false,
+            None,
+        )
+        .with_ignores_lights(script.ignores_lights);
+        v.half_length_m = 0.5 * BICYCLE_LENGTH_M;
+        v.half_width_m = 0.5 * BICYCLE_WIDTH_M;
+        v.cruise_mps = Some(script.speed_mps.max(0.1));
+        v.ride_offset_m = ride_offset_m;
+        v.lane_offset_m = ride_offset_m;
+        v.target_offset_m = ride_offset_m;
+        v.place();
+        v.speed_mps = v.target_speed_mps();
+        v
+    }
+
+    /// Whether it is a bicycle.
+    pub fn is_cyclist(&self) -> bool {
+        self.cruise_mps.is_some()
+    }
+
+    /// The distance of `p` from the centre line of its corridor (its path moved `lane_offset_m` to the right),
+    /// given `p`'s projection `s_p` on the path and its unsigned distance `lateral_m` from it, metres.
+    pub fn corridor_lateral_m(&self, p: DVec2, s_p: f64, lateral_m: f64) -> f64 {
+        if self.lane_offset_m == 0.0 {
+            return lateral_m;
+        }
+        (self.signed_lateral_m(p, s_p) + self.lane_offset_m).abs()
+    }
+
+    /// Where `p` lies across the path at arc length `s_p`: metres to the left (negative: right).
+    pub fn signed_lateral_m(&self, p: DVec2, s_p: f64) -> f64 {
+        let at = self.path.pose_at(s_p);
+        (p - at.pos).dot(at.dir.perp())
+    }
+
     fn with_emergency(mut self, emergency: Option<EmergencyKind>) -> Vehicle {
         self.emergency = emergency;
         self
@@ -143,7 +230,7 @@ impl Vehicle {
 
     /// Sets the stop lines along its path; those its front bumper has passed are behind it.
     pub fn set_stop_lines(&mut self, stop_lines: Vec<super::signals::StopLine>) {
-        let front = self.s_m + HALF_LENGTH_M;
+        let front = self.s_m + self.half_length_m;
         self.next_stop = stop_lines.iter().take_while(|l| l.s_m <= front).count();
         self.stop_lines = stop_lines;
     }
@@ -186,6 +273,15 @@ impl Vehicle {
         let speed_factor = speed_factor.max(0.05);
         Vehicle {
             id,
+            half_length_m: HALF_LENGTH_M,
+            half_width_m: HALF_WIDTH_M,
+            cruise_mps: None,
+            ride_offset_m: 0.0,
+            lane_offset_m: 0.0,
+            target_offset_m: 0.0,
+            overtaking: None,
+            swerving_for: None,
+            odometer_m: 0.0,
             s_m,
             speed_mps: pose.speed_limit_mps * speed_factor,
             accel_mps2: 0.0,
@@ -209,6 +305,11 @@ impl Vehicle {
         }
     }
 
+    /// Half its footprint's extents: along its heading, across, metres.
+    pub fn half_extents(&self) -> DVec2 {
+        DVec2::new(self.half_length_m, self.half_width_m)
+    }
+
     /// Velocity vector, m/s.
     pub fn velocity(&self) -> DVec2 {
         self.pose.dir * self.speed_mps
@@ -216,14 +317,17 @@ impl Vehicle {
 
     /// Target (desired) speed at the current position, m/s.
     pub fn target_speed_mps(&self) -> f64 {
-        (self.pose.speed_limit_mps * self.speed_factor).min(self.path.advisory_mps(self.s_m))
+        let cruise = self.cruise_mps.unwrap_or(self.pose.speed_limit_mps * self.speed_factor);
+        cruise.min(self.path.advisory_mps(self.s_m))
     }
 
     /// Advances by `dt_s` with acceleration `accel_mps2` (speed never negative), updating the cached pose.
     pub fn integrate(&mut self, accel_mps2: f64, dt_s: f64) {
         let v0 = self.speed_mps;
         let v1 = (v0 + accel_mps2 * dt_s).max(0.0);
+        let s0 = self.s_m;
         self.s_m = (self.s_m + 0.5 * (v0 + v1) * dt_s).min(self.path.length_m());
+        self.odometer_m += self.s_m - s0;
         self.accel_mps2 = (v1 - v0) / dt_s;
         self.speed_mps = if self.s_m >= self.path.length_m() { 0.0 } else { v1 };
         // Pulling over to the right while yielding, back to the lane centre after: sideways by at most a
@@ -231,14 +335,23 @@ impl Vehicle {
         let target = if self.yielding { PULL_RIGHT_M } else { 0.0 };
         let step = PULL_RIGHT_PER_M * 0.5 * (v0 + v1) * dt_s;
         self.pull_right_m += (target - self.pull_right_m).clamp(-step, step);
+        // Moving out to overtake (or a cyclist swerving) and back in: also by distance travelled.
+        let rate = if self.is_cyclist() {
+            SWERVE_PER_M
+        } else {
+            OVERTAKE_SHIFT_PER_M
+        };
+        let step = rate * 0.5 * (v0 + v1) * dt_s;
+        self.lane_offset_m += (self.target_offset_m - self.lane_offset_m).clamp(-step, step);
         self.place();
     }
 
     /// Caches the pose at `s_m`, moved `pull_right_m` to the right of the path.
-    fn place(&mut self) {
+    pub(crate) fn place(&mut self) {
         self.pose = self.path.pose_at(self.s_m);
-        if self.pull_right_m > 0.0 {
-            self.pose.pos -= self.pose.dir.perp() * self.pull_right_m;
+        let right = self.pull_right_m + self.lane_offset_m;
+        if right != 0.0 {
+            self.pose.pos -= self.pose.dir.perp() * right;
         }
     }
 
