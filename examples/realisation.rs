@@ -39,15 +39,16 @@ fn main() {
         };
         let rig = Rig::from_spec(&plan.spec.sensors);
         // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled,
-        // allocated never annotated, pedestrians never annotated)
-        let counts: Vec<[usize; 8]> = plan
+        // allocated never annotated, pedestrians never annotated, unlabelled allocated crossers that never had
+        // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated)
+        let counts: Vec<[usize; 11]> = plan
             .clips
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
                 let trace = simulate::simulate(clip, &plan.sim, net);
                 let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
-                let mut c = [0usize; 8];
+                let mut c = [0usize; 11];
                 for (i, p) in clip.pedestrians.iter().enumerate() {
                     c[0] += 1;
                     let labelled = usize::from(ann.pedestrians[i].crosser);
@@ -62,6 +63,19 @@ fn main() {
                             c[2] += labelled;
                             c[3] += usize::from(on_road);
                             c[6] += unseen;
+                            if labelled == 0 {
+                                let crossing_frames: Vec<usize> =
+                                    (0..ann.crossing[i].len()).filter(|&f| ann.crossing[i][f]).collect();
+                                let behind = crossing_frames.iter().all(|&f| {
+                                    let (e, q) = (&trace.ego[f], &trace.pedestrians[i][f]);
+                                    (q.pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad)) < 0.0
+                                });
+                                match (crossing_frames.is_empty(), behind) {
+                                    (true, _) => c[8] += 1,
+                                    (false, true) => c[9] += 1,
+                                    (false, false) => c[10] += 1,
+                                }
+                            }
                         }
                         (Role::Crosser, CrosserSource::Baseline) => {
                             c[4] += 1;
@@ -73,8 +87,8 @@ fn main() {
                 c
             })
             .collect();
-        let t = counts.iter().fold([0usize; 8], |mut acc, c| {
-            for k in 0..8 {
+        let t = counts.iter().fold([0usize; 11], |mut acc, c| {
+            for k in 0..11 {
                 acc[k] += c[k];
             }
             acc
@@ -90,6 +104,13 @@ fn main() {
             share(t[6], t[1]),
             t[4],
             share(t[5], t[4])
+        );
+        println!(
+            "  unlabelled allocated crossers: {:.3} never crossed in the clip, {:.3} crossed only behind the camera, \
+             {:.3} crossed in front of it unannotated (too far, small, occluded, out of the image)",
+            share(t[8], t[1]),
+            share(t[9], t[1]),
+            share(t[10], t[1])
         );
     }
 }

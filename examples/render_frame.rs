@@ -3,7 +3,7 @@
 //! in every weather, and for the README's pictures. Prints each image's mean luminance.
 //!
 //! Run: `cargo run --release --example render_frame -- tests/data/specs/weathers.yaml --out DIR [--frame F]
-//! [--set KEY=VALUE]...`
+//! [--clip ID] [--set KEY=VALUE]...` (`--clip`: only that clip).
 
 use std::path::{Path, PathBuf};
 
@@ -26,6 +26,7 @@ fn main() {
     };
     let out = PathBuf::from(value("--out").unwrap_or_else(|| "render".into()));
     let fixed: Option<u32> = value("--frame").and_then(|f| f.parse().ok());
+    let only = value("--clip");
     let options = LoadOptions {
         overrides,
         allow_large: false,
@@ -39,7 +40,11 @@ fn main() {
     };
     std::fs::create_dir_all(&out).expect("output directory");
     let rig = Rig::from_spec(&plan.spec.sensors);
-    for clip in &plan.clips {
+    for clip in plan
+        .clips
+        .iter()
+        .filter(|c| only.as_ref().is_none_or(|id| *id == c.clip_id))
+    {
         let net = &towns[&clip.town].network;
         let trace = simulate::simulate(clip, &plan.sim, net);
         let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;

@@ -288,10 +288,17 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         p if p.starts_with("traffic.signals.") && p != "traffic.signals.enabled" => {
             vec![("traffic.signals.enabled", json!(true))]
         }
-        // Cyclists exist only with a count above 0; overtakes and swerves show with several per clip.
+        // Cyclists exist only with a count above 0; overtakes show with several per clip; a swerve needs a
+        // pedestrian standing on the riding line: cyclists hugging the curb meet those waiting there.
+        "traffic.cyclists.swerve_m" => vec![
+            ("traffic.cyclists.per_clip", json!([8, 8])),
+            ("traffic.cyclists.edge_offset_m", json!(0.3)),
+        ],
         p if p.starts_with("traffic.cyclists.") && p != "traffic.cyclists.per_clip" => {
             vec![("traffic.cyclists.per_clip", json!([5, 5]))]
         }
+        // The lookahead's predicted position matters only in in-road conflicts: more pedestrians make some.
+        "crossing.lookahead.prediction_s" => vec![("pedestrians.per_clip", json!([20, 20]))],
         "annotations.visibility.min_box_far_px.height_px" => {
             vec![("annotations.visibility.min_box_far_px.width_px", json!(2.0))]
         }

@@ -1514,6 +1514,22 @@ const BIKE_COLOURS: [[u8; 3]; 8] = [
 /// Cyclists start at least this far from the ego and from every vehicle's start, metres.
 const CYCLIST_SPACING_M: f64 = 8.0;
 
+/// A vehicle starting within this distance behind a cyclist in its lane could not stop for it, metres (from
+/// 60 km/h at 8 m/s² with a second's reaction, plus the lengths).
+const CYCLIST_CLEAR_BEHIND_M: f64 = 40.0;
+
+/// Whether a vehicle starting at `route`'s start would come up behind a cyclist starting at `sp` in the same
+/// lane within [`CYCLIST_CLEAR_BEHIND_M`].
+fn closing_from_behind(route: &RouteScript, sp: &SpawnPoint) -> bool {
+    let dir = DVec2::from_angle(route.start_heading_rad);
+    let d = sp.pos - route.start;
+    let along = d.dot(dir);
+    along > 0.0
+        && along < CYCLIST_CLEAR_BEHIND_M
+        && d.dot(dir.perp()).abs() < 2.5
+        && DVec2::from_angle(sp.heading_rad).dot(dir) > 0.7
+}
+
 /// The clip's cyclists (`traffic.cyclists.per_clip`), all from the stream `cyclists` (and their riders' looks
 /// from `cyclist/<id>/identity`), so that adding cyclists changes no other draw of the plan. Every other one
 /// starts ahead of the ego in its direction (15–80 m: the ego catches up and overtakes it), the others anywhere
@@ -1553,6 +1569,7 @@ fn plan_cyclists(
                         && (!same_way || ahead)
                         && clear_of_road_pedestrians(sp, peds)
                         && taken.iter().all(|t| t.distance(sp.pos) >= CYCLIST_SPACING_M)
+                        && !vehicles.iter().any(|v| closing_from_behind(&v.route, sp))
                 })
                 .collect()
         };

@@ -129,8 +129,8 @@ pub struct ClipAnnotations {
     pub rejections: Rejections,
     /// Crossing label C of every pedestrian (by id) in every frame, annotated or not.
     pub crossing: Vec<Vec<bool>>,
-    /// Every cyclist-frame in front of the camera whose box reaches into the image, ordered by (frame,
-    /// cyclist).
+    /// Every cyclist-frame in front of the camera whose box reaches at least a pixel into the image, ordered by
+    /// (frame, cyclist).
     pub cyclists: Vec<CyclistRow>,
 }
 
@@ -449,7 +449,8 @@ pub fn annotate(
                 bbox[2].clamp(0.0, width),
                 bbox[3].clamp(0.0, height),
             ];
-            if clipped[2] <= clipped[0] || clipped[3] <= clipped[1] {
+            // In view: at least a pixel of the box inside the image.
+            if clipped[2] - clipped[0] < 1.0 || clipped[3] - clipped[1] < 1.0 {
                 continue;
             }
             let truncated = clipped != bbox;

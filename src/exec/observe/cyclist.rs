@@ -29,7 +29,7 @@ const TORSO_LEAN_RAD: f64 = 0.61;
 
 /// Height of the hips (the saddle) above the ground for a rider of height `height_m`: the leg almost
 /// straight (95 % of its length) with the pedal at the bottom, metres.
-fn hip_height_m(height_m: f64) -> f64 {
+pub fn hip_height_m(height_m: f64) -> f64 {
     let leg = (0.245 + 0.246) * height_m;
     BOTTOM_BRACKET.z - CRANK_M + 0.08 + 0.95 * leg
 }

@@ -1305,6 +1305,33 @@ impl FrameScene {
                 });
                 self.mesh.capsule(&sc, prim);
             }
+            // Lights (emissive at night): a white lamp under the handlebar, a red one under the saddle.
+            let (sin, cos) = (frame.yaw_rad as f32).sin_cos();
+            let fwd = Vec2::new(cos, sin);
+            let centre = stat.rel(frame.pos);
+            let hip_z = cyclist::hip_height_m(cs.rider.height_m) as f32;
+            for (along, z, material, albedo) in [
+                (0.43f32, hip_z - 0.12, Material::HeadLamp, linear([240, 240, 230])),
+                (-0.36, hip_z - 0.16, Material::TailLamp, linear([200, 12, 12])),
+            ] {
+                let lamp = Prim {
+                    material,
+                    tag: tag::BICYCLE,
+                    instance,
+                    albedo,
+                    albedo2: albedo,
+                    normal: Vec3::Z,
+                    aux: 0,
+                };
+                self.mesh.upright_box(
+                    centre.truncate() + fwd * along,
+                    frame.yaw_rad as f32,
+                    Vec2::new(0.03, 0.035),
+                    [centre.z + z - 0.035, centre.z + z + 0.035],
+                    lamp,
+                    lamp,
+                );
+            }
         }
     }
 

@@ -37,10 +37,15 @@ const OVERTAKE_DONE_M: f64 = 2.0;
 /// An overtake counts only if the vehicle came this close to the cyclist while alongside, metres (else their
 /// paths had parted and it passed nobody).
 const OVERTAKE_ALONGSIDE_MAX_M: f64 = 3.0;
-/// A vehicle overtakes only where its path ahead turns by less than this over [`OVERTAKE_STRAIGHT_M`], radians.
+/// A vehicle overtakes only where its path turns by less than this over the whole pass and
+/// [`OVERTAKE_STRAIGHT_M`] beyond (the way back in), radians ...
 const OVERTAKE_MAX_TURN_RAD: f64 = 0.15;
-/// See [`OVERTAKE_MAX_TURN_RAD`], metres.
-const OVERTAKE_STRAIGHT_M: f64 = 40.0;
+/// ... see [`OVERTAKE_MAX_TURN_RAD`], metres ...
+const OVERTAKE_STRAIGHT_M: f64 = 20.0;
+/// ... checked every this many metres.
+const OVERTAKE_STRAIGHT_STEP_M: f64 = 5.0;
+/// A vehicle does not start a pass that would take longer than this at its speeds, seconds.
+const OVERTAKE_MAX_S: f64 = 12.0;
 /// An overtake is given up (without an event) when the cyclist is farther than this, metres (their paths
 /// parted at a junction).
 const OVERTAKE_LOST_M: f64 = 40.0;
@@ -107,9 +112,18 @@ pub(super) fn decide(vehicles: &mut [Vehicle], peds: &[PedView], c: &Cyclists, i
                 && (-5.0..clear_m).contains(&d.dot(me.pose.dir))
                 && d.dot(me.pose.dir.perp()).abs() < OVERTAKE_ONCOMING_LATERAL_M
         });
-        let ahead = me.path.pose_at(me.s_m + OVERTAKE_STRAIGHT_M);
-        let turn = (ahead.heading_rad - me.pose.heading_rad + PI).rem_euclid(TAU) - PI;
-        if turn.abs() > OVERTAKE_MAX_TURN_RAD || me.s_m + OVERTAKE_STRAIGHT_M > me.path.length_m() {
+        // Only where the whole pass (the distance driven while passing, and the way back in) is straight.
+        let pass_along_m = target * pass_s + OVERTAKE_STRAIGHT_M;
+        if pass_s > OVERTAKE_MAX_S || me.s_m + pass_along_m > me.path.length_m() {
+            continue;
+        }
+        let steps = (pass_along_m / OVERTAKE_STRAIGHT_STEP_M).ceil() as usize;
+        let bends = (1..=steps).any(|k| {
+            let ahead = me.path.pose_at(me.s_m + pass_along_m * k as f64 / steps as f64);
+            let turn = (ahead.heading_rad - me.pose.heading_rad + PI).rem_euclid(TAU) - PI;
+            turn.abs() > OVERTAKE_MAX_TURN_RAD
+        });
+        if bends {
             continue;
         }
         let stopping = me.light_ahead.is_some_and(|(gap, _)| gap < OVERTAKE_ONCOMING_CLEAR_M) || me.yielding;

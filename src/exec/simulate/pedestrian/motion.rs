@@ -126,7 +126,14 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
             _ => p.own_speed_mps(m),
         };
         let mut v = ai_velocity(p, ctx, speed);
-        if speed > 0.0 && v != DVec2::ZERO {
+        // On the last metres to its curb point a crosser steps onto its spot: pushed aside by a neighbour waiting
+        // there (a group member on a parallel line, someone else's spot), it would never arrive.
+        let final_approach = !p.attempt.over()
+            && !p.attempt.at_curb()
+            && p.traits
+                .line
+                .is_some_and(|l| l.curb_point().distance(old) < CURB_SLOWDOWN_M);
+        if speed > 0.0 && v != DVec2::ZERO && !final_approach {
             // Simple avoidance: a push away from pedestrians closer than AVOID_RADIUS_M, speed capped.
             let mut push = DVec2::ZERO;
             for (j, &q) in others.iter().enumerate() {
