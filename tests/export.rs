@@ -48,7 +48,10 @@ fn export(format: &str, dataset: &Path, out: &Path) -> (Option<i32>, String, Str
 fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
     let tmp = common::Scratch::new("export");
     let ds = tmp.path().join("ds");
-    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &common::NO_SENSORS, &ds, None);
+    // With cyclists: they go into the OpenSCENARIO files as bicycles and into PIE as vehicles of type bicycle.
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.push("traffic.cyclists.per_clip=[2, 2]");
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &overrides, &ds, None);
     assert_eq!(code, 0, "{stderr}");
 
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
@@ -198,7 +201,8 @@ fn poses_are_openpose18_normalised_in_the_box_with_hidden_joints_zero() {
 
 /// Parses an exported .xosc and checks that each entity's polyline, linearly interpolated in time, passes
 /// within the exporter's tolerance (2 cm, 0.02 rad, plus the file's rounding) of every frame of the tables:
-/// the ego from `frames`, vehicles from `vehicles`, pedestrians from `tracks`; and that the scenario declares
+/// the ego from `frames`, vehicles from `vehicles`, cyclists (bicycles) from `cyclists`, pedestrians from
+/// `tracks`; and that the scenario declares
 /// exactly these entities, points at the exported town and carries the clip's weather.
 fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
     use pedsynth::exec::export::openscenario::{TOLERANCE_M, TOLERANCE_RAD};
@@ -227,7 +231,18 @@ fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
         .map(|n| n.attribute("name").unwrap())
         .collect();
     let vehicles: std::collections::BTreeSet<u32> = clip.vehicles.iter().map(|v| v.vehicle).collect();
-    assert_eq!(declared.len(), 1 + vehicles.len() + clip.tracks.len());
+    let cyclists: std::collections::BTreeSet<u32> = clip.cyclists.iter().map(|c| c.cyclist).collect();
+    assert!(
+        !cyclists.is_empty(),
+        "{}: the test's dataset has cyclists",
+        clip.clip_id
+    );
+    assert_eq!(declared.len(), 1 + vehicles.len() + cyclists.len() + clip.tracks.len());
+    let bicycles = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("Vehicle") && n.attribute("vehicleCategory") == Some("bicycle"))
+        .count();
+    assert_eq!(bicycles, cyclists.len());
     assert_eq!(polylines.len(), declared.len());
     assert_eq!(
         clip.tracks.len(),
@@ -266,6 +281,13 @@ fn check_replay(clip: &pedsynth::exec::export::dataset::Clip, xosc: &str) {
             &format!("vehicle_{}", v.vehicle),
             v.frame,
             [v.x_m, v.y_m, v.z_m, v.yaw_rad],
+        );
+    }
+    for c in &clip.cyclists {
+        check(
+            &format!("cyclist_{}", c.cyclist),
+            c.frame,
+            [c.x_m, c.y_m, c.z_m, c.yaw_rad],
         );
     }
     for (id, track) in &clip.tracks {

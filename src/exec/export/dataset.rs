@@ -98,13 +98,17 @@ pub struct VehicleFrame {
     pub yaw_rad: f64,
 }
 
-/// A cyclist in view of the camera in one frame: its box of rider and bicycle.
+/// A cyclist in one frame: its pose, and its box of rider and bicycle where in view of the camera.
 #[derive(Clone, Copy, Debug)]
-pub struct CyclistBox {
+pub struct CyclistFrame {
     pub frame: u32,
     pub cyclist: u32,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub yaw_rad: f64,
     /// `[x1, y1, x2, y2]`, pixels.
-    pub bbox: [f64; 4],
+    pub bbox: Option<[f64; 4]>,
 }
 
 /// A clip's row of the `clips` table.
@@ -136,9 +140,9 @@ pub struct Clip {
     pub pedestrians: BTreeMap<u32, Pedestrian>,
     /// Sorted by (vehicle, frame).
     pub vehicles: Vec<VehicleFrame>,
-    /// The cyclists' boxes where in view, sorted by (cyclist, frame) (empty without cyclists, or for a dataset
-    /// written before the `cyclists` table existed).
-    pub cyclists: Vec<CyclistBox>,
+    /// The cyclists in every frame, sorted by (cyclist, frame) (empty without cyclists, or for a dataset written
+    /// before the `cyclists` table existed).
+    pub cyclists: Vec<CyclistFrame>,
     /// Every pedestrian's track, by pedestrian id, in frame order (empty for a dataset written before the
     /// `tracks` table existed).
     pub tracks: BTreeMap<u32, Vec<TrackFrame>>,
@@ -448,18 +452,24 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
     clip.vehicles.sort_by_key(|v| (v.vehicle, v.frame));
     let cyclists = file("cyclists");
     if cyclists.is_file() {
-        let cols = ["frame", "cyclist", "in_view", "x1", "y1", "x2", "y2"];
+        let cols = [
+            "frame", "cyclist", "in_view", "x_m", "y_m", "z_m", "yaw_rad", "x1", "y1", "x2", "y2",
+        ];
         for b in tables::read(&cyclists, &cols)? {
             let (frame, cyclist, in_view) = (b.u32s("frame")?, b.u32s("cyclist")?, b.bools("in_view")?);
-            let xy: Vec<_> = cols[3..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            let v: Vec<_> = cols[3..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
             for i in 0..b.rows() {
-                if in_view.value(i) {
-                    clip.cyclists.push(CyclistBox {
-                        frame: frame.value(i),
-                        cyclist: cyclist.value(i),
-                        bbox: std::array::from_fn(|k| f64::from(xy[k].value(i))),
-                    });
-                }
+                clip.cyclists.push(CyclistFrame {
+                    frame: frame.value(i),
+                    cyclist: cyclist.value(i),
+                    x_m: f64::from(v[0].value(i)),
+                    y_m: f64::from(v[1].value(i)),
+                    z_m: f64::from(v[2].value(i)),
+                    yaw_rad: f64::from(v[3].value(i)),
+                    bbox: in_view
+                        .value(i)
+                        .then(|| std::array::from_fn(|k| f64::from(v[4 + k].value(i)))),
+                });
             }
         }
         clip.cyclists.sort_by_key(|c| (c.cyclist, c.frame));

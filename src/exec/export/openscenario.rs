@@ -2,11 +2,12 @@
 //! clip in esmini, CARLA's scenario_runner or any OpenSCENARIO player, with the towns beside them as OpenDRIVE
 //! (`towns/<town>.xodr`: built-in towns exported by `town export`'s writer, imported towns copied).
 //!
-//! A file holds: the road network (a relative `LogicFile` path); the ego, every traffic vehicle and every
-//! pedestrian as entities with their dimensions (vehicles 4.6 × 1.9 × 1.5 m, pedestrians 0.6 m wide and their
-//! body height tall, mass from height at BMI 22); in `Init`, the weather as an `EnvironmentAction` and each
-//! entity teleported to its first pose; in one act, each entity's whole trace (`frames` for the ego,
-//! `vehicles`, `tracks` for pedestrians) as a `FollowTrajectoryAction` with a timed polyline in absolute time.
+//! A file holds: the road network (a relative `LogicFile` path); the ego, every traffic vehicle, every cyclist
+//! and every pedestrian as entities with their dimensions (vehicles 4.6 × 1.9 × 1.5 m, cyclists as vehicles of
+//! category `bicycle` 1.75 × 0.65 × 1.7 m, pedestrians 0.6 m wide and their body height tall, mass from height
+//! at BMI 22); in `Init`, the weather as an `EnvironmentAction` and each entity teleported to its first pose; in
+//! one act, each entity's whole trace (`frames` for the ego, `vehicles`, `cyclists`, `tracks` for pedestrians)
+//! as a `FollowTrajectoryAction` with a timed polyline in absolute time.
 //! Polylines keep only the vertices needed to reproduce every frame within 2 cm and 0.02 rad by linear
 //! interpolation (a pedestrian who waits is two vertices, not one per frame); headings are unwrapped so that
 //! interpolation never turns the long way round.
@@ -25,7 +26,9 @@ use super::dataset::{Clip, Dataset};
 use super::{progress, write_file};
 use crate::dsl::types::TownRef;
 use crate::error::{Error, code};
-use crate::exec::simulate::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
+use crate::exec::simulate::{
+    BICYCLE_HEIGHT_M, BICYCLE_LENGTH_M, BICYCLE_WIDTH_M, VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M,
+};
 use crate::xml::escape;
 
 /// Largest position error of a simplified polyline at any frame, metres.
@@ -159,10 +162,11 @@ struct Entity {
 enum Kind {
     Car,
     Pedestrian { height_m: f64 },
+    Bicycle,
 }
 
 /// The entities of a clip with their traces (headings unwrapped), in a fixed order: ego, vehicles by id,
-/// pedestrians by id.
+/// cyclists by id, pedestrians by id.
 fn collect(clip: &Clip) -> Vec<Entity> {
     let fps = f64::from(clip.fps.max(1));
     let mut out = Vec::new();
@@ -198,6 +202,22 @@ fn collect(clip: &Clip) -> Vec<Entity> {
             name: format!("vehicle_{id}"),
             kind: Kind::Car,
             poses,
+        });
+    }
+    for track in clip.cyclists.chunk_by(|a, b| a.cyclist == b.cyclist) {
+        out.push(Entity {
+            name: format!("cyclist_{}", track[0].cyclist),
+            kind: Kind::Bicycle,
+            poses: track
+                .iter()
+                .map(|c| Pose {
+                    t_s: f64::from(c.frame) / fps,
+                    x_m: c.x_m,
+                    y_m: c.y_m,
+                    z_m: c.z_m,
+                    h_rad: c.yaw_rad,
+                })
+                .collect(),
         });
     }
     for (id, track) in &clip.tracks {
@@ -262,6 +282,14 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
                     "<Vehicle name=\"{}\" vehicleCategory=\"car\" mass=\"1500\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{}\"/><Dimensions width=\"{VEHICLE_WIDTH_M}\" length=\"{VEHICLE_LENGTH_M}\" height=\"{VEHICLE_HEIGHT_M}\"/></BoundingBox>\n<Performance maxSpeed=\"50\" maxAcceleration=\"10\" maxDeceleration=\"10\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.6\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"1.4\" positionZ=\"0.325\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"-1.4\" positionZ=\"0.325\"/>\n</Axles>\n<Properties/>\n</Vehicle>\n",
                     e.name,
                     0.5 * VEHICLE_HEIGHT_M
+                );
+            }
+            Kind::Bicycle => {
+                let _ = write!(
+                    x,
+                    "<Vehicle name=\"{}\" vehicleCategory=\"bicycle\" mass=\"90\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{}\"/><Dimensions width=\"{BICYCLE_WIDTH_M}\" length=\"{BICYCLE_LENGTH_M}\" height=\"{BICYCLE_HEIGHT_M}\"/></BoundingBox>\n<Performance maxSpeed=\"15\" maxAcceleration=\"3\" maxDeceleration=\"8\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.8\" wheelDiameter=\"0.68\" trackWidth=\"0\" positionX=\"0.525\" positionZ=\"0.34\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.68\" trackWidth=\"0\" positionX=\"-0.525\" positionZ=\"0.34\"/>\n</Axles>\n<Properties/>\n</Vehicle>\n",
+                    e.name,
+                    0.5 * BICYCLE_HEIGHT_M
                 );
             }
             Kind::Pedestrian { height_m } => {

@@ -389,7 +389,7 @@ fn write_video(
         let cid = track[0].cyclist;
         let mut boxes = String::new();
         for c in track {
-            let b = c.bbox;
+            let Some(b) = c.bbox else { continue };
             let _ = writeln!(
                 boxes,
                 "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
@@ -398,8 +398,10 @@ fn write_video(
                 c.frame, b[0], b[1], b[2], b[3],
             );
         }
-        vehicle_tracks += 1;
-        let _ = write!(x, "  <track label=\"vehicle\">\n{boxes}  </track>\n");
+        if !boxes.is_empty() {
+            vehicle_tracks += 1;
+            let _ = write!(x, "  <track label=\"vehicle\">\n{boxes}  </track>\n");
+        }
     }
     // Crosswalks of the town near the ego's path, projected like the vehicles: the polygon on the ground.
     if let Some(net) = net {

@@ -52,7 +52,7 @@ use pedestrian::machine::{self, LeaderFacts};
 use pedestrian::params::{FOLLOWER_MAX_IN_VIEW_S, GROUP_LINE_MAX_WIDTH_DIFF, GROUP_LINE_MIN_COS};
 use pedestrian::{Group, Ped, StepCtx, motion, perceive};
 pub use pedestrian::{allowed_speed_range_mps, params as behaviour_params, profile_multiplier, state_speed_mps};
-pub use vehicle::EGO_TIME_HEADWAY_S;
+pub use vehicle::{BICYCLE_HEIGHT_M, BICYCLE_LENGTH_M, BICYCLE_WIDTH_M, EGO_TIME_HEADWAY_S};
 use vehicle::{PedView, Vehicle};
 
 /// Length of every vehicle's footprint box, metres.
