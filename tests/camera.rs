@@ -123,6 +123,15 @@ fn near_pixel(img: &CameraImages, x: f32, y: f32, test: impl Fn(usize) -> bool) 
     })
 }
 
+/// Intersection over union of two boxes `[x_min, y_min, x_max, y_max]`.
+fn box_iou(a: [f32; 4], b: [f32; 4]) -> f64 {
+    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    let inter = iw * ih;
+    let union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter;
+    f64::from(inter / union)
+}
+
 /// Compares every unoccluded annotated pedestrian of one frame with its instance pixels; records a pedestrian
 /// whose pixels leave its box or whose pixels' box differs from it.
 fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut MaskReport) {
@@ -170,11 +179,7 @@ fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut MaskReport
         let share = inside as f64 / n as f64;
         // The pixels' box, with half a pixel around the outermost sample points.
         let pix = [lo.0 - 0.5, lo.1 - 0.5, hi.0 + 0.5, hi.1 + 0.5];
-        let iw = (pix[2].min(b[2]) - pix[0].max(b[0])).max(0.0);
-        let ih = (pix[3].min(b[3]) - pix[1].max(b[1])).max(0.0);
-        let inter = iw * ih;
-        let union = (pix[2] - pix[0]) * (pix[3] - pix[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter;
-        let iou = f64::from(inter / union);
+        let iou = box_iou(pix, b);
         if share < 0.95 || iou < 0.8 {
             report.failures.push(format!(
                 "frame {frame}, pedestrian {}: {share:.3} of its pixels inside its box {b:?} ({:.1} x {:.1} px), IoU \
@@ -984,11 +989,7 @@ fn cyclists_are_drawn_in_their_boxes_as_rider_and_bicycle() {
             }
             let share = inside as f64 / pixels.len() as f64;
             let pix = [lo.0 - 0.5, lo.1 - 0.5, hi.0 + 0.5, hi.1 + 0.5];
-            let iw = (pix[2].min(b[2]) - pix[0].max(b[0])).max(0.0);
-            let ih = (pix[3].min(b[3]) - pix[1].max(b[1])).max(0.0);
-            let inter = iw * ih;
-            let union = (pix[2] - pix[0]) * (pix[3] - pix[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter;
-            let iou = f64::from(inter / union);
+            let iou = box_iou(pix, b);
             assert!(
                 share >= 0.95 && iou >= 0.8,
                 "frame {frame}, cyclist {}: {share:.3} of its pixels in its box {b:?}, IoU {iou:.3} with {pix:?}",

@@ -224,6 +224,17 @@ pub fn place_at(net: &RoadNetwork, x_m: f64, y_m: f64, lights_run: bool) -> Plac
     }
 }
 
+/// Appends a PIE vehicle `<box>` (its `id` and `type` attributes) to a track.
+fn vehicle_box_xml(boxes: &mut String, frame: u32, b: [f64; 4], id: &str, kind: &str) {
+    let _ = writeln!(
+        boxes,
+        "    <box frame=\"{frame}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
+         xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{id}</attribute>\n      \
+         <attribute name=\"type\">{kind}</attribute>\n    </box>",
+        b[0], b[1], b[2], b[3],
+    );
+}
+
 /// A vehicle's projected box in a frame: the 8 corners of its 3D box, all in front of the camera, the box
 /// clipped to the image; `None` when nothing of it is in the image.
 fn vehicle_box(cam: &crate::exec::observe::rig::CameraPose, pos: DVec3, yaw_rad: f64) -> Option<[f64; 4]> {
@@ -370,13 +381,7 @@ fn write_video(
                 continue;
             };
             if let Some(b) = vehicle_box(cam, DVec3::new(vf.x_m, vf.y_m, vf.z_m), vf.yaw_rad) {
-                let _ = writeln!(
-                    boxes,
-                    "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
-                     xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{prefix}_{vid}v</attribute>\n      \
-                     <attribute name=\"type\">car</attribute>\n    </box>",
-                    vf.frame, b[0], b[1], b[2], b[3],
-                );
+                vehicle_box_xml(&mut boxes, vf.frame, b, &format!("{prefix}_{vid}v"), "car");
             }
         }
         if !boxes.is_empty() {
@@ -389,14 +394,9 @@ fn write_video(
         let cid = track[0].cyclist;
         let mut boxes = String::new();
         for c in track {
-            let Some(b) = c.bbox else { continue };
-            let _ = writeln!(
-                boxes,
-                "    <box frame=\"{}\" keyframe=\"1\" occluded=\"0\" outside=\"0\" xtl=\"{:.2}\" ytl=\"{:.2}\" \
-                 xbr=\"{:.2}\" ybr=\"{:.2}\">\n      <attribute name=\"id\">{prefix}_{cid}b</attribute>\n      \
-                 <attribute name=\"type\">bicycle</attribute>\n    </box>",
-                c.frame, b[0], b[1], b[2], b[3],
-            );
+            if let Some(b) = c.bbox {
+                vehicle_box_xml(&mut boxes, c.frame, b, &format!("{prefix}_{cid}b"), "bicycle");
+            }
         }
         if !boxes.is_empty() {
             vehicle_tracks += 1;

@@ -150,6 +150,40 @@ const STAND_MPS: f64 = 0.15;
 /// Speed above which the gait is a run, m/s.
 const RUN_MPS: f64 = 2.4;
 
+/// The capsules of a body of height `h` from its joints in the body frame (COCO order) and its torso points
+/// `[pelvis, chest, neck, head centre]`, placed in the world by `to_world`: the same silhouette for a walker
+/// and a cyclist's rider.
+pub(crate) fn silhouette(
+    joints: &[DVec3; 17],
+    [pelvis, chest, neck, head_centre]: [DVec3; 4],
+    h: f64,
+    to_world: impl Fn(DVec3) -> DVec3,
+) -> [Capsule; CAPSULES] {
+    let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
+    let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
+        a: to_world(a),
+        b: to_world(b),
+        radius_m: r * h,
+    };
+    let j = |k: usize| joints[k];
+    [
+        cap(pelvis, chest, 0.085),
+        cap(j(5), j(6), 0.04),
+        cap(head_centre, head_centre, 0.07),
+        cap(j(5), j(7), 0.03),
+        cap(j(6), j(8), 0.03),
+        cap(j(7), j(9), 0.025),
+        cap(j(8), j(10), 0.025),
+        cap(j(11), j(13), 0.045),
+        cap(j(12), j(14), 0.045),
+        cap(j(13), j(15), 0.035),
+        cap(j(14), j(16), 0.035),
+        cap(j(15), toe(j(15)), 0.022),
+        cap(j(16), toe(j(16)), 0.022),
+        cap(neck, head_centre, 0.035),
+    ]
+}
+
 /// Poses a body of height `height_m` for one trace frame; `offset_body` shifts it in the body frame (used for
 /// a parent's child).
 pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
@@ -252,33 +286,11 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     let rot = DMat3::from_rotation_z(frame.yaw_rad);
     let to_world = |p: DVec3| frame.pos + rot * (p + offset_body);
     let joints = local.map(to_world);
-    let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
     let pelvis = DVec3::new(0.0, 0.0, hip_z);
     let chest = DVec3::new(0.0, 0.0, 0.78 * h);
-    let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
-        a: to_world(a),
-        b: to_world(b),
-        radius_m: r * h,
-    };
-    let capsules = [
-        cap(pelvis, chest, 0.085),
-        cap(l_shoulder, r_shoulder, 0.04),
-        cap(head_centre, head_centre, 0.07),
-        cap(l_shoulder, l_elbow, 0.03),
-        cap(r_shoulder, r_elbow, 0.03),
-        cap(l_elbow, l_wrist, 0.025),
-        cap(r_elbow, r_wrist, 0.025),
-        cap(l_hip, l_knee, 0.045),
-        cap(r_hip, r_knee, 0.045),
-        cap(l_knee, l_ankle, 0.035),
-        cap(r_knee, r_ankle, 0.035),
-        cap(l_ankle, toe(l_ankle), 0.022),
-        cap(r_ankle, toe(r_ankle), 0.022),
-        cap(neck, head_centre, 0.035),
-    ];
     BodyPose {
         joints,
-        capsules,
+        capsules: silhouette(&local, [pelvis, chest, neck, head_centre], h, to_world),
         height_m,
         ground: to_world(DVec3::ZERO),
         yaw_rad: frame.yaw_rad,

@@ -97,30 +97,9 @@ pub fn rider_pose(frame: &CyclistFrame, height_m: f64) -> BodyPose {
     ];
     let rot = DMat3::from_rotation_z(frame.yaw_rad);
     let to_world = |p: DVec3| frame.pos + rot * p;
-    let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
-    let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
-        a: to_world(a),
-        b: to_world(b),
-        radius_m: r * h,
-    };
     BodyPose {
         joints: local.map(to_world),
-        capsules: [
-            cap(pelvis, chest, 0.085),
-            cap(l_shoulder, r_shoulder, 0.04),
-            cap(head_centre, head_centre, 0.07),
-            cap(l_shoulder, l_elbow, 0.03),
-            cap(r_shoulder, r_elbow, 0.03),
-            cap(l_elbow, l_wrist, 0.025),
-            cap(r_elbow, r_wrist, 0.025),
-            cap(l_hip, l_knee, 0.045),
-            cap(r_hip, r_knee, 0.045),
-            cap(l_knee, l_ankle, 0.035),
-            cap(r_knee, r_ankle, 0.035),
-            cap(l_ankle, toe(l_ankle), 0.022),
-            cap(r_ankle, toe(r_ankle), 0.022),
-            cap(neck, head_centre, 0.035),
-        ],
+        capsules: super::body::silhouette(&local, [pelvis, chest, neck, head_centre], h, to_world),
         height_m,
         ground: frame.pos,
         yaw_rad: frame.yaw_rad,
