@@ -117,7 +117,7 @@ pub struct CrosserAllocation {
     /// Whether the layer is on.
     pub enabled: bool,
     /// Largest share of pedestrians allocated as crossers. The planner allocates what the target needs, up to
-    /// this share. The paper's code allocates a fixed 90%; here the default is 1.0, because about a fifth of the
+    /// this share. The paper's code allocates a fixed 90%; here the default is 1.0, because about 15 % of the
     /// allocated crossers are not seen crossing (`calibration::CROSSER_REALISATION`) and the paper's 75% target
     /// must stay reachable.
     pub max_crosser_ratio: f64,
