@@ -236,13 +236,19 @@ fn with_every_vehicle_ignoring_lights_the_reds_are_run_and_without_lights_nothin
     );
 
     // Lights off (the default): no light traced, no red-light event, and the same plan but for the setting.
+    // With lights on the planner counts on a lower realisation (`calibration::crosser_realisation`): a target
+    // scaled by the two realisations plans the same share of crossers.
     let (off_plan, off) = run("specs/pedsynth_pp.yaml", &["dataset.clips.count=2"]);
+    let scaled =
+        0.6 * pedsynth::calibration::CROSSER_REALISATION_WITH_SIGNALS / pedsynth::calibration::CROSSER_REALISATION;
+    let target = format!("crossing.target_ratio={scaled}");
     let (mut on_plan, _) = run(
         "specs/pedsynth_pp.yaml",
         &[
             "traffic.signals.enabled=true",
             "traffic.signals.crosswalk_share=0",
             "dataset.clips.count=2",
+            &target,
         ],
     );
     // With nobody placed at a signalised crosswalk, the lights change no draw of the clip scripts but the

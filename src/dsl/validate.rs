@@ -15,7 +15,11 @@ const MIX_TOLERANCE: f64 = 1e-6;
 /// Validates `spec` (already merged onto the defaults); `tree` is the user's YAML for locating problems.
 /// With `allow_large`, the sanity limits are not checked (`--allow-large`).
 pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, problems: &mut Vec<Problem>) {
-    let mut v = Validator { tree, problems };
+    let mut v = Validator {
+        tree,
+        problems,
+        realisation: crate::calibration::crosser_realisation(spec).0,
+    };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
     v.crossing(&spec.crossing);
@@ -88,12 +92,11 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
 /// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, the
 /// lowest is 0 (the planner lowers the baseline for targets below it: `planner::baseline_crosser_ratio`) and the
 /// highest is what its largest allocation yields once the measured share of planned crossers that end up
-/// labelled crossers is taken into account ([`crate::calibration::CROSSER_REALISATION`]).
-pub fn reachable_crossing_ratio(crossing: &Crossing) -> (f64, f64) {
+/// labelled crossers (`realisation`: [`crate::calibration::crosser_realisation`]) is taken into account.
+pub fn reachable_crossing_ratio(crossing: &Crossing, realisation: f64) -> (f64, f64) {
     let l1 = &crossing.layers.crosser_allocation;
     if l1.enabled {
-        let hi = (l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio)
-            * crate::calibration::CROSSER_REALISATION;
+        let hi = (l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio) * realisation;
         (0.0, hi)
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)
@@ -121,6 +124,8 @@ fn is_identifier(name: &str) -> bool {
 struct Validator<'a> {
     tree: &'a Node,
     problems: &'a mut Vec<Problem>,
+    /// The share of planned crossers expected to be labelled crossers (`calibration::crosser_realisation`).
+    realisation: f64,
 }
 
 impl Validator<'_> {
@@ -665,7 +670,7 @@ impl Validator<'_> {
         );
 
         let before = self.problems.len();
-        let (lo, hi) = reachable_crossing_ratio(c);
+        let (lo, hi) = reachable_crossing_ratio(c, self.realisation);
         let tolerance = if l.crosser_allocation.enabled { 1e-9 } else { 0.02 };
         let target_valid = (0.0..=1.0).contains(&c.target_ratio) && (0.0..=1.0).contains(&c.baseline_ratio);
         if self.problems.len() == before
@@ -682,7 +687,7 @@ impl Validator<'_> {
             } else if c.target_ratio > hi {
                 format!(
                     "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view), so with every pedestrian planned to cross the labelled ratio is about {}: lower the target",
-                    100.0 * crate::calibration::CROSSER_REALISATION,
+                    100.0 * self.realisation,
                     fmt_num(hi)
                 )
             } else {

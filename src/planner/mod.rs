@@ -456,7 +456,7 @@ fn crosser_shares(spec: &Spec) -> (f64, f64) {
     }
     // Plan enough crossers that the expected share labelled crossers in the dataset meets the target; allocated
     // and baseline crossers are labelled at the same measured rate.
-    let planned = (c.target_ratio / crate::calibration::CROSSER_REALISATION).clamp(0.0, 1.0);
+    let planned = (c.target_ratio / crate::calibration::crosser_realisation(spec).0).clamp(0.0, 1.0);
     if planned <= b {
         // The baseline alone would overshoot: it carries all the crossers, at the planned share.
         return (0.0, planned);

@@ -342,10 +342,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         stats.planned_crossing_ratio = round(stats.crossers as f64 / stats.pedestrians as f64, 4);
         // Allocated and baseline crossers alike end up labelled at the measured realisation (the planner
         // allocates on that assumption).
-        let (realisation, spread) = (
-            crate::calibration::CROSSER_REALISATION,
-            crate::calibration::CROSSER_REALISATION_SPREAD,
-        );
+        let (realisation, spread) = crate::calibration::crosser_realisation(spec);
         let crossers = stats.crossers as f64;
         let expected = crossers * realisation;
         stats.expected_crossing_ratio = round(expected / stats.pedestrians as f64, 4);

@@ -97,8 +97,9 @@ impl Default for Cyclists {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Signals {
-    /// Whether the lights run. Off by default: the crossing-rate calibration was measured without them (the ego
-    /// stopping at red lights changes when crossers are in view).
+    /// Whether the lights run. Off by default (the paper's set-up has none). With them on the planner counts on
+    /// the share of planned crossers seen crossing measured with lights (`calibration::crosser_realisation`:
+    /// crossers wait for "walk" and the ego stops at red lights, so fewer are seen crossing).
     pub enabled: bool,
     /// Green time of each phase, seconds (CARLA's default: 10).
     pub green_s: f64,
