@@ -16,7 +16,7 @@ use arrow_schema::{DataType, Field, Schema};
 use parquet::arrow::ArrowWriter;
 use parquet::basic::{Compression as ParquetCompression, ZstdLevel};
 use parquet::file::metadata::KeyValue;
-use parquet::file::properties::WriterProperties;
+use parquet::file::properties::{WriterProperties, WriterPropertiesBuilder};
 
 use crate::dsl::types::{Compression, Output, PoseFormat};
 use crate::error::{Error, code};
@@ -963,6 +963,19 @@ pub fn cyclists_batch(
 /// The Parquet writer settings of a dataset file: the spec's codec (zstd by default) and the file's key-value
 /// metadata.
 pub fn writer_properties(output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> WriterProperties {
+    properties_builder(output, meta, table, clip_id).build()
+}
+
+/// [`writer_properties`] for the DVS events: millions of rows of mostly distinct values, where dictionary pages
+/// cost time (interning every value) and zstd alone packs tighter (quickstart: 81.7 MB instead of 89.0 MB;
+/// the LiDAR's quantised columns are the other way round, 158 MB with dictionaries and 205 MB without).
+pub fn events_writer_properties(output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> WriterProperties {
+    properties_builder(output, meta, table, clip_id)
+        .set_dictionary_enabled(false)
+        .build()
+}
+
+fn properties_builder(output: &Output, meta: &FileMeta, table: &str, clip_id: &str) -> WriterPropertiesBuilder {
     let compression = match output.compression {
         Compression::Zstd => ParquetCompression::ZSTD(ZstdLevel::try_new(output.zstd_level as i32).unwrap_or_default()),
         Compression::Snappy => ParquetCompression::SNAPPY,
@@ -979,7 +992,6 @@ pub fn writer_properties(output: &Output, meta: &FileMeta, table: &str, clip_id:
             kv("pedsynth.table", table.to_owned()),
             kv("pedsynth.clip_id", clip_id.to_owned()),
         ]))
-        .build()
 }
 
 /// The error of a file that cannot be encoded as Parquet.

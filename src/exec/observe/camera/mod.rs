@@ -81,13 +81,20 @@ struct SunView {
 }
 
 impl SunView {
-    fn project(&self, p: Vec3) -> DVec3 {
+    /// Shadow-map pixel coordinates and depth towards the sun of a scene point.
+    #[inline]
+    fn project_f32(&self, p: Vec3) -> Vec3 {
         let d = p - self.centre;
-        DVec3::new(
-            f64::from(d.dot(self.u) * self.scale + SHADOW_PX as f32 * 0.5),
-            f64::from(d.dot(self.v) * self.scale + SHADOW_PX as f32 * 0.5),
-            f64::from(d.dot(self.dir)),
+        Vec3::new(
+            d.dot(self.u) * self.scale + SHADOW_PX as f32 * 0.5,
+            d.dot(self.v) * self.scale + SHADOW_PX as f32 * 0.5,
+            d.dot(self.dir),
         )
+    }
+
+    /// [`SunView::project_f32`] for the rasteriser.
+    fn project(&self, p: Vec3) -> DVec3 {
+        self.project_f32(p).as_dvec3()
     }
 }
 
@@ -280,15 +287,15 @@ impl Renderer {
     #[inline]
     fn sunlit(&self, p: Vec3, normal: Vec3) -> f32 {
         let Some(sun) = &self.sun else { return 1.0 };
-        let q = sun.project(p + normal * 0.05);
-        let (x, y) = (q.x as f32 - 0.5, q.y as f32 - 0.5);
+        let q = sun.project_f32(p + normal * 0.05);
+        let (x, y) = (q.x - 0.5, q.y - 0.5);
         let (x0, y0) = (shade::floor_f32(x), shade::floor_f32(y));
         if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
             return 1.0;
         }
         let (fx, fy) = (x - x0, y - y0);
         let i = y0 as usize * SHADOW_PX + x0 as usize;
-        let depth = q.z as f32 + 0.08;
+        let depth = q.z + 0.08;
         let lit = |k: usize| if self.shadow.key[k] > depth { 0.0 } else { 1.0 };
         let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
         let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;
@@ -371,7 +378,11 @@ impl Renderer {
             let p = cam + ray * z;
             let dist = ray.length() * z;
             let view = -ray / ray.length();
-            let shadow = if self.sun.is_some() {
+            // A flat surface turned away from the sun gets none of it whether in shadow or not (bodies shade
+            // with per-point normals).
+            let away =
+                prim.normal.dot(self.light.sun_dir) <= 0.0 && !matches!(prim.material, Material::Body | Material::Head);
+            let shadow = if self.sun.is_some() && !away {
                 self.sunlit(p, prim.normal)
             } else {
                 1.0
