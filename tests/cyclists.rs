@@ -198,3 +198,156 @@ fn a_dataset_with_cyclists_is_deterministic_and_its_tables_hold_together() {
     assert_eq!(s.cyclist_contacts, 0);
     assert!(s.min_overtaking_clearance_m.is_some_and(|c| c >= clearance - 1e-3));
 }
+
+/// CARLA's Town01 with every 0.3 m shoulder of a road outside junctions turned into a 1.5 m bike lane
+/// (OpenDRIVE lane type `biking`) beside the driving lane: the map's text changed in memory and written to
+/// `dir`, never into the repository. `None` (the test skips) where the CARLA maps are absent.
+fn town01_with_bike_lanes(dir: &Path) -> Option<std::path::PathBuf> {
+    let text = std::fs::read_to_string(common::carla_map("Town01")?).expect("read Town01");
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    while let Some(start) = rest.find("<road ") {
+        out.push_str(&rest[..start]);
+        let end = rest[start..].find("</road>").expect("road closes") + start;
+        let road = &rest[start..end];
+        if road[..road.find('>').expect("tag")].contains("junction=\"-1\"") {
+            let mut r = road;
+            while let Some(k) = r.find("type=\"shoulder\"") {
+                let close = r[k..].find("</lane>").expect("lane closes") + k;
+                out.push_str(&r[..k]);
+                out.push_str(
+                    &r[k..close]
+                        .replacen("type=\"shoulder\"", "type=\"biking\"", 1)
+                        .replace("a=\"2.9999999999999982e-1\"", "a=\"1.5\""),
+                );
+                r = &r[close..];
+            }
+            out.push_str(r);
+        } else {
+            out.push_str(road);
+        }
+        rest = &rest[end..];
+    }
+    out.push_str(rest);
+    let path = dir.join("bike_town.xodr");
+    std::fs::write(&path, out).expect("write the map");
+    Some(path)
+}
+
+/// The traces of a small dataset with four cyclists per clip on `town` (an OpenDRIVE file in `dir`).
+fn bike_traces(dir: &Path, town: &str) -> (pedsynth::world::RoadNetwork, Vec<pedsynth::exec::trace::ClipTrace>) {
+    let spec = dir.join(format!("{town}.yaml"));
+    std::fs::write(
+        &spec,
+        format!(
+            "version: 1\ndataset:\n  name: bike_lanes\n  seed: 5\n  towns: [{{name: {town}, opendrive: {town}.xodr}}]\n  \
+             weathers: [clear_noon]\n  clips: {{count: 8, per: weather}}\n  clip_duration_s: [15, 15]\n\
+             traffic:\n  cyclists: {{per_clip: [4, 4]}}\n"
+        ),
+    )
+    .expect("write the spec");
+    let options = LoadOptions {
+        overrides: common::NO_SENSORS.iter().map(|s| (*s).to_owned()).collect(),
+        allow_large: false,
+    };
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&spec, &options).unwrap_or_else(|e| panic!("{e}"));
+    let net = towns.values().next().expect("one town").network.clone();
+    let traces = plan
+        .clips
+        .iter()
+        .map(|clip| pedsynth::exec::simulate::simulate(clip, &plan.sim, &net))
+        .collect();
+    (net, traces)
+}
+
+#[test]
+fn cyclists_ride_in_the_bike_lanes_of_a_map_that_has_them() {
+    let scratch = common::Scratch::new("bike-lanes");
+    let Some(map) = town01_with_bike_lanes(scratch.path()) else {
+        return;
+    };
+    let summary = pedsynth::world::RoadNetwork::load(map.to_str().expect("utf-8 path"))
+        .expect("the map loads")
+        .summary();
+    assert!(summary.bike_lane_km > 1.0, "{summary:?}");
+    std::fs::copy(
+        common::carla_map("Town01").expect("Town01"),
+        scratch.path().join("plain_town.xodr"),
+    )
+    .expect("copy");
+
+    let (net, traces) = bike_traces(scratch.path(), "bike_town");
+    let (mut frames, mut in_lane, mut settled, mut settled_on_bike_lane) = (0usize, 0usize, 0usize, 0usize);
+    let mut passes_in_lane = 0usize;
+    for trace in &traces {
+        for cyclist in &trace.cyclists {
+            for (f, c) in cyclist.iter().enumerate() {
+                frames += 1;
+                in_lane += usize::from(c.in_bike_lane);
+                // A cyclist moves over 0.3 m per metre ridden: two seconds after it entered the bike lane it rides
+                // on it.
+                if f >= 60 && cyclist[f - 60..=f].iter().all(|x| x.in_bike_lane) {
+                    settled += 1;
+                    let hit = net.lane_at(c.pos.truncate());
+                    settled_on_bike_lane +=
+                        usize::from(hit.is_some_and(|h| h.lane_type == pedsynth::world::LaneType::Biking));
+                }
+            }
+        }
+        for e in &trace.events {
+            if let pedsynth::exec::trace::Event::OvertookCyclist { frame, cyclist, .. } = e {
+                passes_in_lane += usize::from(trace.cyclists[*cyclist as usize][*frame as usize].in_bike_lane);
+            }
+            assert!(
+                !matches!(
+                    e,
+                    pedsynth::exec::trace::Event::Contact {
+                        vehicle: pedsynth::exec::trace::VehicleId::Cyclist(_),
+                        ..
+                    }
+                ),
+                "{}: {e:?}",
+                trace.clip_id
+            );
+        }
+    }
+    eprintln!(
+        "bike lanes: {in_lane} of {frames} cyclist frames in a bike lane; {settled_on_bike_lane} of {settled} settled \
+         ones on a biking lane; {passes_in_lane} overtakes of a cyclist in a bike lane"
+    );
+    assert!(
+        frames > 0 && in_lane * 2 > frames,
+        "{in_lane} of {frames} cyclist frames in a bike lane"
+    );
+    assert!(
+        settled > 0 && settled_on_bike_lane * 100 >= settled * 99,
+        "{settled_on_bike_lane} of {settled} settled frames on a biking lane"
+    );
+    // Vehicles pass a cyclist in its own lane without moving out.
+    assert_eq!(
+        passes_in_lane, 0,
+        "vehicles moved out to overtake cyclists in bike lanes"
+    );
+
+    // The same map without bike lanes: cyclists ride by the edge of the driving lane.
+    let (_, plain) = bike_traces(scratch.path(), "plain_town");
+    assert!(
+        plain
+            .iter()
+            .flat_map(|t| &t.cyclists)
+            .flatten()
+            .all(|c| !c.in_bike_lane)
+    );
+    let overtakes = |traces: &[pedsynth::exec::trace::ClipTrace]| {
+        traces
+            .iter()
+            .flat_map(|t| &t.events)
+            .filter(|e| matches!(e, pedsynth::exec::trace::Event::OvertookCyclist { .. }))
+            .count()
+    };
+    eprintln!(
+        "overtakes with bike lanes {}, without {}",
+        overtakes(&traces),
+        overtakes(&plain)
+    );
+}

@@ -120,6 +120,9 @@ pub struct CyclistFrame {
     pub ridden_m: f64,
     /// Whether it is swerving around a pedestrian.
     pub swerving: bool,
+    /// Whether it rides in a bike lane (OpenDRIVE `biking`) beside its route's driving lane.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub in_bike_lane: bool,
     /// The state of the traffic light at the next stop line on its path, if one is within 80 m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub light: Option<LightState>,

@@ -54,6 +54,9 @@ pub fn town_show(name_or_path: &str, png: Option<&Path>, json: bool) -> Result<S
         s.bounds_m[1],
         s.bounds_m[3]
     );
+    if s.bike_lane_km > 0.0 {
+        out.push_str(&format!("  bike lanes {:.2} km\n", s.bike_lane_km));
+    }
     if s.signal_count > 0 {
         out.push_str(&format!(
             "  traffic lights: {} heads at {} junctions, {} controllers (phases)\n",

@@ -438,6 +438,8 @@ pub struct TownSummary {
     pub driving_lane_km: f64,
     /// Total centre-line length of sidewalk lanes, km, 2 decimals.
     pub sidewalk_km: f64,
+    /// Total centre-line length of bike lanes (OpenDRIVE `biking`), km, 2 decimals.
+    pub bike_lane_km: f64,
     /// Number of driving lanes in the lane graph that have at least one successor.
     pub routable_lane_count: usize,
     /// `[min_x, min_y, max_x, max_y]` of all lane pieces, metres, 1 decimal.
@@ -588,7 +590,8 @@ impl RoadNetwork {
     pub fn summary(&self) -> TownSummary {
         let km = |t: LaneType| {
             let m: f64 = self.lanes.iter().filter(|l| l.lane_type == t).map(|l| l.length_m).sum();
-            (m / 10.0).round() / 100.0
+            // `+ 0.0`: an empty sum is −0.0.
+            (m / 10.0).round() / 100.0 + 0.0
         };
         let r1 = |v: f64| (v * 10.0).round() / 10.0;
         TownSummary {
@@ -608,6 +611,7 @@ impl RoadNetwork {
                 .sum(),
             driving_lane_km: km(LaneType::Driving),
             sidewalk_km: km(LaneType::Sidewalk),
+            bike_lane_km: km(LaneType::Biking),
             routable_lane_count: self.lane_graph.routable_lane_count(),
             bounds_m: [
                 r1(self.bounds.0.x),

@@ -17,6 +17,8 @@ use crate::world::{LaneType, RoadNetwork, TravelDirection};
 
 const JOIN_M: f64 = 0.5;
 const JOIN_HEADING_RAD: f64 = 0.6;
+/// A bike lane counts as beside a driving lane across buffer lanes narrower than this, metres.
+pub const BIKE_LANE_BUFFER_MAX_M: f32 = 1.0;
 
 /// Centre-line points of a lane, in its direction of travel (reference direction if undirected).
 pub(crate) fn lane_centre_line(net: &RoadNetwork, lane: u32) -> Vec<DVec2> {
@@ -560,6 +562,67 @@ impl RoadNetwork {
             points[i].heading_rad = heading(points[a].pos, points[b].pos);
         }
         Some(Route { points })
+    }
+
+    /// The bike lane beside a driving lane on the right of its travel (OpenDRIVE lane type `biking`), in the same
+    /// lane section: the next lane outwards, or the first beyond narrow buffer lanes (border, shoulder or other,
+    /// less than [`BIKE_LANE_BUFFER_MAX_M`] wide).
+    pub fn bike_lane_beside(&self, lane: u32) -> Option<u32> {
+        let l = self.lanes.get(lane as usize)?;
+        let step = match (l.travel, l.lane_id.signum()) {
+            (TravelDirection::Forward, -1) => -1,
+            (TravelDirection::Backward, 1) => 1,
+            _ => return None,
+        };
+        let road = self.roads.get(l.road as usize)?;
+        let find = |id: i32| {
+            (road.lanes.start..road.lanes.end)
+                .find(|&k| self.lanes[k as usize].section == l.section && self.lanes[k as usize].lane_id == id)
+        };
+        let mut id = l.lane_id + step;
+        while let Some(k) = find(id) {
+            let next = &self.lanes[k as usize];
+            match next.lane_type {
+                LaneType::Biking => return Some(k),
+                LaneType::Border | LaneType::Shoulder | LaneType::Other
+                    if self.pieces[next.pieces.start as usize..next.pieces.end as usize]
+                        .iter()
+                        .all(|p| p.width_m[0].max(p.width_m[1]) < BIKE_LANE_BUFFER_MAX_M) => {}
+                _ => return None,
+            }
+            id += step;
+        }
+        None
+    }
+
+    /// Where a route along `lanes` (as [`RoadNetwork::route_through`] joins them) runs beside a bike lane: at
+    /// each route point, its arc length and the distance from the point to the centre line of the bike lane
+    /// beside its lane ([`RoadNetwork::bike_lane_beside`]), or `None` where there is none. Empty where the
+    /// route has no bike lane at all.
+    pub fn bike_lane_offsets(&self, lanes: &[u32]) -> Vec<(f64, Option<f64>)> {
+        let beside: HashMap<u32, (u32, Vec<DVec2>)> = lanes
+            .iter()
+            .filter_map(|&l| self.bike_lane_beside(l).map(|b| (l, (b, lane_centre_line(self, b)))))
+            .collect();
+        if beside.is_empty() {
+            return Vec::new();
+        }
+        let Some(route) = self.route_through(lanes) else {
+            return Vec::new();
+        };
+        route
+            .points
+            .iter()
+            .map(|q| {
+                let offset = beside.get(&q.lane).map(|(_, line)| {
+                    line.windows(2)
+                        .map(|w| crate::world::segment_projection(w[0], w[1], q.pos).1)
+                        .fold(f64::INFINITY, f64::min)
+                        .sqrt()
+                });
+                (q.s_m, offset)
+            })
+            .collect()
     }
 
     /// Spawn points every `spacing_m` along the centre lines of routable driving lanes outside junctions.

@@ -173,6 +173,7 @@ mod tests {
             crank_phase,
             ridden_m: 3.0,
             swerving: false,
+            in_bike_lane: false,
             light: None,
         }
     }

@@ -731,7 +731,9 @@ impl StaticScene {
                 let z = f64::from(piece.z_m);
                 let q: [Vec3; 4] = piece.corners.map(|c| b.rel(DVec3::new(c.x, c.y, z)));
                 let (material, tag, albedo) = match lane.lane_type {
-                    LaneType::Driving | LaneType::Parking | LaneType::Biking => (Material::Road, tag::ROAD, asphalt),
+                    LaneType::Driving | LaneType::Parking => (Material::Road, tag::ROAD, asphalt),
+                    // Red-coloured asphalt, as many cities surface their bike lanes (CARLA has no tag for them).
+                    LaneType::Biking => (Material::Road, tag::ROAD, asphalt * Vec3::new(1.45, 0.8, 0.75)),
                     LaneType::Sidewalk => (Material::Sidewalk, tag::SIDEWALK, pavement),
                     LaneType::Shoulder | LaneType::Border => (Material::Road, tag::ROAD, asphalt * 1.1),
                     LaneType::Median | LaneType::Other => (Material::Sidewalk, tag::GROUND, ground),

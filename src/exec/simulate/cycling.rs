@@ -58,6 +58,7 @@ pub(super) fn decide(vehicles: &mut [Vehicle], peds: &[PedView], c: &Cyclists, i
     // Cyclists: swerve around a pedestrian standing in the riding line, where the swerve clears it.
     for v in vehicles.iter_mut().filter(|v| v.is_cyclist()) {
         v.swerving_for = None;
+        v.follow_bike_lane();
         v.target_offset_m = v.ride_offset_m;
         if let Some((k, left_m)) = nearest_ped_in_line(v, peds) {
             let p = &peds[k];

@@ -277,6 +277,7 @@ impl<'a> Sim<'a> {
                 crank_phase: (v.odometer_m * CRANK_TURNS_PER_M).fract(),
                 ridden_m: v.odometer_m,
                 swerving: v.swerving_for.is_some(),
+                in_bike_lane: v.in_bike_lane,
                 light: v.light_ahead.map(|(_, state)| state),
             });
         }

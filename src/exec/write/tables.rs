@@ -26,7 +26,7 @@ use crate::planner::ClipScript;
 use crate::world::LaneType;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 8;
+pub const SCHEMA_VERSION: u32 = 9;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
 pub const TABLES: [&str; 11] = [
@@ -904,6 +904,7 @@ pub fn cyclists_batch(
             field("accel_mps2", DataType::Float32, false),
             field("crank_phase", DataType::Float32, false),
             field("swerving", DataType::Boolean, false),
+            field("in_bike_lane", DataType::Boolean, false),
             field("ignores_lights", DataType::Boolean, false),
             field("light_state", DataType::Utf8, true),
             field("rider_height_m", DataType::Float32, false),
@@ -932,6 +933,7 @@ pub fn cyclists_batch(
             f32c(|f| f.accel_mps2),
             f32c(|f| f.crank_phase),
             Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.2.swerving)))),
+            Arc::new(BooleanArray::from_iter(rows.iter().map(|r| Some(r.2.in_bike_lane)))),
             Arc::new(BooleanArray::from_iter(
                 rows.iter()
                     .map(|r| Some(script_of(r.1).is_some_and(|c| c.ignores_lights))),

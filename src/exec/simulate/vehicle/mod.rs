@@ -49,8 +49,11 @@ pub const BICYCLE_HEIGHT_M: f64 = 1.7;
 /// Lateral margin of a cyclist's corridor for pedestrians beyond the bicycle and the pedestrian, metres (a
 /// bicycle passes a walker closer than a car does).
 pub(crate) const CYCLIST_PED_MARGIN_M: f64 = 0.3;
-/// Sideways metres per metre ridden while a cyclist swerves or returns.
+/// Sideways metres per metre ridden while a cyclist swerves or returns (or moves into or out of a bike lane).
 const SWERVE_PER_M: f64 = 0.3;
+/// A cyclist looks this far ahead along its route for the end of its bike lane, to be back by its driving lane's
+/// edge there (3 m sideways at [`SWERVE_PER_M`]), metres.
+pub(crate) const BIKE_LANE_LOOKAHEAD_M: f64 = 10.0;
 /// Sideways metres per metre driven while a vehicle moves out to overtake a cyclist or back in.
 const OVERTAKE_SHIFT_PER_M: f64 = 0.15;
 
@@ -65,8 +68,14 @@ pub(crate) struct Vehicle {
     pub half_width_m: f64,
     /// A cyclist's cruising speed, m/s (motor vehicles: `None`, their speed follows the limit).
     pub cruise_mps: Option<f64>,
-    /// A cyclist rides this far right of its path (the lane's centre line), metres.
+    /// A cyclist rides this far right of its path (the lane's centre line), metres: `edge_offset_m` from the
+    /// lane's right edge, or the centre of a bike lane beside it ([`Vehicle::ride_offsets`]).
     pub ride_offset_m: f64,
+    /// A cyclist's ride offset along its path where its route has a bike lane: `(s from, offset, in a bike
+    /// lane)`, metres, in path order (empty where the route has none: the offset stays `ride_offset_m`).
+    pub ride_offsets: Vec<(f64, f64, bool)>,
+    /// Whether a cyclist rides in a bike lane at its current position.
+    pub in_bike_lane: bool,
     /// Where it is across its lane: metres to the right of the path (a cyclist's ride offset, less a swerve;
     /// negative for a vehicle moved out to overtake). Its corridor is centred here.
     pub lane_offset_m: f64,
@@ -191,8 +200,14 @@ impl Vehicle {
         v.half_width_m = 0.5 * BICYCLE_WIDTH_M;
         v.cruise_mps = Some(script.speed_mps.max(0.1));
         v.ride_offset_m = ride_offset_m;
-        v.lane_offset_m = ride_offset_m;
-        v.target_offset_m = ride_offset_m;
+        v.ride_offsets = net
+            .bike_lane_offsets(&script.route.lanes_in(net))
+            .into_iter()
+            .map(|(s, bike)| (s, bike.unwrap_or(ride_offset_m), bike.is_some()))
+            .collect();
+        v.follow_bike_lane();
+        v.lane_offset_m = v.ride_offset_m;
+        v.target_offset_m = v.ride_offset_m;
         v.place();
         v.speed_mps = v.target_speed_mps();
         v
@@ -210,6 +225,28 @@ impl Vehicle {
             return lateral_m;
         }
         (self.signed_lateral_m(p, s_p) + self.lane_offset_m).abs()
+    }
+
+    /// Sets a cyclist's ride offset for where it is now: a bike lane's centre where its route has one beside
+    /// it, else `edge_offset_m` from its lane's edge. It leaves a bike lane early enough to be back at the edge
+    /// offset where the lane ends ([`BIKE_LANE_LOOKAHEAD_M`]); it enters one where it begins.
+    pub fn follow_bike_lane(&mut self) {
+        if self.ride_offsets.is_empty() {
+            return;
+        }
+        let k = self.ride_offsets.partition_point(|&(s, ..)| s <= self.s_m).max(1) - 1;
+        let ahead = self.s_m + BIKE_LANE_LOOKAHEAD_M;
+        let window = self.ride_offsets[k..]
+            .iter()
+            .enumerate()
+            .take_while(|&(i, o)| i == 0 || o.0 < ahead);
+        let (mut offset, mut in_lane) = (f64::INFINITY, true);
+        for (_, &(_, o, bike)) in window {
+            offset = offset.min(o);
+            in_lane &= bike;
+        }
+        self.ride_offset_m = offset;
+        self.in_bike_lane = in_lane;
     }
 
     /// Where `p` lies across the path at arc length `s_p`: metres to the left (negative: right).
@@ -277,6 +314,8 @@ impl Vehicle {
             half_width_m: HALF_WIDTH_M,
             cruise_mps: None,
             ride_offset_m: 0.0,
+            ride_offsets: Vec::new(),
+            in_bike_lane: false,
             lane_offset_m: 0.0,
             target_offset_m: 0.0,
             overtaking: None,
