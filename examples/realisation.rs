@@ -95,9 +95,11 @@ fn main() {
         });
         let share = |a: usize, b: usize| if b == 0 { 0.0 } else { a as f64 / b as f64 };
         println!(
-            "{spec}: {} pedestrians ({:.3} never annotated); allocated crossers {}: on a driving lane {:.3}, labelled {:.3}, never annotated {:.3}; baseline crossers {}: labelled {:.3}",
+            "{spec}: {} pedestrians ({:.3} never annotated), crossing ratio {:.3} (target {}); allocated crossers {}: on a driving lane {:.3}, labelled {:.3}, never annotated {:.3}; baseline crossers {}: labelled {:.3}",
             t[0],
             share(t[7], t[0]),
+            share(t[2] + t[5], t[0]),
+            plan.spec.crossing.target_ratio,
             t[1],
             share(t[3], t[1]),
             share(t[2], t[1]),

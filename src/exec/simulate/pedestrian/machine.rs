@@ -126,7 +126,10 @@ fn timeline_allows(p: &Ped, lead_s: f64) -> bool {
     let cut_short = percept.ego_speed_mps > CUT_SHORT_EGO_SPEED_MPS
         && percept.ego_dist_m < CUT_SHORT_EGO_DISTANCE_M
         && p.in_view_s >= CUT_SHORT_MIN_IN_VIEW_S;
-    !percept.ego_ahead || (p.seen_long_enough(lead_s) && p.followers_seen) || cut_short
+    // At a signalised crosswalk the green man, not the camera, sets the moment: the ego waits at its red light
+    // (often behind a queue that hides the curb), and the crossing happens in front of it.
+    let on_walk = percept.walk == Some(WalkSignal::Walk);
+    !percept.ego_ahead || (p.seen_long_enough(lead_s) && p.followers_seen) || cut_short || on_walk
 }
 
 /// Whether the ego is so close ahead, and moving, that stepping out now would put the crosser under its wheels.

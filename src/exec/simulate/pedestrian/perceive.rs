@@ -7,7 +7,7 @@ use super::Ped;
 use super::params::{BLOCKING_CLEARANCE_M, CONFLICT_MIN_VEHICLE_SPEED_MPS};
 use super::state::Activity;
 use crate::exec::observe::rig::CameraPose;
-use crate::exec::simulate::signals::WalkSignal;
+use crate::exec::simulate::signals::{LightState, WalkSignal};
 use crate::exec::simulate::vehicle::{HALF_LENGTH_M, HALF_WIDTH_M, Vehicle};
 use crate::exec::simulate::view::ViewProxy;
 use crate::exec::simulate::{PED_RADIUS_M, ttc};
@@ -82,6 +82,14 @@ pub(crate) struct Surroundings<'a> {
     pub dt_s: f64,
 }
 
+/// Whether `v`'s light binds it, shows red or amber, and its stop line is before its front reaches `pos`.
+fn held_short_of(v: &Vehicle, pos: DVec2) -> bool {
+    v.bound_by_light()
+        && v.light_ahead.is_some_and(|(gap_m, state)| {
+            state != LightState::Green && gap_m < v.pose.pos.distance(pos) - v.half_length_m
+        })
+}
+
 /// Updates `p.percept` from the vehicles' state at the start of the step (`vehicles[0]` is the ego), and the
 /// time the camera has seen the pedestrian. `probes` is scratch space.
 pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings, probes: &mut Vec<DVec2>) {
@@ -105,8 +113,20 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings,
     }
     let range_m = params.gap_acceptance.vehicle_range_m;
     let percept = &mut p.percept;
-    percept.min_ttc_s = ttc::min_ttc_s(pos, vehicles.iter().map(|v| (v.pose.pos, v.velocity())), range_m);
-    percept.min_ttc_others_s = ttc::min_ttc_s(pos, traffic.iter().map(|v| (v.pose.pos, v.velocity())), range_m);
+    // At "walk", a vehicle that its red (or amber) light holds short of the pedestrian stops at its line: no
+    // threat to a crossing on the green man (those that run the light, or cannot stop, still count).
+    let walk = percept.walk == Some(WalkSignal::Walk);
+    let threat = |v: &&Vehicle| !(walk && held_short_of(v, pos));
+    percept.min_ttc_s = ttc::min_ttc_s(
+        pos,
+        vehicles.iter().filter(threat).map(|v| (v.pose.pos, v.velocity())),
+        range_m,
+    );
+    percept.min_ttc_others_s = ttc::min_ttc_s(
+        pos,
+        traffic.iter().filter(threat).map(|v| (v.pose.pos, v.velocity())),
+        range_m,
+    );
     percept.nearest_vehicle_m = vehicles
         .iter()
         .map(|v| v.pose.pos.distance(pos))
