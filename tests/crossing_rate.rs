@@ -3,8 +3,10 @@
 //! than 1,000 pedestrians and check that `pedsynth stats` (computed from the written tables only) reports a
 //! sequence-level crossing ratio within ±3 percentage points of the target (the paper reports 62.5% for a 60%
 //! target). Rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline alone gives, so the planner
-//! lowers the baseline) land within 1 percentage point. Slow statistical tests: they run with
-//! `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
+//! lowers the baseline) land within 1 percentage point. Crossing-heavy targets (0.9, 0.93: above what the
+//! spec's layers reach, so the planner makes every pedestrian a crosser, drops crossing groups and starts more
+//! crossers mid-road) land within 1.5 percentage points, and a target beyond the heaviest adaptation is refused
+//! with the reason. Slow statistical tests: they run with `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
 
 mod common;
 
@@ -72,6 +74,60 @@ fn rare_event_targets_below_the_baseline_are_met_within_1_pp() {
         if target == 0.0 {
             assert_eq!(stats.crossing, 0, "a target of 0 plans no crosser");
         }
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
+
+#[test]
+fn crossing_heavy_targets_are_met_by_adapting_the_layers() {
+    // The adaptation is planned, and a target past the heaviest one is refused (fast checks first).
+    let plan = |target: f64| {
+        let options = pedsynth::dsl::LoadOptions {
+            overrides: vec![format!("crossing.target_ratio={target}")],
+            allow_large: false,
+        };
+        pedsynth::commands::plan_spec_file(std::path::Path::new("tests/data/specs/heldout_crossing.yaml"), &options)
+    };
+    let (_, _, heavy) = plan(0.93).unwrap_or_else(|e| panic!("{e}"));
+    let a = pedsynth::planner::crossing_adaptation(&heavy.spec).expect("0.93 needs an adaptation");
+    assert_eq!(a.max_crosser_ratio, 1.0);
+    assert_eq!(a.group_probability, 0.0);
+    assert!(a.midroad_share > heavy.spec.crossing.layers.midroad_jaywalkers.share_of_crossers);
+    assert!((a.realisation - 0.93).abs() < 1e-9, "{a:?}");
+    assert!(
+        heavy
+            .clips
+            .iter()
+            .flat_map(|c| &c.pedestrians)
+            .all(|p| p.group.is_none())
+    );
+    let (_, _, light) = plan(0.86).unwrap_or_else(|e| panic!("{e}"));
+    let b = pedsynth::planner::crossing_adaptation(&light.spec).expect("0.86 needs an adaptation");
+    assert!(b.group_probability > 0.0 && b.group_probability < light.spec.crossing.layers.groups.probability);
+    let (_, _, usual) = plan(0.6).unwrap_or_else(|e| panic!("{e}"));
+    assert!(pedsynth::planner::crossing_adaptation(&usual.spec).is_none());
+    let refused = format!(
+        "{:?}",
+        plan(0.95).err().expect("0.95 is beyond the heaviest adaptation")
+    );
+    assert!(refused.contains("unreachable_target"), "{refused}");
+
+    if !common::slow_tests("the crossing-heavy crossing-rate sweep") {
+        return;
+    }
+    for target in [0.9, 0.93] {
+        let (out, stats) = generate(target);
+        eprintln!(
+            "target {target}: achieved {:.3} over {} pedestrians",
+            stats.achieved_crossing_ratio, stats.pedestrians
+        );
+        assert!(stats.pedestrians >= 1000, "{} pedestrians", stats.pedestrians);
+        let achieved = stats.achieved_crossing_ratio;
+        assert!(
+            (achieved - target).abs() <= 0.015,
+            "target {target}: achieved {achieved:.3} over {} pedestrians",
+            stats.pedestrians
+        );
         std::fs::remove_dir_all(&out).ok();
     }
 }

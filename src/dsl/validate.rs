@@ -19,6 +19,7 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
         tree,
         problems,
         realisation: crate::calibration::crosser_realisation(spec).0,
+        heavy_realisation: crate::calibration::adapted_realisations(spec).1,
     };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
@@ -91,13 +92,13 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
 
 /// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, the
 /// lowest is 0 (the planner lowers the baseline for targets below it: `planner::baseline_crosser_ratio`) and the
-/// highest is what its largest allocation yields once the measured share of planned crossers that end up
-/// labelled crossers (`realisation`: [`crate::calibration::crosser_realisation`]) is taken into account.
-pub fn reachable_crossing_ratio(crossing: &Crossing, realisation: f64) -> (f64, f64) {
+/// highest is the measured share of planned crossers that end up labelled crossers when every pedestrian is a
+/// crosser under the planner's most crossing-heavy adaptation of the layers (`heavy_realisation`:
+/// [`crate::calibration::adapted_realisations`]; `planner::crossing_adaptation`).
+pub fn reachable_crossing_ratio(crossing: &Crossing, heavy_realisation: f64) -> (f64, f64) {
     let l1 = &crossing.layers.crosser_allocation;
     if l1.enabled {
-        let hi = (l1.max_crosser_ratio + (1.0 - l1.max_crosser_ratio) * crossing.baseline_ratio) * realisation;
-        (0.0, hi)
+        (0.0, heavy_realisation)
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)
     }
@@ -126,6 +127,9 @@ struct Validator<'a> {
     problems: &'a mut Vec<Problem>,
     /// The share of planned crossers expected to be labelled crossers (`calibration::crosser_realisation`).
     realisation: f64,
+    /// The same under the planner's most crossing-heavy adaptation of the layers
+    /// (`calibration::adapted_realisations`).
+    heavy_realisation: f64,
 }
 
 impl Validator<'_> {
@@ -670,7 +674,7 @@ impl Validator<'_> {
         );
 
         let before = self.problems.len();
-        let (lo, hi) = reachable_crossing_ratio(c, self.realisation);
+        let (lo, hi) = reachable_crossing_ratio(c, self.heavy_realisation);
         let tolerance = if l.crosser_allocation.enabled { 1e-9 } else { 0.02 };
         let target_valid = (0.0..=1.0).contains(&c.target_ratio) && (0.0..=1.0).contains(&c.baseline_ratio);
         if self.problems.len() == before
@@ -682,12 +686,11 @@ impl Validator<'_> {
                     "with `crossing.layers.crosser_allocation` off only the baseline ({}) crosses: enable it, or set `target_ratio` to the baseline",
                     fmt_num(lo)
                 )
-            } else if c.target_ratio > hi && l.crosser_allocation.max_crosser_ratio < 1.0 {
-                "raise `crossing.layers.crosser_allocation.max_crosser_ratio`, or lower the target".to_owned()
             } else if c.target_ratio > hi {
                 format!(
-                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view), so with every pedestrian planned to cross the labelled ratio is about {}: lower the target",
+                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view); with every pedestrian planned to cross, none in a group and {:.0} % starting mid-road (the planner's most crossing-heavy layers) the labelled ratio is about {}: lower the target",
                     100.0 * self.realisation,
+                    100.0 * crate::calibration::HEAVY_MIDROAD_SHARE,
                     fmt_num(hi)
                 )
             } else {

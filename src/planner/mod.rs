@@ -23,6 +23,7 @@ use glam::DVec2;
 use rand::RngExt;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha20Rng;
+use serde::Serialize;
 
 use crate::dsl::types::{ClipsPer, Spec, TownRef, WeatherRef};
 use crate::world::{LaneType, RoadNetwork};
@@ -446,6 +447,77 @@ pub fn adapted_baseline(spec: &Spec) -> Option<(f64, f64)> {
     (used < b).then_some((b, used))
 }
 
+/// How the planner adapts the spec's crossing layers to a target above what they reach: every pedestrian may be
+/// a crosser (`max_crosser_ratio` 1), then fewer crossing groups (a single does not wait at the curb for its
+/// companions, so more are seen crossing), then more mid-road jaywalkers (they start on the road), up to
+/// [`crate::calibration::CROSSER_REALISATION_HEAVY`]. `pedsynth plan` prints it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CrossingAdaptation {
+    /// The share of pedestrians layer 1 may allocate (the spec's `max_crosser_ratio` lifted to 1).
+    pub max_crosser_ratio: f64,
+    /// The group probability used (the spec's `crossing.layers.groups.probability`, or less).
+    pub group_probability: f64,
+    /// The share of crossers starting mid-road used (the spec's layer 3 share, or more).
+    pub midroad_share: f64,
+    /// The share of planned crossers expected to be labelled crossers under these layers.
+    pub realisation: f64,
+}
+
+/// The planner's adaptation of the crossing layers for `spec`'s target, if the spec's own layers do not reach
+/// it ([`CrossingAdaptation`]); `None` with layer 1 off or a target they reach.
+pub fn crossing_adaptation(spec: &Spec) -> Option<CrossingAdaptation> {
+    let c = &spec.crossing;
+    let l = &c.layers;
+    if !l.crosser_allocation.enabled {
+        return None;
+    }
+    let r0 = crate::calibration::crosser_realisation(spec).0;
+    let (r_singles, r_heavy) = crate::calibration::adapted_realisations(spec);
+    let t = c.target_ratio;
+    let b = c.baseline_ratio.clamp(0.0, 1.0);
+    let max = l.crosser_allocation.max_crosser_ratio.clamp(0.0, 1.0);
+    if t <= (max + (1.0 - max) * b) * r0 + 1e-12 {
+        return None;
+    }
+    let groups = if l.groups.enabled {
+        l.groups.probability.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let midroad = if l.midroad_jaywalkers.enabled {
+        l.midroad_jaywalkers.share_of_crossers.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut a = CrossingAdaptation {
+        max_crosser_ratio: 1.0,
+        group_probability: groups,
+        midroad_share: midroad,
+        realisation: r0,
+    };
+    if t <= r0 {
+        return Some(a);
+    }
+    // Fewer groups, in proportion, until none.
+    if groups > 0.0 {
+        let x = ((t - r0) / (r_singles - r0)).min(1.0);
+        a.group_probability = groups * (1.0 - x);
+        a.realisation = r0 + (r_singles - r0) * x;
+        if x < 1.0 {
+            return Some(a);
+        }
+        a.group_probability = 0.0;
+    }
+    // Then more mid-road jaywalkers, up to the heaviest mix measured.
+    let m1 = crate::calibration::HEAVY_MIDROAD_SHARE.max(midroad);
+    if r_heavy > a.realisation {
+        let y = ((t - a.realisation) / (r_heavy - a.realisation)).clamp(0.0, 1.0);
+        a.midroad_share = midroad + (m1 - midroad) * y;
+        a.realisation += (r_heavy - a.realisation) * y;
+    }
+    Some(a)
+}
+
 /// (layer 1's allocated share, the baseline share of the rest).
 fn crosser_shares(spec: &Spec) -> (f64, f64) {
     let c = &spec.crossing;
@@ -453,6 +525,12 @@ fn crosser_shares(spec: &Spec) -> (f64, f64) {
     let b = c.baseline_ratio.clamp(0.0, 1.0);
     if !l1.enabled {
         return (0.0, b);
+    }
+    if let Some(a) = crossing_adaptation(spec) {
+        // Above what the spec's layers reach: as many crossers as the adapted layers' realisation needs.
+        let planned = (c.target_ratio / a.realisation).clamp(0.0, 1.0);
+        let r = if b >= 1.0 { 0.0 } else { (planned - b) / (1.0 - b) };
+        return (r.clamp(0.0, a.max_crosser_ratio), b);
     }
     // Plan enough crossers that the expected share labelled crossers in the dataset meets the target; allocated
     // and baseline crossers are labelled at the same measured rate.
@@ -618,10 +696,13 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
     // Layer 4: group units among each clip's allocated crossers. A group starts at a crosser with probability
     // q, chosen so that the expected share of grouped crossers is the spec's group probability.
     let g = &c.layers.groups;
+    let adaptation = crossing_adaptation(spec);
     let mut group_rng = seeds::rng_for(seed, &tag("groups"));
     let triple_share = g.size_mix.triples / (g.size_mix.pairs + g.size_mix.triples).max(1e-12);
     let mean_size = 2.0 + triple_share;
-    let f = g.probability.clamp(0.0, 1.0);
+    let f = adaptation
+        .map_or(g.probability, |a| a.group_probability)
+        .clamp(0.0, 1.0);
     let q = if g.enabled {
         (f / (mean_size - f * (mean_size - 1.0))).clamp(0.0, 1.0)
     } else {
@@ -655,11 +736,12 @@ fn allocate_pedestrians(spec: &Spec, stratum: &Stratum, basics: &[ClipBasics]) -
     // group shares one behaviour: groups take the behaviour with the most room left, singles fill the rest.
     let total: usize = units.iter().map(Vec::len).sum();
     let l3 = &c.layers.midroad_jaywalkers;
-    let midroad = if l3.enabled {
-        quota::largest_remainder(total, &[l3.share_of_crossers, 1.0 - l3.share_of_crossers])[0]
-    } else {
-        0
+    let midroad_share = match adaptation {
+        Some(a) => a.midroad_share,
+        None if l3.enabled => l3.share_of_crossers,
+        None => 0.0,
     };
+    let midroad = quota::largest_remainder(total, &[midroad_share, 1.0 - midroad_share])[0];
     let mix = &c.layers.behaviour_mix;
     let mix_shares = if mix.enabled {
         [mix.mix.normal, mix.mix.sudden, mix.mix.jaywalk]

@@ -159,6 +159,9 @@ pub struct PlanStats {
     /// The baseline the planner used when it lowered the spec's `baseline_ratio` to meet a low target (else
     /// none).
     pub adapted_baseline: Option<AdaptedBaseline>,
+    /// How the planner adapted the crossing layers to a target above what the spec's layers reach (else none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adapted_layers: Option<super::CrossingAdaptation>,
     /// Target crossing ratio.
     pub target_crossing_ratio: f64,
     /// Pedestrians per archetype.
@@ -237,6 +240,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
             spec_ratio,
             used_ratio: round(used, 4),
         }),
+        adapted_layers: super::crossing_adaptation(spec),
         target_crossing_ratio: plan.target_crossing_ratio,
         archetypes: spec.pedestrians.archetype_mix.keys().map(|k| (k.clone(), 0)).collect(),
         behaviours: Behaviour::ALL.iter().map(|b| (b.name().to_owned(), 0)).collect(),
@@ -343,6 +347,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         // Allocated and baseline crossers alike end up labelled at the measured realisation (the planner
         // allocates on that assumption).
         let (realisation, spread) = crate::calibration::crosser_realisation(spec);
+        let realisation = super::crossing_adaptation(spec).map_or(realisation, |a| a.realisation);
         let crossers = stats.crossers as f64;
         let expected = crossers * realisation;
         stats.expected_crossing_ratio = round(expected / stats.pedestrians as f64, 4);
@@ -520,6 +525,16 @@ impl std::fmt::Display for PlanStats {
             stats.expected_crossing_ratio_sd,
             stats.target_crossing_ratio
         )?;
+        if let Some(a) = &stats.adapted_layers {
+            writeln!(
+                out,
+                "note: the target is above what the spec's crossing layers reach, so the planner adapted them: up to {:.0} % of the pedestrians crossers, crossing groups at probability {:.3}, {:.3} of the crossers starting mid-road (expected realisation {:.3})",
+                100.0 * a.max_crosser_ratio,
+                a.group_probability,
+                a.midroad_share,
+                a.realisation
+            )?;
+        }
         if let Some(b) = &stats.adapted_baseline {
             writeln!(
                 out,

@@ -117,9 +117,10 @@ pub struct CrosserAllocation {
     /// Whether the layer is on.
     pub enabled: bool,
     /// Largest share of pedestrians allocated as crossers. The planner allocates what the target needs, up to
-    /// this share. The paper's code allocates a fixed 90%; here the default is 1.0, because about 15 % of the
-    /// allocated crossers are not seen crossing (`calibration::CROSSER_REALISATION`) and the paper's 75% target
-    /// must stay reachable.
+    /// this share (lifted to 1.0, with a note in `pedsynth plan`, for a target this share does not reach). The
+    /// paper's code allocates a fixed 90%; here the default is 1.0, because about 15 % of the allocated crossers
+    /// are not seen crossing (`calibration::CROSSER_REALISATION`) and the paper's 75% target must stay
+    /// reachable.
     pub max_crosser_ratio: f64,
     /// Crossers spawn on sidewalks this far ahead of the ego vehicle along its route, metres.
     pub spawn_ahead_m: Range,
