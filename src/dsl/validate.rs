@@ -19,7 +19,7 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
         tree,
         problems,
         realisation: crate::calibration::crosser_realisation(spec).0,
-        heavy_realisation: crate::calibration::adapted_realisations(spec).1,
+        heavy_realisation: crate::calibration::heaviest_realisation(spec),
     };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
@@ -98,7 +98,10 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
 pub fn reachable_crossing_ratio(crossing: &Crossing, heavy_realisation: f64) -> (f64, f64) {
     let l1 = &crossing.layers.crosser_allocation;
     if l1.enabled {
-        (0.0, heavy_realisation)
+        (
+            0.0,
+            (heavy_realisation + crate::calibration::HEAVY_TARGET_TOLERANCE).min(1.0),
+        )
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)
     }
@@ -688,10 +691,9 @@ impl Validator<'_> {
                 )
             } else if c.target_ratio > hi {
                 format!(
-                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view); with every pedestrian planned to cross, none in a group and {:.0} % starting mid-road (the planner's most crossing-heavy layers) the labelled ratio is about {}: lower the target",
+                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view); with every pedestrian planned to cross, none in a group and all starting mid-road (the planner's most crossing-heavy layers) the labelled ratio is about {}: lower the target",
                     100.0 * self.realisation,
-                    100.0 * crate::calibration::HEAVY_MIDROAD_SHARE,
-                    fmt_num(hi)
+                    fmt_num(self.heavy_realisation)
                 )
             } else {
                 "lower `crossing.baseline_ratio`, or raise the target".to_owned()

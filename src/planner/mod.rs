@@ -449,8 +449,8 @@ pub fn adapted_baseline(spec: &Spec) -> Option<(f64, f64)> {
 
 /// How the planner adapts the spec's crossing layers to a target above what they reach: every pedestrian may be
 /// a crosser (`max_crosser_ratio` 1), then fewer crossing groups (a single does not wait at the curb for its
-/// companions, so more are seen crossing), then more mid-road jaywalkers (they start on the road), up to
-/// [`crate::calibration::CROSSER_REALISATION_HEAVY`]. `pedsynth plan` prints it.
+/// companions, so more are seen crossing), then more mid-road jaywalkers (they start on the road), up to all of
+/// them ([`crate::calibration::MIDROAD_LADDER`]). `pedsynth plan` prints it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CrossingAdaptation {
     /// The share of pedestrians layer 1 may allocate (the spec's `max_crosser_ratio` lifted to 1).
@@ -472,7 +472,7 @@ pub fn crossing_adaptation(spec: &Spec) -> Option<CrossingAdaptation> {
         return None;
     }
     let r0 = crate::calibration::crosser_realisation(spec).0;
-    let (r_singles, r_heavy) = crate::calibration::adapted_realisations(spec);
+    let (r_singles, ladder) = crate::calibration::adapted_realisations(spec);
     let t = c.target_ratio;
     let b = c.baseline_ratio.clamp(0.0, 1.0);
     let max = l.crosser_allocation.max_crosser_ratio.clamp(0.0, 1.0);
@@ -508,12 +508,17 @@ pub fn crossing_adaptation(spec: &Spec) -> Option<CrossingAdaptation> {
         }
         a.group_probability = 0.0;
     }
-    // Then more mid-road jaywalkers, up to the heaviest mix measured.
-    let m1 = crate::calibration::HEAVY_MIDROAD_SHARE.max(midroad);
-    if r_heavy > a.realisation {
-        let y = ((t - a.realisation) / (r_heavy - a.realisation)).clamp(0.0, 1.0);
-        a.midroad_share = midroad + (m1 - midroad) * y;
-        a.realisation += (r_heavy - a.realisation) * y;
+    // Then more mid-road jaywalkers, along the measured ladder (linear between its steps), up to all of them.
+    let mut from = (midroad, a.realisation);
+    let base = a.realisation;
+    for &(share, realisation) in ladder.iter().filter(|s| s.0 > midroad && s.1 > base) {
+        let y = ((t - from.1) / (realisation - from.1)).clamp(0.0, 1.0);
+        a.midroad_share = from.0 + (share - from.0) * y;
+        a.realisation = from.1 + (realisation - from.1) * y;
+        if y < 1.0 {
+            break;
+        }
+        from = (share, realisation);
     }
     Some(a)
 }
