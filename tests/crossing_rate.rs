@@ -1,8 +1,8 @@
 //! Crossing-rate control, end to end, on a spec the calibration was not fitted on
-//! (`tests/data/specs/heldout_crossing.yaml`): for targets 0.4, 0.5, 0.6 and 0.75, generate a dataset of more
-//! than 1,000 pedestrians and check that `pedsynth stats` (computed from the written tables only) reports a
-//! sequence-level crossing ratio within ±3 percentage points of the target (the paper reports 62.5% for a 60%
-//! target). Rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline alone gives, so the planner
+//! (`tests/data/specs/heldout_crossing.yaml`): for every target 0, 0.05, 0.1, ..., 0.95, 1, generate a dataset
+//! of more than 1,000 pedestrians and check the sequence-level crossing ratio that `pedsynth stats` (computed
+//! from the written tables only) reports. Targets 0.15 to 0.85 land within ±2 percentage points (the paper
+//! reports 62.5% for a 60% target; measured misses up to 1.6 pp). Rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline alone gives, so the planner
 //! lowers the baseline) land within 1 percentage point. Crossing-heavy targets (0.9, 0.95, 1: above what the
 //! spec's layers reach, so the planner makes every pedestrian a crosser, drops crossing groups and starts more
 //! crossers mid-road) land within 1.5 percentage points. Slow statistical tests: they run with `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
@@ -30,11 +30,12 @@ fn generate(target: f64) -> (PathBuf, stats::DatasetStats) {
 }
 
 #[test]
-fn achieved_crossing_ratio_on_a_held_out_spec_is_within_3_pp_of_the_target() {
+fn achieved_crossing_ratio_on_a_held_out_spec_is_within_2_pp_of_the_target() {
     if !common::slow_tests("the crossing-rate sweep") {
         return;
     }
-    for target in [0.4, 0.5, 0.6, 0.75] {
+    for target in (3..=17).map(|k| f64::from(k) * 0.05) {
+        let target = (target * 100.0).round() / 100.0;
         let (out, stats) = generate(target);
         eprintln!(
             "target {target}: achieved {:.3} over {} pedestrians",
@@ -44,7 +45,7 @@ fn achieved_crossing_ratio_on_a_held_out_spec_is_within_3_pp_of_the_target() {
         assert_eq!(stats.target_crossing_ratio, Some(target));
         let achieved = stats.achieved_crossing_ratio;
         assert!(
-            (achieved - target).abs() <= 0.03,
+            (achieved - target).abs() <= 0.02,
             "target {target}: achieved {achieved:.3} over {} pedestrians",
             stats.pedestrians
         );
