@@ -64,10 +64,6 @@ pub const MIDROAD_LADDER: [(f64, f64, f64); 4] = [
     (1.0, 0.988, 0.988),
 ];
 
-/// How far above the heaviest adaptation's realisation a target is still accepted (it is then missed by at most
-/// this much: a target of 1 lands near 0.988).
-pub const HEAVY_TARGET_TOLERANCE: f64 = 0.015;
-
 /// For `spec`'s lights: the realisation of singles, and the mid-road ladder `(share, realisation)` above it.
 pub fn adapted_realisations(spec: &crate::dsl::types::Spec) -> (f64, [(f64, f64); 4]) {
     let lights = spec.traffic.signals.enabled;
@@ -78,12 +74,6 @@ pub fn adapted_realisations(spec: &crate::dsl::types::Spec) -> (f64, [(f64, f64)
         CROSSER_REALISATION_SINGLES
     };
     (singles, ladder)
-}
-
-/// The highest realisation the planner's adaptations reach for `spec` (every crosser a single, all starting
-/// mid-road).
-pub fn heaviest_realisation(spec: &crate::dsl::types::Spec) -> f64 {
-    adapted_realisations(spec).1[MIDROAD_LADDER.len() - 1].1
 }
 
 /// The realisation the planner counts on for `spec` and its spread between specs: with or without traffic

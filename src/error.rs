@@ -134,7 +134,7 @@ pub const CODES: &[CodeInfo] = &[
     ),
     input(
         spec::UNREACHABLE_TARGET,
-        "a target crossing ratio that the enabled layers cannot reach",
+        "a target crossing ratio that the enabled layers cannot reach (only with `crossing.layers.crosser_allocation` off: the planner meets every target in [0, 1] with it on)",
     ),
     input(spec::UNSUPPORTED_VERSION, "a `version` other than 1"),
     input(

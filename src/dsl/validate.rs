@@ -15,12 +15,7 @@ const MIX_TOLERANCE: f64 = 1e-6;
 /// Validates `spec` (already merged onto the defaults); `tree` is the user's YAML for locating problems.
 /// With `allow_large`, the sanity limits are not checked (`--allow-large`).
 pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, problems: &mut Vec<Problem>) {
-    let mut v = Validator {
-        tree,
-        problems,
-        realisation: crate::calibration::crosser_realisation(spec).0,
-        heavy_realisation: crate::calibration::heaviest_realisation(spec),
-    };
+    let mut v = Validator { tree, problems };
     v.dataset(&spec.dataset, base_dir);
     v.pedestrians(&spec.pedestrians);
     v.crossing(&spec.crossing);
@@ -90,18 +85,14 @@ pub fn rough_dataset_bytes(spec: &Spec) -> f64 {
     frames * per_frame
 }
 
-/// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, the
-/// lowest is 0 (the planner lowers the baseline for targets below it: `planner::baseline_crosser_ratio`) and the
-/// highest is the measured share of planned crossers that end up labelled crossers when every pedestrian is a
-/// crosser under the planner's most crossing-heavy adaptation of the layers (`heavy_realisation`:
-/// [`crate::calibration::adapted_realisations`]; `planner::crossing_adaptation`).
-pub fn reachable_crossing_ratio(crossing: &Crossing, heavy_realisation: f64) -> (f64, f64) {
+/// The share of pedestrians the enabled layers can make cross, as `(lowest, highest)`. With layer 1 on, every
+/// target: the planner lowers the baseline for targets below it (`planner::baseline_crosser_ratio`) and adapts
+/// the layers for targets above what they reach (`planner::crossing_adaptation`; a target of 1 lands near
+/// [`crate::calibration::MIDROAD_LADDER`]'s last realisation, which `pedsynth plan` prints).
+pub fn reachable_crossing_ratio(crossing: &Crossing) -> (f64, f64) {
     let l1 = &crossing.layers.crosser_allocation;
     if l1.enabled {
-        (
-            0.0,
-            (heavy_realisation + crate::calibration::HEAVY_TARGET_TOLERANCE).min(1.0),
-        )
+        (0.0, 1.0)
     } else {
         (crossing.baseline_ratio, crossing.baseline_ratio)
     }
@@ -128,11 +119,6 @@ fn is_identifier(name: &str) -> bool {
 struct Validator<'a> {
     tree: &'a Node,
     problems: &'a mut Vec<Problem>,
-    /// The share of planned crossers expected to be labelled crossers (`calibration::crosser_realisation`).
-    realisation: f64,
-    /// The same under the planner's most crossing-heavy adaptation of the layers
-    /// (`calibration::adapted_realisations`).
-    heavy_realisation: f64,
 }
 
 impl Validator<'_> {
@@ -677,27 +663,18 @@ impl Validator<'_> {
         );
 
         let before = self.problems.len();
-        let (lo, hi) = reachable_crossing_ratio(c, self.heavy_realisation);
+        let (lo, hi) = reachable_crossing_ratio(c);
         let tolerance = if l.crosser_allocation.enabled { 1e-9 } else { 0.02 };
         let target_valid = (0.0..=1.0).contains(&c.target_ratio) && (0.0..=1.0).contains(&c.baseline_ratio);
         if self.problems.len() == before
             && target_valid
             && (c.target_ratio > hi + tolerance || c.target_ratio < lo - tolerance)
         {
-            let help = if !l.crosser_allocation.enabled {
-                format!(
-                    "with `crossing.layers.crosser_allocation` off only the baseline ({}) crosses: enable it, or set `target_ratio` to the baseline",
-                    fmt_num(lo)
-                )
-            } else if c.target_ratio > hi {
-                format!(
-                    "about {:.0} % of planned crossers end up labelled crossers (the others cross after the ego has passed or out of its view); with every pedestrian planned to cross, none in a group and all starting mid-road (the planner's most crossing-heavy layers) the labelled ratio is about {}: lower the target",
-                    100.0 * self.realisation,
-                    fmt_num(self.heavy_realisation)
-                )
-            } else {
-                "lower `crossing.baseline_ratio`, or raise the target".to_owned()
-            };
+            // Only the baseline can miss a target: with layer 1 on, the planner reaches every target in [0, 1].
+            let help = format!(
+                "with `crossing.layers.crosser_allocation` off only the baseline ({}) crosses: enable it, or set `target_ratio` to the baseline",
+                fmt_num(lo)
+            );
             let problem = Problem::new(
                 code::UNREACHABLE_TARGET,
                 format!(

@@ -531,21 +531,20 @@ fn crosser_shares(spec: &Spec) -> (f64, f64) {
     if !l1.enabled {
         return (0.0, b);
     }
-    if let Some(a) = crossing_adaptation(spec) {
-        // Above what the spec's layers reach: as many crossers as the adapted layers' realisation needs.
-        let planned = (c.target_ratio / a.realisation).clamp(0.0, 1.0);
-        let r = if b >= 1.0 { 0.0 } else { (planned - b) / (1.0 - b) };
-        return (r.clamp(0.0, a.max_crosser_ratio), b);
-    }
     // Plan enough crossers that the expected share labelled crossers in the dataset meets the target; allocated
-    // and baseline crossers are labelled at the same measured rate.
-    let planned = (c.target_ratio / crate::calibration::crosser_realisation(spec).0).clamp(0.0, 1.0);
+    // and baseline crossers are labelled at the same measured rate (that of the adapted layers, above what the
+    // spec's layers reach).
+    let (realisation, max) = match crossing_adaptation(spec) {
+        Some(a) => (a.realisation, a.max_crosser_ratio),
+        None => (crate::calibration::crosser_realisation(spec).0, l1.max_crosser_ratio),
+    };
+    let planned = (c.target_ratio / realisation).clamp(0.0, 1.0);
     if planned <= b {
         // The baseline alone would overshoot: it carries all the crossers, at the planned share.
         return (0.0, planned);
     }
     let r = if b >= 1.0 { 0.0 } else { (planned - b) / (1.0 - b) };
-    (r.clamp(0.0, l1.max_crosser_ratio), b)
+    (r.clamp(0.0, max), b)
 }
 
 /// The draws of a stratum: each clip's basics, then the stratum's pedestrian allocations and driving profiles.
