@@ -40,15 +40,16 @@ fn main() {
         let rig = Rig::from_spec(&plan.spec.sensors);
         // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled,
         // allocated never annotated, pedestrians never annotated, unlabelled allocated crossers that never had
-        // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated)
-        let counts: Vec<[usize; 11]> = plan
+        // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated, allocated in
+        // clips with an emergency vehicle, ... labelled)
+        let counts: Vec<[usize; 13]> = plan
             .clips
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
                 let trace = simulate::simulate(clip, &plan.sim, net);
                 let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
-                let mut c = [0usize; 11];
+                let mut c = [0usize; 13];
                 for (i, p) in clip.pedestrians.iter().enumerate() {
                     c[0] += 1;
                     let labelled = usize::from(ann.pedestrians[i].crosser);
@@ -60,6 +61,10 @@ fn main() {
                     match (p.role, p.crosser_source) {
                         (Role::Crosser, CrosserSource::Allocated) => {
                             c[1] += 1;
+                            if clip.vehicles.iter().any(|v| v.emergency.is_some()) {
+                                c[11] += 1;
+                                c[12] += labelled;
+                            }
                             c[2] += labelled;
                             c[3] += usize::from(on_road);
                             c[6] += unseen;
@@ -87,8 +92,8 @@ fn main() {
                 c
             })
             .collect();
-        let t = counts.iter().fold([0usize; 11], |mut acc, c| {
-            for k in 0..11 {
+        let t = counts.iter().fold([0usize; 13], |mut acc, c| {
+            for k in 0..13 {
                 acc[k] += c[k];
             }
             acc
@@ -114,5 +119,14 @@ fn main() {
             share(t[9], t[1]),
             share(t[10], t[1])
         );
+        if t[11] > 0 {
+            println!(
+                "  allocated crossers labelled in clips with an emergency vehicle {:.3} ({}), in the others {:.3} ({})",
+                share(t[12], t[11]),
+                t[11],
+                share(t[2] - t[12], t[1] - t[11]),
+                t[1] - t[11]
+            );
+        }
     }
 }

@@ -171,6 +171,7 @@ fn clip(
         vehicles,
         pedestrians,
         cyclists: Vec::new(),
+        signal_offsets: Vec::new(),
         timeline_extension_s: 0.0,
     }
 }

@@ -14,6 +14,8 @@ pub mod prepared;
 pub mod quota;
 pub mod script;
 pub mod seeds;
+pub mod signal_plans;
+mod staging;
 pub mod stats;
 
 use std::collections::BTreeMap;
@@ -868,13 +870,13 @@ fn plan_clip(
         });
         match placed {
             Ok((pedestrians, vehicles)) => {
-                planned = Some((ego, pedestrians, vehicles));
+                planned = Some((route, ego, pedestrians, vehicles));
                 break;
             }
             Err(e) => last_error = e,
         }
     }
-    let Some((ego, pedestrians, mut vehicles)) = planned else {
+    let Some((route, ego, pedestrians, mut vehicles)) = planned else {
         return Err(format!("{last_error} (tried {ROUTE_ATTEMPTS} ego routes)"));
     };
     if let Some(kind) = basics.emergency {
@@ -890,11 +892,27 @@ fn plan_clip(
         )?);
     }
     let cyclists = plan_cyclists(spec, town, &ego.route, &pedestrians, &vehicles, needed_m, basics.seed);
-    // The clip lasts at least as long as its crossers' timelines, up to a cap.
+    // Where lights run, the clip's signalised crossing is staged (the ego waits at red in front of it), and the
+    // ego's red-light waits count in the crossers' timelines.
     let cruise_mps = ego_cruise_mps(net, &ego);
+    let timing = &spec.traffic.signals;
+    let lights = timing.enabled && !net.signals.is_empty();
+    let signal_offsets: Vec<(u32, f64)> = if lights {
+        staging::staged_offset(net, timing, basics.seed, &route, &pedestrians, cruise_mps)
+            .into_iter()
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let plans = lights.then(|| signal_plans::SignalPlans::new(net, timing, basics.seed).with_offsets(&signal_offsets));
+    let schedule = match &plans {
+        Some(plans) => staging::EgoSchedule::with_lights(cruise_mps, net, &route, plans),
+        None => staging::EgoSchedule::cruising(cruise_mps),
+    };
+    // The clip lasts at least as long as its crossers' timelines, up to a cap.
     let needed_s = pedestrians
         .iter()
-        .filter_map(|p| timeline_duration_s(p, cruise_mps))
+        .filter_map(|p| timeline_duration_s(p, &schedule, plans.as_ref().map(|plans| (plans, net))))
         .fold(0.0, f64::max);
     let extension_s = (needed_s - duration_s).clamp(0.0, (MAX_TIMELINE_EXTENSION - 1.0) * duration_s);
     let frame_count = if extension_s > 0.0 {
@@ -916,6 +934,7 @@ fn plan_clip(
         vehicles,
         pedestrians,
         cyclists,
+        signal_offsets,
         timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
     })
 }
@@ -945,16 +964,29 @@ fn ego_cruise_mps(net: &RoadNetwork, ego: &EgoScript) -> f64 {
     (limit * (1.0 - ego.speed_below_limit_pct / 100.0)).max(1.0)
 }
 
-/// The time a crosser's timeline needs from the clip's start, seconds: until it is in view (the ego comes within
-/// view, or it walks to its curb), its time in view, and the crossing.
-fn timeline_duration_s(p: &PedestrianScript, cruise_mps: f64) -> Option<f64> {
+/// The time a crosser's timeline needs from the clip's start, seconds: until it is in view (the ego, waiting at
+/// red lights on the way, comes within view, or it walks to its curb), its time in view, and the crossing. At a
+/// signalised crosswalk (where `lights` run) "walk" sets the moment instead: the first after it has reached its
+/// curb and checked.
+fn timeline_duration_s(
+    p: &PedestrianScript,
+    schedule: &staging::EgoSchedule,
+    lights: Option<(&signal_plans::SignalPlans, &RoadNetwork)>,
+) -> Option<f64> {
     let in_view_s = p.in_view_before_crossing_s?;
     let crossing = p.crossing.as_ref()?;
     let speed = p.base_speed_mps.max(0.3);
     let curb = crossing.near_curb - crossing.direction * CURB_STANDOFF_M;
     let approach_s = p.spawn.distance(curb) / speed;
-    let into_view_s = (p.ahead_of_ego_m - VIEW_DISTANCE_ESTIMATE_M).max(0.0) / cruise_mps;
-    Some(approach_s.max(into_view_s) + in_view_s + crossing.carriageway_width_m / speed + CROSSING_MARGIN_S)
+    let into_view_s = schedule.time_at(p.ahead_of_ego_m - VIEW_DISTANCE_ESTIMATE_M);
+    let signal = lights
+        .filter(|_| !p.red_light_violator)
+        .and_then(|(plans, net)| Some((plans, net, staging::crossing_signal(net, p)?)));
+    let start_s = match signal {
+        Some((plans, net, signal)) => staging::walk_start_s(plans, net, signal, approach_s + staging::SIGNAL_CHECK_S),
+        None => approach_s.max(into_view_s) + in_view_s,
+    };
+    Some(start_s + crossing.carriageway_width_m / speed + CROSSING_MARGIN_S)
 }
 
 fn route_script(route: &Route, start_s_m: f64) -> RouteScript {

@@ -127,6 +127,10 @@ pub struct ClipScript {
     /// Cyclists (`traffic.cyclists`; absent from the plan file when there are none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cyclists: Vec<CyclistScript>,
+    /// Signal offsets the planner sets in place of the drawn ones, (junction index, offset into its cycle in
+    /// seconds): the junction where it stages the clip's signalised crossing. Empty without traffic lights.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub signal_offsets: Vec<(u32, f64)>,
     /// How much the clip was lengthened beyond its drawn duration so that its crossers' timelines fit, seconds.
     pub timeline_extension_s: f64,
 }

@@ -181,7 +181,7 @@ impl<'a> Sim<'a> {
             .signals
             .as_ref()
             .filter(|_| !net.signals.is_empty())
-            .map(|t| signals::SignalPlans::new(net, t, script.seed));
+            .map(|t| signals::SignalPlans::new(net, t, script.seed).with_offsets(&script.signal_offsets));
         if lights.is_some() {
             // A pedestrian whose crossing runs along a signalised crosswalk heeds its signal.
             for p in &mut peds {

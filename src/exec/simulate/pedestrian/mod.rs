@@ -28,7 +28,7 @@ use rand::RngExt;
 use rand_chacha::ChaCha20Rng;
 
 use crate::dsl::types::SpeedProfileMultipliers;
-use crate::exec::trace::{Gesture, PedState, PedestrianId};
+use crate::exec::trace::{Gesture, PedState, PedestrianId, WalkSignal};
 use crate::planner::{Behaviour, CrosserSource, PedestrianScript, Role, SimParams, SpawnPlace, SpeedProfile};
 use crate::world::{LaneType, RoadNetwork};
 use params::{CHECK_MIN_S, CURB_STANDOFF_M, DISTRACTION_EPISODE_S, FINISH_BEYOND_CURB_M, STANDING_SHARE};
@@ -384,16 +384,23 @@ impl Ped {
             .is_none_or(|t| self.in_view_s + lead_s >= t)
     }
 
+    /// Whether its signalised crosswalk shows "don't walk" (or flashes) and it is not one to cross against the
+    /// signal: it waits for "walk", and drivers with green do not stop for it.
+    pub fn waits_for_walk(&self) -> bool {
+        self.percept.walk.is_some_and(|w| w != WalkSignal::Walk) && !self.traits.red_light_violator
+    }
+
     /// Whether it heads for its curb point or waits there (a crosser or hard negative on the sidewalk, not yet
     /// across): what makes the ego ease off.
     pub fn heading_for_curb(&self) -> bool {
-        self.traits.line.is_some() && !self.attempt.over() && !self.activity.crossing_motion()
+        !self.waits_for_walk() && self.traits.line.is_some() && !self.attempt.over() && !self.activity.crossing_motion()
     }
 
     /// Whether it waits at its curb point attentively (looking, checking the traffic, hesitating): what makes the
     /// ego stop short and let it go.
     pub fn waiting_at_curb(&self) -> bool {
-        self.attempt.at_curb()
+        !self.waits_for_walk()
+            && self.attempt.at_curb()
             && !self.attempt.over()
             && matches!(
                 self.activity,

@@ -189,8 +189,9 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     body.gait_phase = (body.gait_phase + dist / STRIDE_M).fract();
     p.state_time_s += dt;
     // The patience clock runs while waiting at the curb for a gap: once the crosser's timeline would let it go
-    // (seen long enough, or the ego has passed), not while it waits for the approaching ego.
-    let trying = !p.percept.ego_ahead || p.seen_long_enough(0.0);
+    // (seen long enough, or the ego has passed), not while it waits for the approaching ego, nor while it waits
+    // for "walk" at a signalised crosswalk (waiting for the signal is no gap to lose patience over).
+    let trying = (!p.percept.ego_ahead || p.seen_long_enough(0.0)) && !p.waits_for_walk();
     if let Attempt::Undecided {
         at_curb: true,
         waited_s,
