@@ -42,7 +42,7 @@ fn main() {
         // allocated never annotated, pedestrians never annotated, unlabelled allocated crossers that never had
         // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated, allocated in
         // clips with an emergency vehicle, ... labelled)
-        let counts: Vec<[usize; 13]> = plan
+        let per_clip: Vec<(&str, [usize; 13])> = plan
             .clips
             .par_iter()
             .map(|clip| {
@@ -89,9 +89,17 @@ fn main() {
                         _ => {}
                     }
                 }
-                c
+                (clip.town.as_str(), c)
             })
             .collect();
+        let counts: Vec<[usize; 13]> = per_clip.iter().map(|&(_, c)| c).collect();
+        // Allocated crossers and those labelled, per town.
+        let mut towns_seen: std::collections::BTreeMap<&str, (usize, usize)> = std::collections::BTreeMap::new();
+        for &(town, c) in &per_clip {
+            let e = towns_seen.entry(town).or_default();
+            e.0 += c[1];
+            e.1 += c[2];
+        }
         let t = counts.iter().fold([0usize; 13], |mut acc, c| {
             for k in 0..13 {
                 acc[k] += c[k];
@@ -119,6 +127,11 @@ fn main() {
             share(t[9], t[1]),
             share(t[10], t[1])
         );
+        let by_town: Vec<String> = towns_seen
+            .iter()
+            .map(|(town, &(n, l))| format!("{town} {:.3} ({n})", share(l, n)))
+            .collect();
+        println!("  allocated crossers labelled per town: {}", by_town.join(", "));
         if t[11] > 0 {
             println!(
                 "  allocated crossers labelled in clips with an emergency vehicle {:.3} ({}), in the others {:.3} ({})",
