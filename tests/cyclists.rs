@@ -18,14 +18,7 @@ const SPEC: &str = "specs/pedsynth_pp.yaml";
 const CYCLISTS: [&str; 2] = ["traffic.cyclists.per_clip=[2, 4]", "dataset.clips.count=4"];
 
 fn plan(overrides: &[&str]) -> pedsynth::planner::Plan {
-    let options = LoadOptions {
-        overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
-        allow_large: false,
-    };
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(SPEC);
-    pedsynth::commands::plan_spec_file(&path, &options)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .2
+    common::plan_spec(SPEC, overrides).1
 }
 
 #[test]

@@ -8,7 +8,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use arrow_array::Array;
-use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::read::tables;
 use pedsynth::exec::write::Layout;
 
@@ -20,14 +19,7 @@ const EMERGENCY: [&str; 3] = [
 ];
 
 fn plan(overrides: &[&str]) -> pedsynth::planner::Plan {
-    let options = LoadOptions {
-        overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
-        allow_large: false,
-    };
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(SPEC);
-    pedsynth::commands::plan_spec_file(&path, &options)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .2
+    common::plan_spec(SPEC, overrides).1
 }
 
 #[test]

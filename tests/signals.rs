@@ -7,9 +7,7 @@
 mod common;
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
-use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::simulate;
 use pedsynth::exec::trace::{ClipTrace, Event, LightState, VehicleId};
 use pedsynth::planner::{ClipScript, Plan};
@@ -17,12 +15,7 @@ use pedsynth::world::RoadNetwork;
 
 /// Plans `spec` with `overrides` and simulates every clip.
 fn run(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
-    let options = LoadOptions {
-        overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
-        allow_large: false,
-    };
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(spec);
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
+    let (towns, plan) = common::plan_spec(spec, overrides);
     let traces = simulate::simulate_all(&plan, &towns).expect("towns present");
     (plan, traces)
 }
@@ -355,12 +348,10 @@ fn staged_signalised_crossings_are_seen_crossing_on_walk() {
     // there), so the crossers waiting at signalised crosswalks step out on "walk" in front of the ego, which
     // waits at red, and are labelled crossers. Measured 2026-11-26 on the held-out spec (lights on): 124 of 134
     // labelled (0.93; 358 of 379 on PedSynth++), against 87 of 134 (0.65; 292 of 379) without the staging.
-    let options = LoadOptions {
-        overrides: vec!["traffic.signals.enabled=true".to_owned()],
-        allow_large: false,
-    };
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/heldout_crossing.yaml");
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
+    let (towns, plan) = common::plan_spec(
+        "tests/data/specs/heldout_crossing.yaml",
+        &["traffic.signals.enabled=true"],
+    );
     let rig = pedsynth::exec::observe::rig::Rig::from_spec(&plan.spec.sensors);
     let (mut staged, mut heeding, mut labelled) = (0, 0, 0);
     for clip in &plan.clips {

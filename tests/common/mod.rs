@@ -8,7 +8,7 @@
 //!   by skipping.
 //! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
 //!
-//! Also: `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
+//! Also: planning a spec with `--set` overrides (`plan_spec`), `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
 //! sensors off (`NO_SENSORS`, `NO_CAMERAS`), and the --jobs 1 / --jobs 2 comparison.
 #![allow(dead_code)]
 
@@ -351,4 +351,22 @@ pub fn assert_resume_rewrites_clip(
         all_files(out) == *want,
         "a resumed run differs from an uninterrupted one"
     );
+}
+
+/// Plans `spec` (a path relative to the repository) with the `--set` `overrides`: its towns and its plan.
+/// Panics with the diagnostic when the spec does not plan.
+pub fn plan_spec(
+    spec: &str,
+    overrides: &[&str],
+) -> (
+    std::collections::BTreeMap<String, pedsynth::planner::TownContext>,
+    pedsynth::planner::Plan,
+) {
+    let options = pedsynth::dsl::LoadOptions {
+        overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
+        allow_large: false,
+    };
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(spec);
+    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
+    (towns, plan)
 }

@@ -460,13 +460,7 @@ pub fn annotate(
                 !matches!(occ, Occluder::Person { owner, .. } if *owner == RIDER_OWNER_BASE + ci as u32)
                     && may_block(occ, cam.centre.truncate(), ground, 1.5)
             }));
-            let samples = [
-                rider.capsules[0].a,
-                rider.capsules[0].b,
-                rider.capsules[2].a,
-                (rider.capsules[7].a + rider.capsules[7].b) * 0.5,
-                (rider.capsules[8].a + rider.capsules[8].b) * 0.5,
-            ];
+            let samples = rider.occlusion_samples();
             let mut keypoints = [0f32; 51];
             let mut keypoints_3d = [0f32; 51];
             let mut hidden = 0u32;
@@ -480,8 +474,7 @@ pub fn annotate(
                 } else {
                     2.0
                 };
-                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
-                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
+                set_keypoint((&mut keypoints, &mut keypoints_3d), k, p.px, flag, *joint);
             }
             for sample in samples {
                 hidden += u32::from(occluded(town, &near, cam.centre, sample));
@@ -542,13 +535,7 @@ pub fn annotate(
                 continue;
             }
             // Keypoints and occlusion: the 17 joints plus torso and head samples.
-            let samples = [
-                pose.capsules[0].a,
-                pose.capsules[0].b,
-                pose.capsules[2].a,
-                (pose.capsules[7].a + pose.capsules[7].b) * 0.5,
-                (pose.capsules[8].a + pose.capsules[8].b) * 0.5,
-            ];
+            let samples = pose.occlusion_samples();
             let projected = pose.joints.map(|j| cam.project(j));
             let inside = projected.map(|p| p.depth_m > 0.05 && cam.in_image(p.px));
             let seen = inside.iter().map(|&i| u32::from(i)).sum::<u32>() + samples.len() as u32;
@@ -583,8 +570,7 @@ pub fn annotate(
                 } else {
                     2.0
                 };
-                keypoints[3 * k..3 * k + 3].copy_from_slice(&[p.px.x as f32, p.px.y as f32, flag]);
-                keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
+                set_keypoint((&mut keypoints, &mut keypoints_3d), k, p.px, flag, *joint);
             }
             let mut rejected = too_hidden(hidden);
             for sample in samples {
@@ -639,6 +625,19 @@ pub fn annotate(
     }
     out.crossing = labels;
     out
+}
+
+/// Writes joint `k` into a row's keypoint arrays: its pixel `px` with visibility `flag` (COCO's 0 / 1 / 2), and
+/// its world position.
+fn set_keypoint(
+    (keypoints, keypoints_3d): (&mut [f32; 51], &mut [f32; 51]),
+    k: usize,
+    px: DVec2,
+    flag: f32,
+    joint: DVec3,
+) {
+    keypoints[3 * k..3 * k + 3].copy_from_slice(&[px.x as f32, px.y as f32, flag]);
+    keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
 }
 
 #[cfg(test)]

@@ -150,6 +150,33 @@ const STAND_MPS: f64 = 0.15;
 /// Speed above which the gait is a run, m/s.
 const RUN_MPS: f64 = 2.4;
 
+impl BodyPose {
+    /// The points besides the 17 joints whose occlusion counts towards a body's: both ends of the torso, the
+    /// head's centre and the middle of both thighs (the capsules of [`silhouette`]'s layout).
+    pub fn occlusion_samples(&self) -> [DVec3; 5] {
+        let c = &self.capsules;
+        [c[0].a, c[0].b, c[2].a, (c[7].a + c[7].b) * 0.5, (c[8].a + c[8].b) * 0.5]
+    }
+}
+
+/// The head's keypoints (nose, left and right eye, left and right ear) and its centre for a body of height
+/// `h` whose neck is at `neck` and whose head is turned by `head_rot` about it: the one head layout of walkers
+/// and riders (COCO-17's first five joints).
+pub(crate) fn head_points(neck: DVec3, head_rot: DMat3, h: f64) -> ([DVec3; 5], DVec3) {
+    let head_point =
+        |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
+    (
+        [
+            head_point(0.06, 0.0, 0.92),
+            head_point(0.05, 0.018, 0.936),
+            head_point(0.05, -0.018, 0.936),
+            head_point(-0.005, 0.045, 0.93),
+            head_point(-0.005, -0.045, 0.93),
+        ],
+        head_point(0.0, 0.0, 0.93),
+    )
+}
+
 /// The capsules of a body of height `h` from its joints in the body frame (COCO order) and its torso points
 /// `[pelvis, chest, neck, head centre]`, placed in the world by `to_world`: the same silhouette for a walker
 /// and a cyclist's rider.
@@ -270,14 +297,7 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     // Head: turned by the head yaw about the neck, pitched down when reading a phone.
     let neck = DVec3::new(0.0, 0.0, 0.87 * h);
     let head_rot = DMat3::from_rotation_z(frame.head_yaw_rad) * DMat3::from_rotation_y(head_pitch);
-    let head_point =
-        |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
-    let nose = head_point(0.06, 0.0, 0.92);
-    let l_eye = head_point(0.05, 0.018, 0.936);
-    let r_eye = head_point(0.05, -0.018, 0.936);
-    let l_ear = head_point(-0.005, 0.045, 0.93);
-    let r_ear = head_point(-0.005, -0.045, 0.93);
-    let head_centre = head_point(0.0, 0.0, 0.93);
+    let ([nose, l_eye, r_eye, l_ear, r_ear], head_centre) = head_points(neck, head_rot, h);
 
     let local = [
         nose, l_eye, r_eye, l_ear, r_ear, l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist, l_hip, r_hip,

@@ -83,13 +83,7 @@ pub fn rider_pose(frame: &CyclistFrame, height_m: f64) -> BodyPose {
     let (l_shoulder, l_elbow, l_wrist) = arm(1.0);
     let (r_shoulder, r_elbow, r_wrist) = arm(-1.0);
     // The head is level (the rider looks ahead), its points placed around the neck as in the standing body.
-    let head_point = |x: f64, y: f64, z: f64| neck + DVec3::new(x, y, z - 0.87) * h;
-    let nose = head_point(0.06, 0.0, 0.92);
-    let l_eye = head_point(0.05, 0.018, 0.936);
-    let r_eye = head_point(0.05, -0.018, 0.936);
-    let l_ear = head_point(-0.005, 0.045, 0.93);
-    let r_ear = head_point(-0.005, -0.045, 0.93);
-    let head_centre = head_point(0.0, 0.0, 0.93);
+    let ([nose, l_eye, r_eye, l_ear, r_ear], head_centre) = super::body::head_points(neck, DMat3::IDENTITY, h);
 
     let local = [
         nose, l_eye, r_eye, l_ear, r_ear, l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist, l_hip, r_hip,
