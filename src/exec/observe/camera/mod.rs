@@ -366,12 +366,12 @@ impl Renderer {
         let sw = w * SS;
         let inv_f = 1.0 / f;
         let inv_ss = 1.0 / SS as f32;
-        // The colour of one sample (or of the pixel centre when all samples agree), fogged.
-        let shade_at = |prim_id: u32, key: f32, u: f32, v: f32| -> Vec3 {
+        // The colour of one sample (or of the pixel centre when all samples agree), fogged, and its semantic tag.
+        let shade_at = |prim_id: u32, key: f32, u: f32, v: f32| -> (Vec3, u8) {
             let ray = fwd + right * ((u - cx) * inv_f) + down * ((v - cy) * inv_f);
             if prim_id == EMPTY || key <= 0.0 {
                 let dir = ray.normalize();
-                return shade::fog(&self.light, self.light.sky(dir), 1.0e4);
+                return (shade::fog(&self.light, self.light.sky(dir), 1.0e4), tag::SKY);
             }
             let prim: &Prim = frame.prim(scene, prim_id);
             let z = 1.0 / key;
@@ -387,7 +387,8 @@ impl Renderer {
             } else {
                 1.0
             };
-            shade::fog(&self.light, shade::surface(&ctx, prim, p, view, shadow), dist)
+            let (colour, semantic) = shade::surface(&ctx, prim, p, view, shadow);
+            (shade::fog(&self.light, colour, dist), semantic)
         };
         for row in 0..h {
             let y = y0 + row;
@@ -396,24 +397,16 @@ impl Renderer {
                 let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
                 let prims = ids.map(|i| self.vis.prim[i]);
                 let keys = ids.map(|i| self.vis.key[i]);
-                // Labels: the first sample.
+                // Labels: the first sample's primitive; its semantic tag where it is shaded (road paint is
+                // looked up once, for the colour and the label).
                 let o = row * w + x;
-                let (u0, v0) = (x as f32 + 0.5 * inv_ss, y as f32 + 0.5 * inv_ss);
                 if prims[0] == EMPTY {
                     out.depth_m[o] = SKY_DEPTH_M;
-                    out.semantic[o] = tag::SKY;
                     out.instance[o] = 0;
                 } else {
                     let prim = frame.prim(scene, prims[0]);
-                    let z = 1.0 / keys[0];
-                    out.depth_m[o] = z.min(SKY_DEPTH_M);
+                    out.depth_m[o] = (1.0 / keys[0]).min(SKY_DEPTH_M);
                     out.instance[o] = prim.instance;
-                    out.semantic[o] = if prim.material == Material::Road {
-                        let ray = fwd + right * ((u0 - cx) * inv_f) + down * ((v0 - cy) * inv_f);
-                        shade::semantic(scene, prim, cam + ray * z)
-                    } else {
-                        prim.tag
-                    };
                 }
                 let colour = if prims.iter().all(|&p| p == prims[0]) {
                     let key = if prims[0] == EMPTY {
@@ -421,12 +414,20 @@ impl Renderer {
                     } else {
                         (keys[0] + keys[1] + keys[2] + keys[3]) * 0.25
                     };
-                    shade_at(prims[0], key, x as f32 + 0.5, y as f32 + 0.5)
+                    // One primitive: the pixel centre's colour and tag.
+                    let (colour, semantic) = shade_at(prims[0], key, x as f32 + 0.5, y as f32 + 0.5);
+                    out.semantic[o] = semantic;
+                    colour
                 } else {
                     let mut sum = Vec3::ZERO;
                     for (k, (&p, &key)) in prims.iter().zip(&keys).enumerate() {
                         let (sx, sy) = ((k % SS) as f32, (k / SS) as f32);
-                        sum += shade_at(p, key, x as f32 + (sx + 0.5) * inv_ss, y as f32 + (sy + 0.5) * inv_ss);
+                        let (colour, semantic) =
+                            shade_at(p, key, x as f32 + (sx + 0.5) * inv_ss, y as f32 + (sy + 0.5) * inv_ss);
+                        if k == 0 {
+                            out.semantic[o] = semantic;
+                        }
+                        sum += colour;
                     }
                     sum * 0.25
                 };

@@ -86,9 +86,10 @@ pub struct ShadeContext<'a> {
     pub lights: &'a ActiveLights,
 }
 
-/// The shaded colour of a surface point, before fog: `p` scene-relative, `view` the unit vector from the
-/// point to the camera, `shadow` the sun's visibility (0–1).
-pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32) -> Vec3 {
+/// The shaded colour of a surface point, before fog, and its semantic tag (road paint turns road into road
+/// line): `p` scene-relative, `view` the unit vector from the point to the camera, `shadow` the sun's
+/// visibility (0–1).
+pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32) -> (Vec3, u8) {
     let l = ctx.light;
     let nz = ctx.noise;
     let xy = p.truncate();
@@ -98,15 +99,19 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
     // Mirror-like reflection share (wet ground, glass, paint).
     let mut gloss = 0.0f32;
     let mut ground = false;
+    let mut semantic = prim.tag;
     match prim.material {
         Material::Road => {
             ground = true;
             let grain = 1.0 + 0.16 * nz.sample(xy * 1.3) + 0.08 * nz.sample(xy * 6.1 + 37.0);
             albedo *= grain;
             if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
-                && let Some((paint, _)) = road_paint(ctx.scene, piece, xy)
+                && let Some((paint, paint_tag)) = road_paint(ctx.scene, piece, xy)
             {
                 albedo = paint * (0.92 + 0.08 * nz.sample(xy * 9.0));
+                if prim.tag == tag::ROAD {
+                    semantic = paint_tag;
+                }
             }
         }
         Material::Sidewalk => {
@@ -228,7 +233,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         let fresnel = 0.04 + 0.96 * (1.0 - cos).powi(5);
         colour += l.sky(r) * (gloss * (0.08 + 0.92 * fresnel));
     }
-    colour
+    (colour, semantic)
 }
 
 /// Applies fog over a distance.
@@ -236,19 +241,6 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
 pub fn fog(light: &Lighting, colour: Vec3, dist_m: f32) -> Vec3 {
     let f = (-light.fog_per_m * dist_m).exp();
     colour * f + light.fog * (1.0 - f)
-}
-
-/// The semantic tag of a surface point (road paint turns road into road line).
-#[inline]
-pub fn semantic(scene: &StaticScene, prim: &Prim, p: Vec3) -> u8 {
-    if prim.material == Material::Road
-        && prim.tag == tag::ROAD
-        && let Some(piece) = scene.pieces.get(prim.aux as usize)
-        && let Some((_, t)) = road_paint(scene, piece, p.truncate())
-    {
-        return t;
-    }
-    prim.tag
 }
 
 #[cfg(test)]
