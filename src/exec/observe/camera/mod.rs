@@ -8,7 +8,8 @@
 //!
 //! A frame is drawn at `SS × SS` samples per pixel into the visibility buffer, with the same
 //! [`CameraPose`](crate::exec::observe::rig::CameraPose) (intrinsics and pose) that the annotations project
-//! with. Label streams are point samples of it (the pixel's first sample, at `(u + 0.25, v + 0.25)`);
+//! with. Label streams are point samples of it (the pixel's first sample, at `(u + 0.25, v + 0.25)`; road
+//! paint's semantic label at the pixel centre when all samples see one primitive, where the colour is shaded);
 //! RGB shades a pixel once where its samples see one primitive and each sample where they differ (edge
 //! antialiasing), then adds rain streaks and maps to sRGB.
 
