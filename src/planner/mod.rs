@@ -897,14 +897,18 @@ fn plan_clip(
     let cruise_mps = ego_cruise_mps(net, &ego);
     let timing = &spec.traffic.signals;
     let lights = timing.enabled && !net.signals.is_empty();
-    let signal_offsets: Vec<(u32, f64)> = if lights {
-        staging::staged_offset(net, timing, basics.seed, &route, &pedestrians, cruise_mps)
-            .into_iter()
-            .collect()
+    let (signal_offsets, plans) = if lights {
+        let drawn = signal_plans::SignalPlans::new(net, timing, basics.seed);
+        let schedule = staging::EgoSchedule::with_lights(cruise_mps, net, &route, &drawn);
+        let offsets: Vec<(u32, f64)> =
+            staging::staged_offset(net, basics.seed, &route, &pedestrians, (&drawn, &schedule))
+                .into_iter()
+                .collect();
+        let plans = drawn.with_offsets(&offsets);
+        (offsets, Some(plans))
     } else {
-        Vec::new()
+        (Vec::new(), None)
     };
-    let plans = lights.then(|| signal_plans::SignalPlans::new(net, timing, basics.seed).with_offsets(&signal_offsets));
     let schedule = match &plans {
         Some(plans) => staging::EgoSchedule::with_lights(cruise_mps, net, &route, plans),
         None => staging::EgoSchedule::cruising(cruise_mps),

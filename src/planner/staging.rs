@@ -12,7 +12,6 @@ use rand::RngExt;
 use super::script::{PedestrianScript, Role};
 use super::seeds;
 use super::signal_plans::{SignalPlans, WalkSignal};
-use crate::dsl::types::Signals;
 use crate::world::signals::{STOP_LINE_SETBACK_M, crosswalk_signal, signalised_entries};
 use crate::world::{RoadNetwork, Route};
 
@@ -65,7 +64,8 @@ impl EgoSchedule {
         schedule
     }
 
-    /// When the ego reaches arc length `s_m` of its route (it starts at 0), seconds.
+    /// When the ego reaches arc length `s_m` of its route (it starts at 0), seconds: the waits at stop lines
+    /// before `s_m` count, one at `s_m` itself does not.
     pub fn time_at(&self, s_m: f64) -> f64 {
         let waited: f64 = self.waits.iter().filter(|&&(s, _)| s < s_m).map(|&(_, w)| w).sum();
         s_m.max(0.0) / self.cruise_mps.max(0.1) + waited
@@ -82,14 +82,14 @@ pub(crate) fn crossing_signal(net: &RoadNetwork, p: &PedestrianScript) -> Option
 /// The offset the planner sets for the junction of the first crosser (in pedestrian order) waiting at a
 /// signalised crosswalk on the ego's approach (junction, offset into its cycle), or none: the ego's light there
 /// turns amber [`STAGED_AMBER_LEAD_S`] (± [`STAGED_JITTER_S`], from the clip's `plan/signal_offsets` stream)
-/// before the ego would reach its stop line, with earlier junctions as drawn.
+/// before the ego would reach its stop line. `drawn` are the clip's drawn plans and `schedule` the ego's drive
+/// under them: the waits at earlier junctions count, the one being staged does not.
 pub(crate) fn staged_offset(
     net: &RoadNetwork,
-    timing: &Signals,
     clip_seed: u64,
     route: &Route,
     pedestrians: &[PedestrianScript],
-    cruise_mps: f64,
+    (drawn, schedule): (&SignalPlans, &EgoSchedule),
 ) -> Option<(u32, f64)> {
     let entries = signalised_entries(net, route);
     let (s_entry_m, light) = pedestrians
@@ -103,17 +103,11 @@ pub(crate) fn staged_offset(
                 .find(|&&(_, e)| net.signals.get(e as usize).is_some_and(|l| l.junction == junction))
                 .and_then(|&(s, e)| Some((s, net.signals.get(e as usize)?)))
         })?;
-    let plans = SignalPlans::new(net, timing, clip_seed);
-    let before = EgoSchedule::with_lights(cruise_mps, net, route, &plans);
     let stop_line_m = (s_entry_m - STOP_LINE_SETBACK_M).max(0.0);
     let jitter_s = seeds::clip_rng(clip_seed, "plan/signal_offsets").random_range(-STAGED_JITTER_S..=STAGED_JITTER_S);
-    // Only the waits before this stop line count: it is the one being staged.
-    let schedule = EgoSchedule {
-        cruise_mps,
-        waits: before.waits.into_iter().filter(|&(s, _)| s < stop_line_m).collect(),
-    };
+    // `time_at` counts only the waits before this stop line.
     let amber_at_s = schedule.time_at(stop_line_m) - STAGED_AMBER_LEAD_S + jitter_s;
-    Some((light.junction, plans.offset_ending_green_at(light, amber_at_s)))
+    Some((light.junction, drawn.offset_ending_green_at(light, amber_at_s)))
 }
 
 /// When a crosser at a signalised crosswalk can step out, seconds into the clip: the first moment from `ready_s`

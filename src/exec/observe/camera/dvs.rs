@@ -184,6 +184,24 @@ mod tests {
     }
 
     #[test]
+    fn an_image_gives_every_pixel_its_own_log_intensity_where_neighbours_repeat() {
+        // Runs of equal pixels (the last value is reused) broken by changes, across the rows that are split
+        // between workers: every value equals the pixel's own.
+        let (w, h) = (37, 41);
+        let rgb: Vec<u8> = (0..w * h)
+            .flat_map(|i| {
+                let v = ((i / 3) % 7 * 31) as u8;
+                [v, v.wrapping_add((i % 5 == 0) as u8), 200 - v / 2]
+            })
+            .collect();
+        let mut esim = Esim::new(&params(), w, h);
+        esim.step(&rgb, 0, 1, &mut Vec::new());
+        for (i, px) in rgb.chunks_exact(3).enumerate() {
+            assert_eq!(esim.current[i], log_intensity(&params(), [px[0], px[1], px[2]]), "pixel {i}");
+        }
+    }
+
+    #[test]
     fn a_ramp_crosses_thresholds_at_interpolated_times() {
         // One pixel rising from L = 0 to 1.0 over 1 ms: crossings at 0.3, 0.6 and 0.9, i.e. at 300, 600 and
         // 900 µs (by hand: t = (cross − it) · dt / (itdt − it)).
