@@ -197,7 +197,11 @@ mod tests {
         let mut esim = Esim::new(&params(), w, h);
         esim.step(&rgb, 0, 1, &mut Vec::new());
         for (i, px) in rgb.chunks_exact(3).enumerate() {
-            assert_eq!(esim.current[i], log_intensity(&params(), [px[0], px[1], px[2]]), "pixel {i}");
+            assert_eq!(
+                esim.current[i],
+                log_intensity(&params(), [px[0], px[1], px[2]]),
+                "pixel {i}"
+            );
         }
     }
 
