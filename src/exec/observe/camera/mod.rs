@@ -289,18 +289,7 @@ impl Renderer {
     fn sunlit(&self, p: Vec3, normal: Vec3) -> f32 {
         let Some(sun) = &self.sun else { return 1.0 };
         let q = sun.project_f32(p + normal * 0.05);
-        let (x, y) = (q.x - 0.5, q.y - 0.5);
-        let (x0, y0) = (shade::floor_f32(x), shade::floor_f32(y));
-        if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
-            return 1.0;
-        }
-        let (fx, fy) = (x - x0, y - y0);
-        let i = y0 as usize * SHADOW_PX + x0 as usize;
-        let depth = q.z + 0.08;
-        let lit = |k: usize| if self.shadow.key[k] > depth { 0.0 } else { 1.0 };
-        let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
-        let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;
-        a + (b - a) * fy
+        pcf(&self.shadow.key, q.x - 0.5, q.y - 0.5, q.z + 0.08)
     }
 
     fn choose_lights(&mut self, scene: &StaticScene, frame: &FrameScene, cam: Vec3, pose: &CameraPose) {
@@ -391,6 +380,8 @@ impl Renderer {
             let (colour, semantic) = shade::surface(&ctx, prim, p, view, shadow);
             (shade::fog(&self.light, colour, dist), semantic)
         };
+        // One row's linear colours, tone-mapped at once.
+        let mut linear = vec![0.0f32; w * 3];
         for row in 0..h {
             let y = y0 + row;
             for x in 0..w {
@@ -432,13 +423,9 @@ impl Renderer {
                     }
                     sum * 0.25
                 };
-                let px = &mut out.rgb[o * 3..o * 3 + 3];
-                for (ch, value) in px.iter_mut().zip(colour.to_array()) {
-                    let s = (value.max(0.0) * (1.0 / LUT_MAX)).min(1.0).sqrt();
-                    // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
-                    *ch = self.lut[(s * (LUT_LEN - 1) as f32) as i32 as usize & (LUT_LEN - 1)];
-                }
+                linear[x * 3..x * 3 + 3].copy_from_slice(&colour.to_array());
             }
+            tone_map(&linear, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
     }
 
@@ -476,6 +463,43 @@ impl Renderer {
     }
 }
 
+/// Percentage-closer filtering of a [`SHADOW_PX`]-square shadow map at texel coordinates `(x, y)` (texel
+/// centres at integers) for a point at depth key `depth`: 1 lit, 0 in shadow, bilinear between.
+#[inline]
+fn pcf(key: &[f32], x: f32, y: f32, depth: f32) -> f32 {
+    let (x0, y0) = (shade::floor_f32(x), shade::floor_f32(y));
+    if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
+        return 1.0;
+    }
+    let (xi, yi) = (x0 as usize, y0 as usize);
+    let (fx, fy) = (x - x0, y - y0);
+    let i = yi * SHADOW_PX + xi;
+    let lit = |k: usize| if key[k] > depth { 0.0 } else { 1.0 };
+    let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
+    let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;
+    a + (b - a) * fy
+}
+
+/// Maps linear colour values to sRGB bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`,
+/// the square roots four at a time (`wide`: SSE where it is there; correctly rounded either way, so the same
+/// values as one at a time).
+fn tone_map(linear: &[f32], lut: &[u8; LUT_LEN], out: &mut [u8]) {
+    // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
+    let index = |s: f32| (s * (LUT_LEN - 1) as f32) as i32 as usize & (LUT_LEN - 1);
+    let scaled = |v: f32| (v.max(0.0) * (1.0 / LUT_MAX)).min(1.0);
+    let n = linear.len().min(out.len());
+    let whole = n / 4 * 4;
+    for (src, dst) in linear[..whole].chunks_exact(4).zip(out[..whole].chunks_exact_mut(4)) {
+        let s = wide::f32x4::new([scaled(src[0]), scaled(src[1]), scaled(src[2]), scaled(src[3])]).sqrt();
+        for (d, s) in dst.iter_mut().zip(s.to_array()) {
+            *d = lut[index(s)];
+        }
+    }
+    for (d, &v) in out[whole..n].iter_mut().zip(&linear[whole..n]) {
+        *d = lut[index(scaled(v).sqrt())];
+    }
+}
+
 /// The luminance of an 8-bit sRGB pixel (the DVS's intensity, 0–255).
 pub fn luminance(rgb: &[u8]) -> f32 {
     0.2989 * f32::from(rgb[0]) + 0.587 * f32::from(rgb[1]) + 0.114 * f32::from(rgb[2])
@@ -484,4 +508,36 @@ pub fn luminance(rgb: &[u8]) -> f32 {
 /// A random generator for a (clip, frame, sub-step) stream.
 pub fn streak_seed(clip_seed: u64, frame: u32, substep: u32) -> u64 {
     splitmix64(clip_seed ^ splitmix64((u64::from(frame) << 16) | u64::from(substep)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_row_tone_map_equals_the_per_value_formula() {
+        let lut = build_lut();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        // Every length up to 13 (the SIMD part and its tail), values below 0, in range and beyond LUT_MAX.
+        for n in 0..=13 {
+            let linear: Vec<f32> = (0..n)
+                .map(|i| match i % 4 {
+                    0 => rng.random_range(-1.0..0.0),
+                    1 => rng.random_range(0.0..0.01),
+                    2 => rng.random_range(0.0..LUT_MAX),
+                    _ => rng.random_range(LUT_MAX..20.0),
+                })
+                .collect();
+            let mut out = vec![0u8; n];
+            tone_map(&linear, &lut, &mut out);
+            let expected: Vec<u8> = linear
+                .iter()
+                .map(|&v| {
+                    let s = (v.max(0.0) * (1.0 / LUT_MAX)).min(1.0).sqrt();
+                    lut[(s * (LUT_LEN - 1) as f32) as usize]
+                })
+                .collect();
+            assert_eq!(out, expected, "{linear:?}");
+        }
+    }
 }
