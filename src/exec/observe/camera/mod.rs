@@ -366,8 +366,8 @@ impl Renderer {
             let prim: &Prim = frame.prim(scene, prim_id);
             let z = 1.0 / key;
             let p = cam + ray * z;
-            let dist = ray.length() * z;
-            let view = -ray / ray.length();
+            let ray_len = ray.length();
+            let dist = ray_len * z;
             // A flat surface turned away from the sun gets none of it whether in shadow or not (bodies shade
             // with per-point normals).
             let away =
@@ -377,7 +377,7 @@ impl Renderer {
             } else {
                 1.0
             };
-            let (colour, semantic) = shade::surface(&ctx, prim, p, view, shadow);
+            let (colour, semantic) = shade::surface(&ctx, prim, p, (ray, ray_len), shadow);
             (shade::fog(&self.light, colour, dist), semantic)
         };
         // One row's linear colours, tone-mapped at once.

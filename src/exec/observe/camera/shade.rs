@@ -87,9 +87,10 @@ pub struct ShadeContext<'a> {
 }
 
 /// The shaded colour of a surface point, before fog, and its semantic tag (road paint turns road into road
-/// line): `p` scene-relative, `view` the unit vector from the point to the camera, `shadow` the sun's
-/// visibility (0–1).
-pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32) -> (Vec3, u8) {
+/// line): `p` scene-relative, `(ray, ray_len)` the camera's ray to it and its length (the view direction is
+/// worked out only where a reflection needs it), `shadow` the sun's visibility (0–1).
+#[inline(always)]
+pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, (ray, ray_len): (Vec3, f32), shadow: f32) -> (Vec3, u8) {
     let l = ctx.light;
     let nz = ctx.noise;
     let xy = p.truncate();
@@ -179,6 +180,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, view: Vec3, shadow: f32
         albedo *= 1.0 - 0.4 * l.wet - 0.2 * puddle;
         gloss = gloss.max(l.wet * 0.25 + 0.6 * puddle);
     }
+
+    // The unit vector from the point to the camera, for reflections (glossy surfaces only).
+    let view = if gloss > 0.0 { -ray / ray_len } else { Vec3::ZERO };
 
     // Light received.
     let ndl = normal.dot(l.sun_dir).max(0.0);
