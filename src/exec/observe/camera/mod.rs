@@ -467,13 +467,13 @@ impl Renderer {
 /// centres at integers) for a point at depth key `depth`: 1 lit, 0 in shadow, bilinear between.
 #[inline]
 fn pcf(key: &[f32], x: f32, y: f32, depth: f32) -> f32 {
-    let (x0, y0) = (shade::floor_f32(x), shade::floor_f32(y));
-    if x0 < 0.0 || y0 < 0.0 || x0 >= (SHADOW_PX - 1) as f32 || y0 >= (SHADOW_PX - 1) as f32 {
+    let (x0, y0) = (shade::floor_i32(x), shade::floor_i32(y));
+    let last = (SHADOW_PX - 1) as i32;
+    if x0 < 0 || y0 < 0 || x0 >= last || y0 >= last {
         return 1.0;
     }
-    let (xi, yi) = (x0 as usize, y0 as usize);
-    let (fx, fy) = (x - x0, y - y0);
-    let i = yi * SHADOW_PX + xi;
+    let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+    let i = y0 as usize * SHADOW_PX + x0 as usize;
     let lit = |k: usize| if key[k] > depth { 0.0 } else { 1.0 };
     let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
     let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;

@@ -13,15 +13,35 @@ use crate::mix::splitmix64;
 /// spot of texture lookups); the same value for every finite `x` and NaN (only `−0.0` becomes `+0.0`).
 #[inline(always)]
 pub fn floor_f32(x: f32) -> f32 {
-    // Every float of magnitude 2^23 or more is an integer already.
-    if x.abs() < 8_388_608.0 { floor_i32(x) as f32 } else { x }
+    if x.abs() < ROUNDING_RANGE {
+        let r = (x + ROUNDING_MAGIC) - ROUNDING_MAGIC;
+        if r > x { r - 1.0 } else { r }
+    } else if x.abs() < 8_388_608.0 {
+        floor_i32(x) as f32
+    } else {
+        // Every float of magnitude 2^23 or more is an integer already.
+        x
+    }
 }
 
-/// `x.floor()` as an integer, for `|x| < 2^31` (texture coordinates; NaN gives 0).
+/// Adding `1.5 × 2^23` to a float of magnitude below [`ROUNDING_RANGE`] rounds it to an integer, held in the
+/// sum's low mantissa bits (its unit in the last place is 1).
+const ROUNDING_MAGIC: f32 = 12_582_912.0;
+const ROUNDING_RANGE: f32 = 4_194_304.0;
+
+/// `x.floor()` as an integer, for `|x| < 2^31` (texture coordinates; NaN gives 0). Below 2^22 in magnitude
+/// (every texture and shadow-map coordinate) without the saturating float-to-integer conversion, whose
+/// range checks cost as much as the rest of a texture lookup.
 #[inline(always)]
 pub fn floor_i32(x: f32) -> i32 {
-    let t = x as i32;
-    t - i32::from(t as f32 > x)
+    if x.abs() < ROUNDING_RANGE {
+        let big = x + ROUNDING_MAGIC;
+        let nearest = big.to_bits() as i32 - ROUNDING_MAGIC.to_bits() as i32;
+        nearest - i32::from(big - ROUNDING_MAGIC > x)
+    } else {
+        let t = x as i32;
+        t - i32::from(t as f32 > x)
+    }
 }
 
 /// A seeded tileable value-noise table, sampled bilinearly (values in [−1, 1]).
@@ -277,8 +297,23 @@ mod tests {
             8_388_608.0,
             1.0e30,
             -1.0e30,
+            4_194_303.5,
+            -4_194_303.5,
+            4_194_304.0,
+            -4_194_304.0,
+            4_194_304.5,
+            -4_194_304.5,
+            2.5,
+            -2.5,
+            3.5,
+            -3.5,
+            0.999_999_94,
+            -0.999_999_94,
         ] {
             assert_eq!(floor_f32(v), v.floor(), "{v}");
+            if v.abs() < 2.0e9 {
+                assert_eq!(floor_i32(v) as f32, v.floor(), "{v}");
+            }
         }
         assert!(floor_f32(f32::NAN).is_nan());
         assert_eq!(floor_f32(f32::INFINITY), f32::INFINITY);
