@@ -485,7 +485,8 @@ fn pcf(key: &[f32], x: f32, y: f32, depth: f32) -> f32 {
 /// values as one at a time).
 fn tone_map(linear: &[f32], lut: &[u8; LUT_LEN], out: &mut [u8]) {
     // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
-    let index = |s: f32| (s * (LUT_LEN - 1) as f32) as i32 as usize & (LUT_LEN - 1);
+    // (`floor_i32`: the truncation of a non-negative value without a saturating conversion.)
+    let index = |s: f32| shade::floor_i32(s * (LUT_LEN - 1) as f32) as usize & (LUT_LEN - 1);
     let scaled = |v: f32| (v.max(0.0) * (1.0 / LUT_MAX)).min(1.0);
     let n = linear.len().min(out.len());
     let whole = n / 4 * 4;

@@ -139,10 +139,13 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, (ray, ray_len): (Vec3, 
             ground = true;
             if prim.tag == tag::SIDEWALK {
                 let g = xy / 0.6;
-                let cell = Vec2::new(floor_f32(g.x), floor_f32(g.y));
-                let f = g - cell;
-                let tile = 0.88 + 0.2 * nz.cell(cell.x as i32, cell.y as i32, 7);
-                albedo *= if f.x < 0.05 || f.y < 0.05 { 0.62 } else { tile };
+                let (ix, iy) = (floor_i32(g.x), floor_i32(g.y));
+                let f = g - Vec2::new(ix as f32, iy as f32);
+                albedo *= if f.x < 0.05 || f.y < 0.05 {
+                    0.62
+                } else {
+                    0.88 + 0.2 * nz.cell(ix, iy, 7)
+                };
             }
             albedo *= 1.0 + 0.08 * nz.sample(xy * 3.7);
         }
@@ -160,10 +163,10 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, (ray, ray_len): (Vec3, 
             let along_dir = Vec2::new(-normal.y, normal.x);
             let a = xy.dot(along_dir) / 2.8;
             let z = p.z / 3.2;
-            let (cell_a, cell_z) = (floor_f32(a), floor_f32(z));
-            let (fa, fz) = (a - cell_a, z - cell_z);
+            let (cell_a, cell_z) = (floor_i32(a), floor_i32(z));
+            let (fa, fz) = (a - cell_a as f32, z - cell_z as f32);
             if fa > 0.22 && fa < 0.78 && fz > 0.3 && fz < 0.82 && p.z > 1.2 {
-                let lit = nz.cell(cell_a as i32, cell_z as i32, prim.aux) < 0.22;
+                let lit = nz.cell(cell_a, cell_z, prim.aux) < 0.22;
                 albedo = Vec3::new(0.03, 0.035, 0.045);
                 gloss = 0.35;
                 if lit {
