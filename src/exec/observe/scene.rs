@@ -1007,12 +1007,22 @@ pub fn road_paint(scene: &StaticScene, piece: &PieceSurface, p: Vec2) -> Option<
         if mark == Mark::None {
             continue;
         }
-        let (dist, t) = edge(a, b);
         let half = if mark == Mark::Centre {
             MARK_WIDTH_M * 0.5
         } else {
             MARK_WIDTH_M
         };
+        // Far outside the edge's bounding box grown by the mark's half width (a millimetre more than rounding
+        // could take off the distance): farther than `half` from the edge, without working the distance out.
+        let reach = half + 1e-3;
+        if p.x < a.x.min(b.x) - reach
+            || p.x > a.x.max(b.x) + reach
+            || p.y < a.y.min(b.y) - reach
+            || p.y > a.y.max(b.y) + reach
+        {
+            continue;
+        }
+        let (dist, t) = edge(a, b);
         if dist > half {
             continue;
         }
