@@ -380,8 +380,9 @@ impl Renderer {
             let (colour, semantic) = shade::surface(&ctx, prim, p, (ray, ray_len), shadow);
             (shade::fog(&self.light, colour, dist), semantic)
         };
-        // One row's linear colours, tone-mapped at once.
-        let mut linear = vec![0.0f32; w * 3];
+        // Linear colours of up to TONE_RUN pixels of a row, tone-mapped at once (on the stack: no allocation).
+        const TONE_RUN: usize = 64;
+        let mut linear = [0.0f32; TONE_RUN * 3];
         for row in 0..h {
             let y = y0 + row;
             for x in 0..w {
@@ -423,9 +424,13 @@ impl Renderer {
                     }
                     sum * 0.25
                 };
-                linear[x * 3..x * 3 + 3].copy_from_slice(&colour.to_array());
+                let k = x % TONE_RUN;
+                linear[k * 3..k * 3 + 3].copy_from_slice(&colour.to_array());
+                if k == TONE_RUN - 1 || x == w - 1 {
+                    let start = o - k;
+                    tone_map(&linear[..(k + 1) * 3], &self.lut, &mut out.rgb[start * 3..(o + 1) * 3]);
+                }
             }
-            tone_map(&linear, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
     }
 

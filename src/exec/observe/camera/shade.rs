@@ -13,15 +13,8 @@ use crate::mix::splitmix64;
 /// spot of texture lookups); the same value for every finite `x` and NaN (only `−0.0` becomes `+0.0`).
 #[inline(always)]
 pub fn floor_f32(x: f32) -> f32 {
-    if x.abs() < ROUNDING_RANGE {
-        let r = (x + ROUNDING_MAGIC) - ROUNDING_MAGIC;
-        if r > x { r - 1.0 } else { r }
-    } else if x.abs() < 8_388_608.0 {
-        floor_i32(x) as f32
-    } else {
-        // Every float of magnitude 2^23 or more is an integer already.
-        x
-    }
+    // Every float of magnitude 2^23 or more is an integer already.
+    if x.abs() < 8_388_608.0 { floor_i32(x) as f32 } else { x }
 }
 
 /// Adding `1.5 × 2^23` to a float of magnitude below [`ROUNDING_RANGE`] rounds it to an integer, held in the
