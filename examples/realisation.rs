@@ -2,6 +2,12 @@
 //! that end up labelled crossers (C = 1 in at least one annotated frame), per spec.
 //!
 //! Run: `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml [--set KEY=VALUE]...`
+//!
+//! With `REALISATION_WHY=1` it also prints, on stderr, one line per unlabelled allocated crosser: why (never
+//! crossed, crossed only behind the camera, crossed in front unannotated), its state and distance to its curb
+//! when the ego passed it (or the clip ended), how long before that it reached its curb, the states it went
+//! through in the last 10 s, the ego's speed, the share of the clip the ego drove slower than 4 m/s and stood,
+//! and its group's members with their distances to their curbs.
 
 use std::path::Path;
 
@@ -42,7 +48,8 @@ fn main() {
         // allocated never annotated, pedestrians never annotated, unlabelled allocated crossers that never had
         // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated, allocated in
         // clips with an emergency vehicle, ... labelled)
-        let per_clip: Vec<(&str, [usize; 13])> = plan
+        let why_wanted = std::env::var_os("REALISATION_WHY").is_some();
+        let per_clip: Vec<(&str, [usize; 13], Vec<String>)> = plan
             .clips
             .par_iter()
             .map(|clip| {
@@ -50,6 +57,7 @@ fn main() {
                 let trace = simulate::simulate(clip, &plan.sim, net);
                 let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
                 let mut c = [0usize; 13];
+                let mut why: Vec<String> = Vec::new();
                 for (i, p) in clip.pedestrians.iter().enumerate() {
                     c[0] += 1;
                     let labelled = usize::from(ann.pedestrians[i].crosser);
@@ -75,6 +83,14 @@ fn main() {
                                     let (e, q) = (&trace.ego[f], &trace.pedestrians[i][f]);
                                     (q.pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad)) < 0.0
                                 });
+                                if why_wanted {
+                                    let kind = match (crossing_frames.is_empty(), behind) {
+                                        (true, _) => "never crossed",
+                                        (false, true) => "crossed behind",
+                                        (false, false) => "unannotated",
+                                    };
+                                    why.push(why_unlabelled(kind, clip, &trace, i));
+                                }
                                 match (crossing_frames.is_empty(), behind) {
                                     (true, _) => c[8] += 1,
                                     (false, true) => c[9] += 1,
@@ -89,13 +105,20 @@ fn main() {
                         _ => {}
                     }
                 }
-                (clip.town.as_str(), c)
+                (clip.town.as_str(), c, why)
             })
             .collect();
-        let counts: Vec<[usize; 13]> = per_clip.iter().map(|&(_, c)| c).collect();
+        let counts: Vec<[usize; 13]> = per_clip.iter().map(|(_, c, _)| *c).collect();
+        if why_wanted {
+            for (_, _, why) in &per_clip {
+                for w in why {
+                    eprintln!("{w}");
+                }
+            }
+        }
         // Allocated crossers and those labelled, per town.
         let mut towns_seen: std::collections::BTreeMap<&str, (usize, usize)> = std::collections::BTreeMap::new();
-        for &(town, c) in &per_clip {
+        for &(town, c, _) in &per_clip {
             let e = towns_seen.entry(town).or_default();
             e.0 += c[1];
             e.1 += c[2];
@@ -142,4 +165,85 @@ fn main() {
             );
         }
     }
+}
+
+/// One line on why allocated crosser `i` of `clip` was not labelled a crosser (`kind`), from its trace.
+fn why_unlabelled(
+    kind: &str,
+    clip: &pedsynth::planner::ClipScript,
+    trace: &pedsynth::exec::trace::ClipTrace,
+    i: usize,
+) -> String {
+    let p = &clip.pedestrians[i];
+    let frames = &trace.pedestrians[i];
+    let ahead = |f: usize, pos: glam::DVec3| {
+        let e = &trace.ego[f];
+        (pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad))
+    };
+    let passed = (0..frames.len()).find(|&f| ahead(f, frames[f].pos) < 0.0);
+    let at = passed.unwrap_or(frames.len() - 1);
+    let curb_m = |j: usize| {
+        clip.pedestrians[j].crossing.as_ref().map_or(f64::NAN, |x| {
+            x.near_curb.distance(trace.pedestrians[j][at].pos.truncate())
+        })
+    };
+    let reached = p
+        .crossing
+        .as_ref()
+        .and_then(|x| (0..frames.len()).find(|&f| x.near_curb.distance(frames[f].pos.truncate()) < 0.7));
+    let mut states: Vec<String> = Vec::new();
+    for f in &frames[at.saturating_sub(10 * clip.fps as usize)..=at] {
+        let s = format!("{:?}", f.state);
+        if states.last() != Some(&s) {
+            states.push(s);
+        }
+    }
+    let ego = &trace.ego[at];
+    let share = |pred: &dyn Fn(f64) -> bool| {
+        trace.ego[..=at].iter().filter(|e| pred(e.speed_mps)).count() as f64 / (at + 1) as f64
+    };
+    let group: Vec<String> = p
+        .group
+        .iter()
+        .flat_map(|g| {
+            clip.pedestrians
+                .iter()
+                .enumerate()
+                .filter(move |(_, q)| q.group.is_some_and(|h| h.group_id == g.group_id))
+                .map(move |(j, q)| {
+                    format!(
+                        "{}{}: {:.1} m",
+                        if q.id == g.leader { "leader " } else { "" },
+                        q.id,
+                        curb_m(j)
+                    )
+                })
+        })
+        .collect();
+    format!(
+        "{kind}: {} pedestrian {} ({:?}): {} at frame {at} ({:.0} % of the clip) in {:?}, {:.1} m from its curb, {:.1} m \
+         ahead and {:.1} m beside the ego; reached its curb {} frames before; states {}; ego at {:.1} m/s, slower \
+         than 4 m/s {:.0} % and standing {:.0} % of the time; group [{}]",
+        clip.clip_id,
+        p.id,
+        p.behaviour,
+        if passed.is_some() {
+            "the ego passed it"
+        } else {
+            "the clip ended"
+        },
+        100.0 * at as f64 / frames.len() as f64,
+        frames[at].state,
+        curb_m(i),
+        ahead(at, frames[at].pos),
+        (frames[at].pos - ego.pos)
+            .truncate()
+            .perp_dot(glam::DVec2::from_angle(ego.yaw_rad)),
+        reached.map_or("never".to_owned(), |r| (at as i64 - r as i64).to_string()),
+        states.join(" > "),
+        ego.speed_mps,
+        100.0 * share(&|v| v < 4.0),
+        100.0 * share(&|v| v < 0.3),
+        group.join(", "),
+    )
 }
