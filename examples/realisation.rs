@@ -79,22 +79,17 @@ fn main() {
                             if labelled == 0 {
                                 let crossing_frames: Vec<usize> =
                                     (0..ann.crossing[i].len()).filter(|&f| ann.crossing[i][f]).collect();
-                                let behind = crossing_frames.iter().all(|&f| {
-                                    let (e, q) = (&trace.ego[f], &trace.pedestrians[i][f]);
-                                    (q.pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad)) < 0.0
-                                });
+                                let behind = crossing_frames
+                                    .iter()
+                                    .all(|&f| ahead_of_ego_m(&trace, f, trace.pedestrians[i][f].pos) < 0.0);
+                                let (slot, kind) = match (crossing_frames.is_empty(), behind) {
+                                    (true, _) => (8, "never crossed"),
+                                    (false, true) => (9, "crossed behind"),
+                                    (false, false) => (10, "unannotated"),
+                                };
+                                c[slot] += 1;
                                 if why_wanted {
-                                    let kind = match (crossing_frames.is_empty(), behind) {
-                                        (true, _) => "never crossed",
-                                        (false, true) => "crossed behind",
-                                        (false, false) => "unannotated",
-                                    };
                                     why.push(why_unlabelled(kind, clip, &trace, i));
-                                }
-                                match (crossing_frames.is_empty(), behind) {
-                                    (true, _) => c[8] += 1,
-                                    (false, true) => c[9] += 1,
-                                    (false, false) => c[10] += 1,
                                 }
                             }
                         }
@@ -176,11 +171,7 @@ fn why_unlabelled(
 ) -> String {
     let p = &clip.pedestrians[i];
     let frames = &trace.pedestrians[i];
-    let ahead = |f: usize, pos: glam::DVec3| {
-        let e = &trace.ego[f];
-        (pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad))
-    };
-    let passed = (0..frames.len()).find(|&f| ahead(f, frames[f].pos) < 0.0);
+    let passed = (0..frames.len()).find(|&f| ahead_of_ego_m(trace, f, frames[f].pos) < 0.0);
     let at = passed.unwrap_or(frames.len() - 1);
     let curb_m = |j: usize| {
         clip.pedestrians[j].crossing.as_ref().map_or(f64::NAN, |x| {
@@ -191,13 +182,12 @@ fn why_unlabelled(
         .crossing
         .as_ref()
         .and_then(|x| (0..frames.len()).find(|&f| x.near_curb.distance(frames[f].pos.truncate()) < 0.7));
-    let mut states: Vec<String> = Vec::new();
-    for f in &frames[at.saturating_sub(10 * clip.fps as usize)..=at] {
-        let s = format!("{:?}", f.state);
-        if states.last() != Some(&s) {
-            states.push(s);
-        }
-    }
+    let mut states: Vec<pedsynth::exec::trace::PedState> = frames[at.saturating_sub(10 * clip.fps as usize)..=at]
+        .iter()
+        .map(|f| f.state)
+        .collect();
+    states.dedup();
+    let states: Vec<String> = states.iter().map(|s| format!("{s:?}")).collect();
     let ego = &trace.ego[at];
     let share = |pred: &dyn Fn(f64) -> bool| {
         trace.ego[..=at].iter().filter(|e| pred(e.speed_mps)).count() as f64 / (at + 1) as f64
@@ -235,7 +225,7 @@ fn why_unlabelled(
         100.0 * at as f64 / frames.len() as f64,
         frames[at].state,
         curb_m(i),
-        ahead(at, frames[at].pos),
+        ahead_of_ego_m(trace, at, frames[at].pos),
         (frames[at].pos - ego.pos)
             .truncate()
             .perp_dot(glam::DVec2::from_angle(ego.yaw_rad)),
@@ -246,4 +236,10 @@ fn why_unlabelled(
         100.0 * share(&|v| v < 0.3),
         group.join(", "),
     )
+}
+
+/// How far `pos` lies ahead of the ego in frame `f`, along its heading, metres (negative: behind it).
+fn ahead_of_ego_m(trace: &pedsynth::exec::trace::ClipTrace, f: usize, pos: glam::DVec3) -> f64 {
+    let e = &trace.ego[f];
+    (pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad))
 }
