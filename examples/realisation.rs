@@ -81,7 +81,7 @@ fn main() {
                                     (0..ann.crossing[i].len()).filter(|&f| ann.crossing[i][f]).collect();
                                 let behind = crossing_frames
                                     .iter()
-                                    .all(|&f| ahead_of_ego_m(&trace, f, trace.pedestrians[i][f].pos) < 0.0);
+                                    .all(|&f| from_ego_m(&trace, f, trace.pedestrians[i][f].pos).x < 0.0);
                                 let (slot, kind) = match (crossing_frames.is_empty(), behind) {
                                     (true, _) => (8, "never crossed"),
                                     (false, true) => (9, "crossed behind"),
@@ -171,7 +171,7 @@ fn why_unlabelled(
 ) -> String {
     let p = &clip.pedestrians[i];
     let frames = &trace.pedestrians[i];
-    let passed = (0..frames.len()).find(|&f| ahead_of_ego_m(trace, f, frames[f].pos) < 0.0);
+    let passed = (0..frames.len()).find(|&f| from_ego_m(trace, f, frames[f].pos).x < 0.0);
     let at = passed.unwrap_or(frames.len() - 1);
     let curb_m = |j: usize| {
         clip.pedestrians[j].crossing.as_ref().map_or(f64::NAN, |x| {
@@ -187,7 +187,7 @@ fn why_unlabelled(
         .map(|f| f.state)
         .collect();
     states.dedup();
-    let states: Vec<String> = states.iter().map(|s| format!("{s:?}")).collect();
+    let offset = from_ego_m(trace, at, frames[at].pos);
     let ego = &trace.ego[at];
     let share = |pred: &dyn Fn(f64) -> bool| {
         trace.ego[..=at].iter().filter(|e| pred(e.speed_mps)).count() as f64 / (at + 1) as f64
@@ -212,7 +212,7 @@ fn why_unlabelled(
         .collect();
     format!(
         "{kind}: {} pedestrian {} ({:?}): {} at frame {at} ({:.0} % of the clip) in {:?}, {:.1} m from its curb, {:.1} m \
-         ahead and {:.1} m beside the ego; reached its curb {} frames before; states {}; ego at {:.1} m/s, slower \
+         ahead and {:.1} m to the right of the ego; reached its curb {} frames before; states {}; ego at {:.1} m/s, slower \
          than 4 m/s {:.0} % and standing {:.0} % of the time; group [{}]",
         clip.clip_id,
         p.id,
@@ -225,12 +225,10 @@ fn why_unlabelled(
         100.0 * at as f64 / frames.len() as f64,
         frames[at].state,
         curb_m(i),
-        ahead_of_ego_m(trace, at, frames[at].pos),
-        (frames[at].pos - ego.pos)
-            .truncate()
-            .perp_dot(glam::DVec2::from_angle(ego.yaw_rad)),
+        offset.x,
+        offset.y,
         reached.map_or("never".to_owned(), |r| (at as i64 - r as i64).to_string()),
-        states.join(" > "),
+        states.iter().map(|s| format!("{s:?}")).collect::<Vec<_>>().join(" > "),
         ego.speed_mps,
         100.0 * share(&|v| v < 4.0),
         100.0 * share(&|v| v < 0.3),
@@ -238,8 +236,10 @@ fn why_unlabelled(
     )
 }
 
-/// How far `pos` lies ahead of the ego in frame `f`, along its heading, metres (negative: behind it).
-fn ahead_of_ego_m(trace: &pedsynth::exec::trace::ClipTrace, f: usize, pos: glam::DVec3) -> f64 {
+/// Where `pos` lies from the ego in frame `f`, metres: `x` ahead along its heading (negative: behind it), `y`
+/// to its right.
+fn from_ego_m(trace: &pedsynth::exec::trace::ClipTrace, f: usize, pos: glam::DVec3) -> glam::DVec2 {
     let e = &trace.ego[f];
-    (pos - e.pos).truncate().dot(glam::DVec2::from_angle(e.yaw_rad))
+    let (d, heading) = ((pos - e.pos).truncate(), glam::DVec2::from_angle(e.yaw_rad));
+    glam::DVec2::new(d.dot(heading), d.perp_dot(heading))
 }
