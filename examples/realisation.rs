@@ -1,6 +1,10 @@
 //! Measures the crossing realisation that `src/calibration.rs` records: the share of planned crossers (layer 1)
 //! that end up labelled crossers (C = 1 in at least one annotated frame), per spec.
 //!
+//! It then realises every clip as `generate` does (`exec::realise`: promotions and demotions until the clip
+//! has its planned count of labelled crossers) and prints the resulting crossing ratio and how many clips met
+//! their count.
+//!
 //! Run: `cargo run --release --example realisation -- specs/balanced_50.yaml specs/pedsynth_pp.yaml [--set KEY=VALUE]...`
 //!
 //! With `REALISATION_WHY=1` it also prints, on stderr, one line per unlabelled allocated crosser: why (never
@@ -17,6 +21,9 @@ use pedsynth::exec::simulate;
 use pedsynth::planner::{CrosserSource, Role};
 use pedsynth::world::LaneType;
 use rayon::prelude::*;
+
+/// One clip's town, counts (see `main`), lines on unlabelled crossers and the executor's realisation counts.
+type ClipCounts<'a> = (&'a str, [usize; 13], Vec<String>, [usize; 6]);
 
 fn main() {
     // `--set KEY=VALUE` arguments apply to every spec.
@@ -49,7 +56,7 @@ fn main() {
         // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated, allocated in
         // clips with an emergency vehicle, ... labelled)
         let why_wanted = std::env::var_os("REALISATION_WHY").is_some();
-        let per_clip: Vec<(&str, [usize; 13], Vec<String>)> = plan
+        let per_clip: Vec<ClipCounts> = plan
             .clips
             .par_iter()
             .map(|clip| {
@@ -100,12 +107,34 @@ fn main() {
                         _ => {}
                     }
                 }
-                (clip.town.as_str(), c, why)
+                // The executor's realisation (`exec::realise`): (planned labelled crossers, labelled, clips with a
+                // count, clips meeting it, re-simulations, squared miss).
+                let r = pedsynth::exec::realise::realise(clip, &plan.spec, &plan.sim, &rig, net);
+                let wanted = clip.labelled_crossers.map_or(0, |w| w as usize);
+                let got = r.labelled_crossers() as usize;
+                if std::env::var_os("REALISATION_MISSES").is_some() && clip.labelled_crossers.is_some() && got != wanted
+                {
+                    eprintln!(
+                        "{}: {got} labelled of {wanted} planned, {} pedestrians, {} re-simulations",
+                        clip.clip_id,
+                        clip.pedestrians.len(),
+                        r.rounds
+                    );
+                }
+                let topup = [
+                    wanted,
+                    got,
+                    usize::from(clip.labelled_crossers.is_some()),
+                    usize::from(clip.labelled_crossers.is_some() && got == wanted),
+                    r.rounds,
+                    got.abs_diff(wanted).pow(2),
+                ];
+                (clip.town.as_str(), c, why, topup)
             })
             .collect();
-        let counts: Vec<[usize; 13]> = per_clip.iter().map(|(_, c, _)| *c).collect();
+        let counts: Vec<[usize; 13]> = per_clip.iter().map(|(_, c, _, _)| *c).collect();
         if why_wanted {
-            for (_, _, why) in &per_clip {
+            for (_, _, why, _) in &per_clip {
                 for w in why {
                     eprintln!("{w}");
                 }
@@ -113,7 +142,7 @@ fn main() {
         }
         // Allocated crossers and those labelled, per town.
         let mut towns_seen: std::collections::BTreeMap<&str, (usize, usize)> = std::collections::BTreeMap::new();
-        for &(town, c, _) in &per_clip {
+        for &(town, c, _, _) in &per_clip {
             let e = towns_seen.entry(town).or_default();
             e.0 += c[1];
             e.1 += c[2];
@@ -144,6 +173,24 @@ fn main() {
             share(t[8], t[1]),
             share(t[9], t[1]),
             share(t[10], t[1])
+        );
+        let u = per_clip.iter().fold([0usize; 6], |mut acc, (_, _, _, x)| {
+            for k in 0..6 {
+                acc[k] += x[k];
+            }
+            acc
+        });
+        println!(
+            "  realised by the executor (promotions and demotions): crossing ratio {:.4} ({} labelled of {} planned \
+             over {} pedestrians); {} of {} clips meet their count (mean squared miss {:.3}); {} re-simulations",
+            share(u[1], t[0]),
+            u[1],
+            u[0],
+            t[0],
+            u[3],
+            u[2],
+            share(u[5], u[2]),
+            u[4]
         );
         let by_town: Vec<String> = towns_seen
             .iter()

@@ -1,12 +1,14 @@
 //! Crossing-rate control, end to end, on a spec the calibration was not fitted on
 //! (`tests/data/specs/heldout_crossing.yaml`): for every target 0, 0.05, 0.1, ..., 0.95, 1, generate a dataset
 //! of more than 1,000 pedestrians and check the sequence-level crossing ratio that `pedsynth stats` (computed
-//! from the written tables only) reports. Targets 0.15 to 0.85 land within ±2 percentage points (the paper
-//! reports 62.5% for a 60% target; measured misses up to 1.6 pp). Rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline alone gives, so the planner
-//! lowers the baseline) land within 1 percentage point. Crossing-heavy targets (0.9, 0.95, 1: above what the
-//! spec's layers reach, so the planner makes every pedestrian a crosser, drops crossing groups and starts more
-//! crossers mid-road) land within 1.5 percentage points. With traffic lights, cyclists and emergency vehicles on
-//! as well, five targets from 0.05 to 0.95 land within 1.5 percentage points. Slow statistical tests: they run with `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
+//! from the written tables only) reports: within 1 percentage point of the target, as issue 15 asks, and so
+//! with traffic lights, cyclists and emergency vehicles on as well (five targets from 0.05 to 0.95). The
+//! planner gives each clip a count of labelled crossers and `generate` promotes or demotes pedestrians until
+//! the clip has it (`exec::realise`); rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline
+//! alone gives) also lower the baseline, crossing-heavy ones (0.9, 0.95, 1) also adapt the layers (every
+//! pedestrian a crosser, no crossing groups, more crossers mid-road). Measured with the realisation example
+//! (the same clips as `generate`): misses of at most 0.5 pp. Slow statistical tests: they run with
+//! `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
 
 mod common;
 
@@ -77,23 +79,22 @@ fn sweep_with(targets: &[f64], tolerance: f64, extra: &[&str]) -> Vec<stats::Dat
 }
 
 #[test]
-fn achieved_crossing_ratio_on_a_held_out_spec_is_within_2_pp_of_the_target() {
+fn achieved_crossing_ratio_on_a_held_out_spec_is_within_1_pp_of_the_target() {
     if !common::slow_tests("the crossing-rate sweep") {
         return;
     }
     let targets: Vec<f64> = (3..=17).map(|k| (f64::from(k) * 5.0).round() / 100.0).collect();
-    sweep(&targets, 0.02);
+    sweep(&targets, 0.01);
 }
 
 #[test]
 fn with_lights_cyclists_and_emergency_vehicles_on_the_targets_are_still_met() {
-    // Measured 2026-11-26 (same spec, every feature on): 0.044 0.094 0.293 0.499 0.707 0.856 0.890 0.944 0.985
-    // for 0.05 0.1 0.3 0.5 0.7 0.85 0.9 0.95 1; with 1,322 pedestrians a planned crosser's binomial outcome
-    // alone spreads the ratio by about 1 pp (1 s.d.).
+    // Measured 2026-11-26 with the realisation example (same spec, every feature on): 0.0461 0.2950 0.4992
+    // 0.7020 0.9486 for 0.05 0.3 0.5 0.7 0.95 (3 to 5 of 180 clips miss their count of labelled crossers).
     if !common::slow_tests("the crossing-rate sweep with every feature on") {
         return;
     }
-    sweep_with(&[0.05, 0.3, 0.5, 0.7, 0.95], 0.015, &EVERY_FEATURE);
+    sweep_with(&[0.05, 0.3, 0.5, 0.7, 0.95], 0.01, &EVERY_FEATURE);
 }
 
 #[test]
@@ -148,5 +149,5 @@ fn crossing_heavy_targets_are_met_by_adapting_the_layers() {
     if !common::slow_tests("the crossing-heavy crossing-rate sweep") {
         return;
     }
-    sweep(&[0.9, 0.95, 1.0], 0.015);
+    sweep(&[0.9, 0.95, 1.0], 0.01);
 }

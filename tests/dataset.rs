@@ -21,7 +21,6 @@ use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use pedsynth::commands::{self, PlanArgs};
 use pedsynth::dsl::LoadOptions;
 use pedsynth::exec::observe::{body, rig::Camera};
-use pedsynth::exec::simulate;
 
 const TABLES: [&str; 7] = [
     "clips",
@@ -698,8 +697,12 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
     let dirs = sphere_directions(256);
     let mut checked_boxes = 0usize;
     let mut worst = 0f64;
-    for script in &plan.clips {
-        let trace = simulate::simulate(script, &plan.sim, &towns[&script.town].network);
+    let rig = pedsynth::exec::observe::rig::Rig::from_spec(&plan.spec.sensors);
+    for planned in &plan.clips {
+        // The clip as `generate` realised it (with any pedestrians promoted or demoted to meet its count).
+        let net = &towns[&planned.town].network;
+        let realised = pedsynth::exec::realise::realise(planned, &plan.spec, &plan.sim, &rig, net);
+        let (script, trace) = (realised.script.as_ref(), &realised.trace);
         // The re-simulation is the one that was written: the ego's trajectory matches exactly.
         for (f, ego) in trace.ego.iter().enumerate() {
             let row = d.frames[&(script.clip_id.clone(), f as u32)];

@@ -390,3 +390,49 @@ fn targets_below_the_baseline_lower_it_and_a_target_of_0_plans_no_crosser() {
     let (loaded, _, plan) = compile("specs/pedsynth_pp.yaml", &["dataset.clips.count=4".to_owned()]);
     assert_eq!(planner::stats::compute(&plan, &loaded.spec).adapted_baseline, None);
 }
+
+#[test]
+fn each_clip_gets_a_count_of_labelled_crossers_that_adds_up_to_the_target() {
+    for target in [0.0, 0.05, 0.5, 0.95, 1.0] {
+        let set = vec![
+            format!("crossing.target_ratio={target}"),
+            "dataset.clips.count=4".to_owned(),
+        ];
+        let (loaded, _, plan) = compile("specs/pedsynth_pp.yaml", &set);
+        let mut total = 0usize;
+        let mut pedestrians = 0usize;
+        for clip in &plan.clips {
+            let wanted = clip.labelled_crossers.expect("layer 1 is on") as usize;
+            assert!(wanted <= clip.pedestrians.len(), "{}", clip.clip_id);
+            // A clip without a planned crosser is given none to label.
+            if !clip.pedestrians.iter().any(|p| p.role == Role::Crosser) {
+                assert_eq!(wanted, 0, "{}", clip.clip_id);
+            }
+            total += wanted;
+            pedestrians += clip.pedestrians.len();
+        }
+        // The target share of each stratum's pedestrians, rounded with a dither: within one per stratum.
+        let strata = planner::stats::compute(&plan, &loaded.spec).cells.len() as f64;
+        let exact = target * pedestrians as f64;
+        assert!(
+            (total as f64 - exact).abs() < strata,
+            "target {target}: {total} for {exact:.1}"
+        );
+        if target == 0.0 {
+            assert_eq!(total, 0);
+        }
+        if target == 1.0 {
+            assert_eq!(total, pedestrians);
+        }
+    }
+    // Without layer 1 no count is set.
+    let (_, _, plan) = compile(
+        "specs/pedsynth_pp.yaml",
+        &[
+            "crossing.layers.crosser_allocation.enabled=false".to_owned(),
+            "crossing.target_ratio=0.09".to_owned(),
+            "dataset.clips.count=2".to_owned(),
+        ],
+    );
+    assert!(plan.clips.iter().all(|c| c.labelled_crossers.is_none()));
+}

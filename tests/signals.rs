@@ -252,6 +252,8 @@ fn with_every_vehicle_ignoring_lights_the_reds_are_run_and_without_lights_nothin
         on.frame_count = off.frame_count;
         on.timeline_extension_s = off.timeline_extension_s;
         on.signal_offsets.clear();
+        // The clip's count of labelled crossers follows the target, which is scaled here.
+        on.labelled_crossers = off.labelled_crossers;
         for p in &mut on.pedestrians {
             p.red_light_violator = false;
         }

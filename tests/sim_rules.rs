@@ -173,6 +173,7 @@ fn clip(
         cyclists: Vec::new(),
         signal_offsets: Vec::new(),
         timeline_extension_s: 0.0,
+        labelled_crossers: None,
     }
 }
 

@@ -5,6 +5,8 @@
 //! ```
 //!
 //! - [`simulate`] — everything that moves: vehicles, the ego, pedestrians and their 12-state behaviour machine.
+//! - [`realise`] — simulate and observe a clip, re-simulating with pedestrians promoted or demoted until it has
+//!   its planned count of labelled crossers.
 //! - [`trace`] — what the simulation produces (per-frame agent states and events).
 //! - [`observe`] — pure functions of (script, trace, frame): sensor rig, bodies, annotations, the scene and
 //!   the camera streams (handed to the writer frame by frame).
@@ -17,6 +19,7 @@ pub mod export;
 pub mod generate;
 pub mod observe;
 pub mod read;
+pub mod realise;
 pub mod simulate;
 pub mod trace;
 pub mod write;
@@ -45,13 +48,13 @@ pub fn run_clip(
     rig: &observe::rig::Rig,
     out: &write::DatasetWriter,
 ) -> Result<ClipCounts, Error> {
-    let trace = simulate::simulate(script, &plan.sim, &town.network);
-    let observations = observe::observe(script, &trace, &plan.spec, rig, &town.network);
+    let realised = realise::realise(script, &plan.spec, &plan.sim, rig, &town.network);
+    let (script, trace, observations) = (realised.script.as_ref(), &realised.trace, &realised.observations);
     let sensors = &plan.spec.sensors;
     let mut images = 0u64;
     let mut sensor_rows = Vec::new();
     if sensors.cameras_enabled() || sensors.lidar.enabled {
-        let stat = observe::scene::StaticScene::build(script, &trace, &town.network);
+        let stat = observe::scene::StaticScene::build(script, trace, &town.network);
         // Cameras and LiDAR write disjoint files: side by side on the rayon pool (an idle worker takes one).
         let (cameras, lidar) = rayon::join(
             || -> Result<Vec<write::sensors::IndexRow>, Error> {
@@ -59,7 +62,7 @@ pub fn run_clip(
                     return Ok(Vec::new());
                 }
                 let mut files = out.clip_sensors(plan, script)?;
-                observe::render_cameras(&stat, script, &trace, sensors, rig, |frame| {
+                observe::render_cameras(&stat, script, trace, sensors, rig, |frame| {
                     images += 1;
                     files.frame(frame)
                 })?;
@@ -70,7 +73,7 @@ pub fn run_clip(
                     return Ok(Vec::new());
                 }
                 let mut files = out.clip_lidar(plan, script)?;
-                observe::scan_lidar(&stat, script, &trace, &sensors.lidar, rig, |tick| files.tick(tick))?;
+                observe::scan_lidar(&stat, script, trace, &sensors.lidar, rig, |tick| files.tick(tick))?;
                 files.finish()
             },
         );
@@ -78,7 +81,7 @@ pub fn run_clip(
         sensor_rows.extend(lidar?);
         write::sensors::sort_index(&mut sensor_rows);
     }
-    out.write_clip(plan, script, &trace, &observations, rig, &sensor_rows)?;
+    out.write_clip(plan, script, trace, observations, rig, &sensor_rows)?;
     Ok(ClipCounts {
         frames: u64::from(script.frame_count),
         pedestrian_frames: u64::from(script.frame_count) * script.pedestrians.len() as u64,

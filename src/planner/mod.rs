@@ -12,6 +12,7 @@
 pub mod identity;
 pub mod prepared;
 pub mod quota;
+pub mod reserve;
 pub mod script;
 pub mod seeds;
 pub mod signal_plans;
@@ -374,7 +375,7 @@ impl LazyPlan {
             });
         };
         let spec = &self.header.spec;
-        let d = cache.get(k, || draw_stratum(spec, s));
+        let d = cache.get(k, || draw_stratum(spec, k, s));
         let b = d.basics.get(j).ok_or_else(no_clip)?;
         let archetype_names: Vec<&String> = spec.pedestrians.archetype_mix.keys().collect();
         let id = clip_id(&s.town, &s.weather, j);
@@ -414,6 +415,8 @@ struct ClipBasics {
     first_vehicle: usize,
     /// The clip's emergency vehicle, if it is one of the stratum's emergency clips.
     emergency: Option<EmergencyKind>,
+    /// The clip's planned count of labelled crossers ([`reserve::labelled_targets`]).
+    labelled_crossers: Option<u32>,
 }
 
 /// Per-pedestrian allocations made at the stratum level (16 bytes: a plan holds one per pedestrian).
@@ -549,8 +552,9 @@ fn crosser_shares(spec: &Spec) -> (f64, f64) {
     (r.clamp(0.0, max), b)
 }
 
-/// The draws of a stratum: each clip's basics, then the stratum's pedestrian allocations and driving profiles.
-fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
+/// The draws of stratum `stratum_index` (plan order): each clip's basics, then the stratum's pedestrian
+/// allocations, each clip's count of labelled crossers and the driving profiles.
+fn draw_stratum(spec: &Spec, stratum_index: usize, stratum: &Stratum) -> StratumDraws {
     let seed = spec.dataset.seed;
     let d = &spec.dataset;
     let (mut first_pedestrian, mut first_vehicle) = (0, 0);
@@ -570,6 +574,7 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
                 first_pedestrian,
                 first_vehicle,
                 emergency: None,
+                labelled_crossers: None,
             };
             first_pedestrian += basics.pedestrians;
             first_vehicle += basics.vehicles;
@@ -580,6 +585,10 @@ fn draw_stratum(spec: &Spec, stratum: &Stratum) -> StratumDraws {
     allocate_emergencies(spec, stratum, &mut basics);
 
     let allocs = allocate_pedestrians(spec, stratum, &basics);
+    let wanted = reserve::labelled_targets(spec, stratum_index, &basics, &allocs);
+    for (b, wanted) in basics.iter_mut().zip(wanted) {
+        b.labelled_crossers = wanted;
+    }
     let m = &spec.traffic.profile_mix;
     let mut stratum_rng = seeds::rng_for(
         seed,
@@ -940,6 +949,7 @@ fn plan_clip(
         cyclists,
         signal_offsets,
         timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
+        labelled_crossers: basics.labelled_crossers,
     })
 }
 

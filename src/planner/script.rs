@@ -13,7 +13,7 @@ use crate::dsl::types::{
 };
 
 /// Version of the plan format.
-pub const PLAN_FORMAT_VERSION: u32 = 5;
+pub const PLAN_FORMAT_VERSION: u32 = 6;
 
 /// A compiled dataset: the clip scripts in a stable order (town, weather, index).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -133,6 +133,12 @@ pub struct ClipScript {
     pub signal_offsets: Vec<(u32, f64)>,
     /// How much the clip was lengthened beyond its drawn duration so that its crossers' timelines fit, seconds.
     pub timeline_extension_s: f64,
+    /// How many of the clip's pedestrians the dataset should label crossers (`crossing.target_ratio` of the
+    /// stratum's pedestrians, shared among its clips by their planned crossers): the executor re-simulates the
+    /// clip, promoting non-crossers or demoting crossers, until it has that many or runs out of candidates
+    /// (`exec::realise`). Absent without layer 1 (crosser allocation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub labelled_crossers: Option<u32>,
 }
 
 impl ClipScript {
@@ -347,6 +353,9 @@ pub enum CrosserSource {
     Allocated,
     /// The CARLA-like baseline.
     Baseline,
+    /// A non-crosser the executor promoted to a crosser because its clip had fewer labelled crossers than
+    /// planned (`ClipScript::labelled_crossers`); only in the written tables, never in a plan.
+    Promoted,
     /// Not a crosser.
     None,
 }

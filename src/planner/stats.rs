@@ -149,10 +149,16 @@ pub struct PlanStats {
     pub crossers_by_source: BTreeMap<String, usize>,
     /// Planned sequence-level crossing ratio.
     pub planned_crossing_ratio: f64,
-    /// Expected share of pedestrians labelled crossers in the dataset (planned crossers × the measured
-    /// realisation, `calibration::CROSSER_REALISATION`).
+    /// Pedestrians the clips' counts of labelled crossers add up to (`ClipScript::labelled_crossers`, which the
+    /// executor meets by promoting and demoting pedestrians); 0 when the clips set none (layer 1 off).
+    pub labelled_crossers: usize,
+    /// Expected share of pedestrians labelled crossers in the dataset: the clips' counts of labelled crossers
+    /// over the pedestrians where they set them, else planned crossers × the measured realisation
+    /// (`calibration::CROSSER_REALISATION`).
     pub expected_crossing_ratio: f64,
-    /// One standard deviation of the labelled crossing ratio around `expected_crossing_ratio`: each planned
+    /// One standard deviation of the labelled crossing ratio around `expected_crossing_ratio`: with counts per
+    /// clip, their measured misses (`calibration::LABELLED_COUNT_MISS_VARIANCE` per clip with a planned
+    /// crosser); else each planned
     /// crosser's outcome (binomial) and the realisation's spread between specs
     /// (`calibration::CROSSER_REALISATION_SPREAD`).
     pub expected_crossing_ratio_sd: f64,
@@ -221,6 +227,8 @@ fn round(x: f64, digits: i32) -> f64 {
 pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
     let mut cells: BTreeMap<(String, String), usize> = BTreeMap::new();
     let mut in_view: Vec<f64> = Vec::new();
+    // Whether the clips set counts of labelled crossers, and how many of those have a planned crosser.
+    let (mut counts_set, mut counted_clips) = (false, 0usize);
     let mut lengthening_s = 0.0;
     let mut stats = PlanStats {
         dataset: plan.dataset.clone(),
@@ -234,6 +242,7 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         crossers: 0,
         crossers_by_source: BTreeMap::new(),
         planned_crossing_ratio: 0.0,
+        labelled_crossers: 0,
         expected_crossing_ratio: 0.0,
         expected_crossing_ratio_sd: 0.0,
         adapted_baseline: super::adapted_baseline(spec).map(|(spec_ratio, used)| AdaptedBaseline {
@@ -319,6 +328,14 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         }
         stats.cyclists += clip.cyclists.len();
         in_view.extend(clip.pedestrians.iter().filter_map(|p| p.in_view_before_crossing_s));
+        if let Some(k) = clip.labelled_crossers {
+            stats.labelled_crossers += k as usize;
+            counts_set = true;
+            // A clip without a planned crosser has nothing to miss (it labels none and promotes none).
+            if clip.pedestrians.iter().any(|p| p.role == Role::Crosser) {
+                counted_clips += 1;
+            }
+        }
         if clip.timeline_extension_s > 0.0 {
             stats.timeline.lengthened_clips += 1;
             lengthening_s += clip.timeline_extension_s;
@@ -349,9 +366,18 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
         let (realisation, spread) = crate::calibration::crosser_realisation(spec);
         let realisation = super::crossing_adaptation(spec).map_or(realisation, |a| a.realisation);
         let crossers = stats.crossers as f64;
-        let expected = crossers * realisation;
+        let (expected, variance) = if counts_set {
+            (
+                stats.labelled_crossers as f64,
+                counted_clips as f64 * crate::calibration::LABELLED_COUNT_MISS_VARIANCE,
+            )
+        } else {
+            (
+                crossers * realisation,
+                crossers * realisation * (1.0 - realisation) + (crossers * spread).powi(2),
+            )
+        };
         stats.expected_crossing_ratio = round(expected / stats.pedestrians as f64, 4);
-        let variance = crossers * realisation * (1.0 - realisation) + (crossers * spread).powi(2);
         stats.expected_crossing_ratio_sd = round(variance.sqrt() / stats.pedestrians as f64, 4);
     }
     stats.estimated_annotated_samples = (stats.pedestrian_frames as f64 * EXPECTED_VISIBLE_SHARE).round() as u64;
@@ -525,6 +551,13 @@ impl std::fmt::Display for PlanStats {
             stats.expected_crossing_ratio_sd,
             stats.target_crossing_ratio
         )?;
+        if stats.labelled_crossers > 0 {
+            writeln!(
+                out,
+                "labelled crossers     {} planned, clip by clip: generate promotes or demotes pedestrians until each clip has its count",
+                stats.labelled_crossers
+            )?;
+        }
         if let Some(a) = &stats.adapted_layers {
             writeln!(
                 out,

@@ -169,7 +169,7 @@ pub(crate) fn transition(
     // window); the phone comes out afterwards.
     if let Distraction::At(at_s) = p.distraction
         && ctx.time_s >= at_s
-        && (p.traits.source != CrosserSource::Allocated || p.attempt.over())
+        && (!matches!(p.traits.source, CrosserSource::Allocated | CrosserSource::Promoted) || p.attempt.over())
     {
         match p.activity {
             Activity::WalkingSidewalk | Activity::LookingAround | Activity::CheckingTraffic | Activity::Hesitating => {
