@@ -16,9 +16,11 @@ use crate::planner::SimParams;
 use crate::world::RoadNetwork;
 
 /// A pedestrian holds at the curb (or hurries across) while an emergency vehicle closes in from nearer than
-/// this, metres. pedsynth: a siren is heard some 100 m away in a city street.
+/// this on a course that passes near it, metres. pedsynth: a siren is heard some 100 m away in a city street.
 pub(crate) const SIREN_HOLD_M: f64 = 100.0;
-/// ... or while one passes within this distance, metres. pedsynth.
+/// ... whose course passes within this distance of the pedestrian, or while one is within it, metres. pedsynth (before
+/// 2026-11-27 any emergency vehicle closing in at all held pedestrians: one circling the block on the next
+/// street kept a whole clip at the curb).
 pub(crate) const SIREN_PASSING_M: f64 = 15.0;
 
 /// What a pedestrian perceives of the traffic.
@@ -43,8 +45,8 @@ pub(crate) struct Percept {
     pub blocked_by_standing: bool,
     /// Whether the ego's camera sees the pedestrian (the simulation's estimate, `view`).
     pub in_view: bool,
-    /// Whether an emergency vehicle's siren is near: closing in from nearer than [`SIREN_HOLD_M`], or passing
-    /// within [`SIREN_PASSING_M`].
+    /// Whether an emergency vehicle's siren is near: within [`SIREN_PASSING_M`], or closing in from nearer than
+    /// [`SIREN_HOLD_M`] on a course that passes within [`SIREN_PASSING_M`].
     pub siren_near: bool,
     /// The pedestrian signal of its signalised crosswalk, if it has one (set by the simulation each step).
     pub walk: Option<WalkSignal>,
@@ -137,7 +139,18 @@ pub(crate) fn perceive(p: &mut Ped, vehicles: &[Vehicle], around: &Surroundings,
     percept.siren_near = vehicles.iter().filter(|v| v.emergency.is_some()).any(|v| {
         let d = pos - v.pose.pos;
         let dist = d.length();
-        dist < SIREN_PASSING_M || (dist < SIREN_HOLD_M && v.velocity().dot(d) > 0.0)
+        if dist < SIREN_PASSING_M {
+            return true;
+        }
+        // Closing in from nearer than SIREN_HOLD_M on a course that passes within SIREN_PASSING_M (down the
+        // pedestrian's street, or across it close by): not one driving by on another street.
+        let vel = v.velocity();
+        let closing = vel.dot(d);
+        if dist >= SIREN_HOLD_M || closing <= 0.0 {
+            return false;
+        }
+        let t_s = closing / vel.length_squared();
+        (d - vel * t_s).length() < SIREN_PASSING_M
     });
     percept.conflict_vehicle = None;
     let Some(line) = p.traits.line else {
