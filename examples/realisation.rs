@@ -115,9 +115,10 @@ fn main() {
                 if std::env::var_os("REALISATION_MISSES").is_some() && clip.labelled_crossers.is_some() && got != wanted
                 {
                     eprintln!(
-                        "{}: {got} labelled of {wanted} planned, {} pedestrians, {} re-simulations",
+                        "{}: {got} labelled of {wanted} planned, {} pedestrians, {} re-simulations (kept: round {})",
                         clip.clip_id,
                         clip.pedestrians.len(),
+                        r.simulations - 1,
                         r.rounds
                     );
                 }
@@ -126,7 +127,7 @@ fn main() {
                     got,
                     usize::from(clip.labelled_crossers.is_some()),
                     usize::from(clip.labelled_crossers.is_some() && got == wanted),
-                    r.rounds,
+                    r.simulations - 1,
                     got.abs_diff(wanted).pow(2),
                 ];
                 (clip.town.as_str(), c, why, topup)

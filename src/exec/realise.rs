@@ -28,8 +28,10 @@ pub struct Realised<'a> {
     pub trace: ClipTrace,
     /// The annotations.
     pub observations: Observations,
-    /// Re-simulations made (0 when the first met the count or the clip sets none).
+    /// The round kept: 0 for the first simulation, k for the k-th re-simulation.
     pub rounds: usize,
+    /// Simulations run in all (1 when the first met the count or the clip sets none).
+    pub simulations: usize,
 }
 
 impl Realised<'_> {
@@ -57,6 +59,7 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
         trace,
         observations,
         rounds: 0,
+        simulations: 1,
     };
     let Some(wanted) = script.labelled_crossers else {
         return best;
@@ -67,6 +70,7 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
     let mut demoted = vec![false; script.pedestrians.len()];
     // The last round's script and observations, where they are not the best's.
     let mut current: Option<(ClipScript, Observations)> = None;
+    let mut simulations = 1;
     for round in 1..=MAX_ROUNDS {
         let (s, o) = match &current {
             Some((s, o)) => (s, o),
@@ -121,6 +125,7 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
             break;
         }
         let (trace, observations) = run(&next);
+        simulations += 1;
         let miss = labelled(&observations).abs_diff(wanted);
         if miss < best_miss {
             best_miss = miss;
@@ -129,11 +134,13 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
                 trace,
                 observations,
                 rounds: round,
+                simulations: 0,
             };
             current = None;
         } else {
             current = Some((next, observations));
         }
     }
+    best.simulations = simulations;
     best
 }
