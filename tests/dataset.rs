@@ -222,6 +222,8 @@ struct ClipRow {
 #[derive(Debug, Clone)]
 struct PedRow {
     crosser: bool,
+    /// `role`, `crosser_source`, `behaviour`.
+    roles: [String; 3],
     first_crossing_frame: Option<u32>,
     annotated_frames: u32,
     height_m: f32,
@@ -328,10 +330,13 @@ fn read_dataset(dir: &Path) -> Dataset {
             u32s(&b, "annotated_frames"),
             f32s(&b, "height_m"),
         );
+        let (role, source, behaviour) = (strs(&b, "role"), strs(&b, "crosser_source"), strs(&b, "behaviour"));
         for i in 0..b.num_rows() {
             let key = (ids[i].clone().expect("id"), ped[i].expect("pedestrian"));
+            let text = |c: &[Option<String>]| c[i].clone().expect("string");
             let row = PedRow {
                 crosser: crosser[i],
+                roles: [text(&role), text(&source), text(&behaviour)],
                 first_crossing_frame: fcf[i],
                 annotated_frames: annotated[i].expect("annotated_frames"),
                 height_m: height[i],
@@ -687,6 +692,15 @@ fn lane_name(l: pedsynth::world::LaneType) -> String {
     s.to_lowercase()
 }
 
+/// An enum's snake_case name, as the tables write it (serde's).
+fn snake<T: serde::Serialize>(v: &T) -> String {
+    serde_json::to_value(v)
+        .expect("serialises")
+        .as_str()
+        .expect("a unit variant")
+        .to_owned()
+}
+
 /// Re-simulates every clip of the dataset and checks the boxes, the trace columns and the labels.
 fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str]) {
     let (loaded, plan) =
@@ -760,6 +774,31 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
                         annotated.contains(&(f as u32, id as u32))
                     ),
                     "tracks {key:?}"
+                );
+            }
+        }
+        // The pedestrians table describes the realised script (roles after promotions and demotions) and its
+        // sequence labels; every change from the plan is one `exec::realise` makes.
+        for (id, (q, planned_p)) in script.pedestrians.iter().zip(&planned.pedestrians).enumerate() {
+            let p = &d.pedestrians[&(script.clip_id.clone(), id as u32)];
+            assert_eq!(
+                p.roles,
+                [snake(&q.role), snake(&q.crosser_source), q.behaviour.name().to_owned()],
+                "{} pedestrian {id}: roles vs the realised script",
+                script.clip_id
+            );
+            assert_eq!(
+                p.crosser, realised.observations.annotations.pedestrians[id].crosser,
+                "{} pedestrian {id}: crosser",
+                script.clip_id
+            );
+            if q != planned_p {
+                assert!(
+                    q.crosser_source == pedsynth::planner::CrosserSource::Promoted
+                        || q.behaviour == pedsynth::planner::Behaviour::HardNegative
+                            && planned_p.role == pedsynth::planner::Role::Crosser,
+                    "{} pedestrian {id}: changed from the plan, neither promoted nor demoted",
+                    script.clip_id
                 );
             }
         }

@@ -1,11 +1,14 @@
 //! Realisation: simulate and observe a clip, then, where its plan sets a count of labelled crossers
-//! (`ClipScript::labelled_crossers`), re-simulate it with non-crossers promoted to crossers or labelled crossers
-//! demoted to hard negatives, or crossers that were not labelled given a new crossing point (`planner::reserve`) until the clip has that many, so that a dataset's crossing
-//! ratio lands on its target instead of spreading with each clip's chance failures.
+//! (`ClipScript::labelled_crossers`), re-simulate it with pedestrians edited by `planner::reserve` until the clip
+//! has that many: short of it, non-crossers and crossers that were not labelled are promoted to crossers at a
+//! new crossing point; over it, labelled crossers are demoted to hard negatives. A dataset's crossing ratio then
+//! lands on its target instead of spreading with each clip's chance failures.
 //!
-//! Rounds are bounded ([`MAX_ROUNDS`]); each round changes as many pedestrians as the count is off by, in a
-//! fixed order (pedestrian id), never one changed before, and the round closest to the count (the earliest of
-//! equals) is kept. Everything is a pure function of (plan, clip): determinism, resume and sharding hold.
+//! Rounds are bounded ([`MAX_ROUNDS`]); each round edits as many pedestrians as the count is off by, in a fixed
+//! order (to promote: non-crossers, then crossers not labelled, each by id; to demote: labelled crossers by id, a
+//! promoted one restored as planned rather than demoted; a demoted or restored pedestrian is never promoted
+//! again), and the round closest to the count (the earliest of equals) is kept. Everything is a pure function of
+//! (plan, clip): determinism, resume and sharding hold.
 
 use std::borrow::Cow;
 
@@ -70,6 +73,8 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
     let mut demoted = vec![false; script.pedestrians.len()];
     // The last round's script and observations, where they are not the best's.
     let mut current: Option<(ClipScript, Observations)> = None;
+    // The ego's route, built when a first promotion needs it (the script holds its lanes).
+    let mut route: Option<Option<crate::world::Route>> = None;
     let mut simulations = 1;
     for round in 1..=MAX_ROUNDS {
         let (s, o) = match &current {
@@ -103,7 +108,10 @@ pub fn realise<'a>(script: &'a ClipScript, spec: &Spec, sim: &SimParams, rig: &R
                 continue;
             }
             let edit = if have < wanted {
-                reserve::promoted(spec, net, &next, i, promotions[i])
+                let route = route.get_or_insert_with(|| net.route_through(&script.ego.route.lanes_in(net)));
+                route
+                    .as_ref()
+                    .and_then(|route| reserve::promoted(spec, net, route, &next, i, promotions[i]))
             } else if promotions[i] > 0 {
                 // A promoted pedestrian is not demoted but restored as planned.
                 Some(script.pedestrians[i].clone())

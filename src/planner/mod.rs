@@ -1136,11 +1136,7 @@ fn plan_pedestrians(
                     // Allocated and baseline crossers, and hard negatives, start within the spawn range ahead of
                     // the ego, far enough that the ego (easing off for them) cannot pass before their time in
                     // view is up.
-                    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max().min(far_m));
-                    let lo = (c.decision_window_m.min()
-                        + EGO_BRAKING_ESTIMATE_M
-                        + COURTESY_SPEED_ESTIMATE_MPS * in_view_before_crossing_s.unwrap_or(0.0))
-                    .clamp(lo, hi);
+                    let (lo, hi) = crosser_spawn_range(spec, route, in_view_before_crossing_s.unwrap_or(0.0));
                     let approach_m = draw(rng, timeline.approach_m);
                     // Where lights run, a share of them waits at a signalised crosswalk on the ego's route (the
                     // first one in range), across the ego's approach road at the junction's mouth.
@@ -1224,6 +1220,19 @@ fn plan_pedestrians(
 }
 
 type Placement = (DVec2, f64, f64, Option<CrossingScript>, SpawnPlace);
+
+/// Where along the ego's route (arc length from its start, metres) a crosser starting on a sidewalk is placed:
+/// within layer 1's spawn range and the visibility gate's distance, and far enough that the ego, easing off for
+/// it, cannot pass before its `in_view_s` is up.
+fn crosser_spawn_range(spec: &Spec, route: &Route, in_view_s: f64) -> (f64, f64) {
+    let c = &spec.crossing;
+    let spawn_ahead = c.layers.crosser_allocation.spawn_ahead_m;
+    let far_m = spec.annotations.visibility.max_distance_m.min(route.length_m() - 1.0);
+    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max().min(far_m));
+    let lo =
+        (c.decision_window_m.min() + EGO_BRAKING_ESTIMATE_M + COURTESY_SPEED_ESTIMATE_MPS * in_view_s).clamp(lo, hi);
+    (lo, hi)
+}
 
 fn draw(rng: &mut ChaCha20Rng, r: crate::dsl::types::Range) -> f64 {
     if r.max() > r.min() {

@@ -11,11 +11,11 @@
 //! the pedestrian's id, so the result is still a pure function of (plan, clip).
 
 use super::{
-    Behaviour, ClipBasics, ClipScript, CrosserSource, PedAlloc, PedestrianScript, Role, Side, SpawnPlace, draw,
-    place_crosser, quota, seeds,
+    Behaviour, ClipBasics, ClipScript, CrosserSource, PedAlloc, PedestrianScript, Role, Side, SpawnPlace,
+    crosser_spawn_range, draw, place_crosser, quota, seeds,
 };
 use crate::dsl::types::Spec;
-use crate::world::RoadNetwork;
+use crate::world::{RoadNetwork, Route};
 use rand::RngExt;
 
 /// Each clip's planned count of labelled crossers: `crossing.target_ratio` of the stratum's pedestrians,
@@ -55,12 +55,19 @@ pub(super) fn labelled_targets(
 }
 
 /// Pedestrian `i` of `clip` made a crosser ([`CrosserSource::Promoted`], normal behaviour, crossing alone)
-/// placed as the planner places layer 1's crossers (a crossing point ahead of the ego within the spawn range,
-/// far enough for its time in view), with the draws of a stream of its own: a non-crosser, or a crosser that
+/// placed as the planner places layer 1's crossers (a crossing point beside `route`, the ego's, within the spawn
+/// range and far enough for its time in view), with the draws of a stream of its own: a non-crosser, or a crosser that
 /// was not labelled one, given a new crossing point (the executor picks which); `attempt` numbers the
 /// pedestrian's promotions (each draws from a stream of its own). `None` for a group's leader
 /// (its companions follow it) or if no free crossing point is found.
-pub fn promoted(spec: &Spec, net: &RoadNetwork, clip: &ClipScript, i: usize, attempt: u32) -> Option<PedestrianScript> {
+pub fn promoted(
+    spec: &Spec,
+    net: &RoadNetwork,
+    route: &Route,
+    clip: &ClipScript,
+    i: usize,
+    attempt: u32,
+) -> Option<PedestrianScript> {
     let p = clip.pedestrians.get(i)?;
     let leads = clip
         .pedestrians
@@ -74,17 +81,11 @@ pub fn promoted(spec: &Spec, net: &RoadNetwork, clip: &ClipScript, i: usize, att
     let in_view_s = draw(&mut rng, c.timeline.in_view_before_crossing_s);
     let approach_m = draw(&mut rng, c.timeline.approach_m);
     let side = if rng.random_bool(0.5) { Side::Left } else { Side::Right };
-    let route = net.route_through(&clip.ego.route.lanes_in(net))?;
-    let spawn_ahead = c.layers.crosser_allocation.spawn_ahead_m;
-    let far_m = spec.annotations.visibility.max_distance_m.min(route.length_m() - 1.0);
-    let (lo, hi) = (spawn_ahead.min(), spawn_ahead.max().min(far_m));
-    let lo =
-        (c.decision_window_m.min() + super::EGO_BRAKING_ESTIMATE_M + super::COURTESY_SPEED_ESTIMATE_MPS * in_view_s)
-            .clamp(lo, hi);
+    let (lo, hi) = crosser_spawn_range(spec, route, in_view_s);
+    // Placed clear of everyone else's spawn and curb points (not of its own old ones).
     let others: Vec<PedestrianScript> = clip.pedestrians.iter().filter(|q| q.id != p.id).cloned().collect();
     let (spawn, heading, ahead, crossing, place) =
-        place_crosser(net, &route, lo, hi, side, approach_m, &others, &mut rng)?;
-    crossing.as_ref()?;
+        place_crosser(net, route, lo, hi, side, approach_m, &others, &mut rng)?;
     Some(PedestrianScript {
         role: Role::Crosser,
         crosser_source: CrosserSource::Promoted,

@@ -353,8 +353,9 @@ pub enum CrosserSource {
     Allocated,
     /// The CARLA-like baseline.
     Baseline,
-    /// A non-crosser the executor promoted to a crosser because its clip had fewer labelled crossers than
-    /// planned (`ClipScript::labelled_crossers`); only in the written tables, never in a plan.
+    /// Made a crosser at a new crossing point by the executor (a non-crosser, or a crosser that was not
+    /// labelled) because its clip had fewer labelled crossers than planned (`ClipScript::labelled_crossers`);
+    /// only in the written tables, never in a plan.
     Promoted,
     /// Not a crosser.
     None,

@@ -158,8 +158,7 @@ pub struct PlanStats {
     pub expected_crossing_ratio: f64,
     /// One standard deviation of the labelled crossing ratio around `expected_crossing_ratio`: with counts per
     /// clip, their measured misses (`calibration::LABELLED_COUNT_MISS_VARIANCE` per clip with a planned
-    /// crosser); else each planned
-    /// crosser's outcome (binomial) and the realisation's spread between specs
+    /// crosser); else each planned crosser's outcome (binomial) and the realisation's spread between specs
     /// (`calibration::CROSSER_REALISATION_SPREAD`).
     pub expected_crossing_ratio_sd: f64,
     /// The baseline the planner used when it lowered the spec's `baseline_ratio` to meet a low target (else

@@ -18,9 +18,9 @@ use crate::world::RoadNetwork;
 /// A pedestrian holds at the curb (or hurries across) while an emergency vehicle closes in from nearer than
 /// this on a course that passes near it, metres. pedsynth: a siren is heard some 100 m away in a city street.
 pub(crate) const SIREN_HOLD_M: f64 = 100.0;
-/// ... whose course passes within this distance of the pedestrian, or while one is within it, metres. pedsynth (before
-/// 2026-11-27 any emergency vehicle closing in at all held pedestrians: one circling the block on the next
-/// street kept a whole clip at the curb).
+/// ... on a course that passes within this distance of the pedestrian, or while one is within it, metres.
+/// pedsynth (before 2026-11-27 any emergency vehicle closing in held pedestrians: one circling the block on the
+/// next street kept a whole clip at the curb).
 pub(crate) const SIREN_PASSING_M: f64 = 15.0;
 
 /// What a pedestrian perceives of the traffic.
