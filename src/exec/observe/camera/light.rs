@@ -4,7 +4,10 @@
 //! surface in full noon sun maps near the middle of the 8-bit range after tone mapping.
 
 use glam::Vec3;
+use std::ops::Add;
+use wide::f32x4;
 
+use super::lanes::{V3, floor_i32x4};
 use crate::dsl::types::WeatherParams;
 
 /// The lighting of a clip.
@@ -96,24 +99,54 @@ impl Lighting {
         }
     }
 
-    /// The sky's colour in a view direction (unit, world frame), the sun's disc included.
-    pub fn sky(&self, dir: Vec3) -> Vec3 {
-        let up = dir.z.max(0.0);
-        let t = up.powf(0.6);
-        let mut c = self.horizon.lerp(self.zenith, t);
-        let cos_sun = dir.dot(self.sun_dir);
-        if cos_sun > 0.9 {
-            let glow = ((cos_sun - 0.9) / 0.1).powi(8);
-            c += self.sun * (0.4 * glow);
-            if cos_sun > 0.9996 {
-                c += self.sun * 4.0;
-            }
+    /// The sky's colour in four view directions (unit, world frame), the sun's disc included.
+    #[inline(always)]
+    pub fn sky4(&self, dir: V3) -> V3 {
+        let up = dir.z.max(f32x4::ZERO);
+        let mut c = V3::lerp(self.horizon, self.zenith, horizon_to_zenith(up));
+        let cos_sun = dir.dot_v(self.sun_dir);
+        let glowing = cos_sun.simd_gt(f32x4::splat(0.9));
+        if glowing.any() {
+            let g = ((cos_sun - 0.9) / 0.1).max(f32x4::ZERO);
+            let g2 = g * g;
+            let g4 = g2 * g2;
+            let disc = cos_sun
+                .simd_gt(f32x4::splat(0.9996))
+                .select(f32x4::splat(4.0), f32x4::ZERO);
+            let k = glowing.select(f32x4::splat(0.4) * g4 * g4 + disc, f32x4::ZERO);
+            c = c.add(V3::splat(self.sun).scale(k));
         }
-        if dir.z < 0.0 {
-            c = c.lerp(self.ground_ambient, (-dir.z * 4.0).min(1.0));
+        let below = dir.z.simd_lt(f32x4::ZERO);
+        if below.any() {
+            let s = below.select((-dir.z * 4.0).min(f32x4::ONE), f32x4::ZERO);
+            c = c.scale(f32x4::ONE - s).add(V3::splat(self.ground_ambient).scale(s));
         }
         c
     }
+}
+
+/// Segments of [`HORIZON_TO_ZENITH`].
+const GRADIENT_STEPS: usize = 256;
+
+/// The sky's gradient `up^0.6` as a table over `√up` (where it is `(√up)^1.2`, smooth enough for linear
+/// interpolation to stay within 10⁻³ of it), so that the sky costs no `powf` per pixel.
+static HORIZON_TO_ZENITH: std::sync::LazyLock<[f32; GRADIENT_STEPS + 2]> = std::sync::LazyLock::new(|| {
+    std::array::from_fn(|i| (i.min(GRADIENT_STEPS) as f64 / GRADIENT_STEPS as f64).powf(1.2) as f32)
+});
+
+/// `up^0.6` for `up` in [0, 1], from [`HORIZON_TO_ZENITH`].
+#[inline(always)]
+fn horizon_to_zenith(up: f32x4) -> f32x4 {
+    let table = &*HORIZON_TO_ZENITH;
+    let s = up.min(f32x4::ONE).sqrt() * GRADIENT_STEPS as f32;
+    let i = floor_i32x4(s)
+        .max(wide::i32x4::ZERO)
+        .min(wide::i32x4::splat(GRADIENT_STEPS as i32));
+    let f = s - i.round_float();
+    let ia = i.to_array();
+    let a = f32x4::new(ia.map(|k| table[k as usize]));
+    let b = f32x4::new(ia.map(|k| table[k as usize + 1]));
+    a + (b - a) * f
 }
 
 #[cfg(test)]
@@ -128,5 +161,18 @@ mod tests {
         assert!(noon.sun.x > 1.0 && night.sun.length() < 1e-3);
         assert!(night.night > 0.99 && noon.night < 0.01);
         assert!(noon.shadows && !night.shadows);
+    }
+
+    #[test]
+    fn the_gradient_table_follows_the_power_law() {
+        for k in 0..=2000 {
+            let up = k as f32 / 2000.0;
+            let got = horizon_to_zenith(f32x4::splat(up)).to_array()[0];
+            assert!(
+                (got - up.powf(0.6)).abs() < 1.0e-3,
+                "{up}: {got} against {}",
+                up.powf(0.6)
+            );
+        }
     }
 }

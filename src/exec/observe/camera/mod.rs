@@ -2,6 +2,7 @@
 //! rasterisation of the scene, and DVS events from the rendered luminance.
 //!
 //! - [`raster`] — the visibility buffer (nearest primitive and depth per sample).
+//! - [`lanes`] — four-lane math for shading four pixels at once.
 //! - [`light`] — lighting from the weather.
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
 //! - [`dvs`] — the ESIM event simulator.
@@ -14,6 +15,7 @@
 //! antialiasing), then adds rain streaks and maps to sRGB.
 
 pub mod dvs;
+pub mod lanes;
 pub mod light;
 pub mod raster;
 pub mod shade;
@@ -26,9 +28,11 @@ use rayon::prelude::*;
 use super::rig::{Camera, CameraPose};
 use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
 use crate::mix::splitmix64;
+use lanes::{V3, floor_i32x4};
 use light::Lighting;
 use raster::{EMPTY, Raster, clip_near};
 use shade::{ActiveLights, Noise, ShadeContext};
+use wide::f32x4;
 
 /// Samples per pixel along each axis.
 pub const SS: usize = 2;
@@ -58,6 +62,9 @@ pub struct CameraImages {
     /// Instance id per pixel (see [`super::scene::CHILD_INSTANCE_BASE`]).
     pub instance: Vec<u16>,
 }
+
+/// The marker of an edge pixel (its samples see different primitives) in a row's primitives.
+const EDGE: u32 = EMPTY - 1;
 
 /// Rows of the images resolved as one task.
 const BAND_ROWS: usize = 16;
@@ -97,6 +104,59 @@ impl SunView {
     fn project(&self, p: Vec3) -> DVec3 {
         self.project_f32(p).as_dvec3()
     }
+
+    /// The sun's visibility at four scene points of a surface (1 lit, 0 in shadow) from the shadow map's
+    /// depth keys, 2×2 percentage-closer filtered: the points are lifted off the surface by 5 cm and
+    /// compared with a bias of 8 cm; texel centres at integers, bilinear between.
+    #[inline(always)]
+    fn sunlit4(&self, key: &[f32], p: V3, normal: Vec3) -> f32x4 {
+        let d = p + V3::splat(normal * 0.05) - V3::splat(self.centre);
+        let half = SHADOW_PX as f32 * 0.5;
+        let x = d.dot_v(self.u) * self.scale + half - 0.5;
+        let y = d.dot_v(self.v) * self.scale + half - 0.5;
+        let depth = (d.dot_v(self.dir) + 0.08).to_array();
+        let (x0, y0) = (floor_i32x4(x), floor_i32x4(y));
+        let (fx, fy) = (x - x0.round_float(), y - y0.round_float());
+        let (xa, ya) = (x0.to_array(), y0.to_array());
+        let last = (SHADOW_PX - 1) as i32;
+        let mut c = [[1.0f32; 4]; 4];
+        for i in 0..4 {
+            if xa[i] < 0 || ya[i] < 0 || xa[i] >= last || ya[i] >= last {
+                continue;
+            }
+            let k = ya[i] as usize * SHADOW_PX + xa[i] as usize;
+            let lit = |k: usize| if key[k] > depth[i] { 0.0 } else { 1.0 };
+            c[0][i] = lit(k);
+            c[1][i] = lit(k + 1);
+            c[2][i] = lit(k + SHADOW_PX);
+            c[3][i] = lit(k + SHADOW_PX + 1);
+        }
+        let [l00, l10, l01, l11] = c.map(f32x4::new);
+        let a = l00 + (l10 - l00) * fx;
+        let b = l01 + (l11 - l01) * fx;
+        a + (b - a) * fy
+    }
+}
+
+/// The camera's view in a render: its centre (scene-relative), axes and intrinsics.
+struct View {
+    cam: Vec3,
+    right: Vec3,
+    down: Vec3,
+    fwd: Vec3,
+    cx: f32,
+    cy: f32,
+    inv_f: f32,
+}
+
+/// One sample of an edge pixel to shade; `slot` is where its colour goes.
+#[derive(Clone, Copy, Debug)]
+struct Sample {
+    prim: u32,
+    slot: u32,
+    key: f32,
+    u: f32,
+    v: f32,
 }
 
 /// A camera renderer: buffers reused from frame to frame (one per worker thread).
@@ -284,14 +344,6 @@ impl Renderer {
         self.sun = Some(sun);
     }
 
-    /// The sun's visibility at a scene point (1 lit, 0 in shadow), 2×2 percentage-closer filtered.
-    #[inline]
-    fn sunlit(&self, p: Vec3, normal: Vec3) -> f32 {
-        let Some(sun) = &self.sun else { return 1.0 };
-        let q = sun.project_f32(p + normal * 0.05);
-        pcf(&self.shadow.key, q.x - 0.5, q.y - 0.5, q.z + 0.08)
-    }
-
     fn choose_lights(&mut self, scene: &StaticScene, frame: &FrameScene, cam: Vec3, pose: &CameraPose) {
         self.lights.lamps.clear();
         self.lights.heads.clear();
@@ -344,8 +396,6 @@ impl Renderer {
         let w = c.width_px as usize;
         let y0 = out.y0;
         let h = out.depth_m.len() / w;
-        let (f, cx, cy) = (c.focal_px as f32, c.width_px as f32 * 0.5, c.height_px as f32 * 0.5);
-        let (right, down, fwd) = (pose.right.as_vec3(), pose.down.as_vec3(), pose.forward.as_vec3());
         let ctx = ShadeContext {
             scene,
             frame,
@@ -353,85 +403,156 @@ impl Renderer {
             noise: &self.noise,
             lights: &self.lights,
         };
-        let sw = w * SS;
-        let inv_f = 1.0 / f;
-        let inv_ss = 1.0 / SS as f32;
-        // The colour of one sample (or of the pixel centre when all samples agree), fogged, and its semantic tag.
-        let shade_at = |prim_id: u32, key: f32, u: f32, v: f32| -> (Vec3, u8) {
-            let ray = fwd + right * ((u - cx) * inv_f) + down * ((v - cy) * inv_f);
-            if prim_id == EMPTY || key <= 0.0 {
-                let dir = ray.normalize();
-                return (shade::fog(&self.light, self.light.sky(dir), 1.0e4), tag::SKY);
-            }
-            let prim: &Prim = frame.prim(scene, prim_id);
-            let z = 1.0 / key;
-            let p = cam + ray * z;
-            let ray_len = ray.length();
-            let dist = ray_len * z;
-            // A flat surface turned away from the sun gets none of it whether in shadow or not (bodies shade
-            // with per-point normals).
-            let away =
-                prim.normal.dot(self.light.sun_dir) <= 0.0 && !matches!(prim.material, Material::Body | Material::Head);
-            let shadow = if self.sun.is_some() && !away {
-                self.sunlit(p, prim.normal)
-            } else {
-                1.0
-            };
-            let (colour, semantic) = shade::surface(&ctx, prim, p, (ray, ray_len), shadow);
-            (shade::fog(&self.light, colour, dist), semantic)
+        let view = View {
+            cam,
+            right: pose.right.as_vec3(),
+            down: pose.down.as_vec3(),
+            fwd: pose.forward.as_vec3(),
+            cx: c.width_px as f32 * 0.5,
+            cy: c.height_px as f32 * 0.5,
+            inv_f: 1.0 / c.focal_px as f32,
         };
-        // Linear colours of up to TONE_RUN pixels of a row, tone-mapped at once (on the stack: no allocation).
-        const TONE_RUN: usize = 64;
-        let mut linear = [0.0f32; TONE_RUN * 3];
+        let sw = w * SS;
+        let inv_ss = 1.0 / SS as f32;
+        // Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
+        let mut row_prim = vec![EMPTY; w];
+        let mut row_key = vec![0.0f32; w];
+        // The samples of the row's edge pixels (four per pixel, in pixel order), and their shaded colours
+        // and tags by slot (the sample's index in that list).
+        let mut edges: Vec<Sample> = Vec::with_capacity(w * SS * SS);
+        let mut edge_colour = vec![Vec3::ZERO; w * SS * SS];
+        let mut edge_tag = vec![0u8; w * SS * SS];
+        let mut linear = vec![0.0f32; w * 3];
         for row in 0..h {
             let y = y0 + row;
-            for x in 0..w {
+            let v_centre = f32x4::splat(y as f32 + 0.5);
+            let labels = row * w..(row + 1) * w;
+            edges.clear();
+            for (x, (((prim_out, key_out), depth), instance)) in row_prim
+                .iter_mut()
+                .zip(row_key.iter_mut())
+                .zip(&mut out.depth_m[labels.clone()])
+                .zip(&mut out.instance[labels.clone()])
+                .enumerate()
+            {
                 let s0 = (y * SS) * sw + x * SS;
                 let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
                 let prims = ids.map(|i| self.vis.prim[i]);
                 let keys = ids.map(|i| self.vis.key[i]);
-                // Labels: the first sample's primitive; its semantic tag where it is shaded (road paint is
-                // looked up once, for the colour and the label).
-                let o = row * w + x;
+                // Labels: the first sample's primitive (its semantic tag comes with the colour).
                 if prims[0] == EMPTY {
-                    out.depth_m[o] = SKY_DEPTH_M;
-                    out.instance[o] = 0;
+                    *depth = SKY_DEPTH_M;
+                    *instance = 0;
                 } else {
-                    let prim = frame.prim(scene, prims[0]);
-                    out.depth_m[o] = (1.0 / keys[0]).min(SKY_DEPTH_M);
-                    out.instance[o] = prim.instance;
+                    *depth = (1.0 / keys[0]).min(SKY_DEPTH_M);
+                    *instance = frame.prim(scene, prims[0]).instance;
                 }
-                let colour = if prims.iter().all(|&p| p == prims[0]) {
-                    let key = if prims[0] == EMPTY {
-                        0.0
-                    } else {
-                        (keys[0] + keys[1] + keys[2] + keys[3]) * 0.25
-                    };
-                    // One primitive: the pixel centre's colour and tag.
-                    let (colour, semantic) = shade_at(prims[0], key, x as f32 + 0.5, y as f32 + 0.5);
-                    out.semantic[o] = semantic;
-                    colour
+                if prims[1] == prims[0] && prims[2] == prims[0] && prims[3] == prims[0] {
+                    *prim_out = prims[0];
+                    *key_out = (keys[0] + keys[1] + keys[2] + keys[3]) * 0.25;
                 } else {
-                    let mut sum = Vec3::ZERO;
-                    for (k, (&p, &key)) in prims.iter().zip(&keys).enumerate() {
+                    *prim_out = EDGE;
+                    for (k, (&prim, &key)) in prims.iter().zip(&keys).enumerate() {
                         let (sx, sy) = ((k % SS) as f32, (k / SS) as f32);
-                        let (colour, semantic) =
-                            shade_at(p, key, x as f32 + (sx + 0.5) * inv_ss, y as f32 + (sy + 0.5) * inv_ss);
-                        if k == 0 {
-                            out.semantic[o] = semantic;
-                        }
-                        sum += colour;
+                        edges.push(Sample {
+                            prim,
+                            slot: edges.len() as u32,
+                            key,
+                            u: x as f32 + (sx + 0.5) * inv_ss,
+                            v: y as f32 + (sy + 0.5) * inv_ss,
+                        });
                     }
-                    sum * 0.25
-                };
-                let k = x % TONE_RUN;
-                linear[k * 3..k * 3 + 3].copy_from_slice(&colour.to_array());
-                if k == TONE_RUN - 1 || x == w - 1 {
-                    let start = o - k;
-                    tone_map(&linear[..(k + 1) * 3], &self.lut, &mut out.rgb[start * 3..(o + 1) * 3]);
                 }
             }
+            // Pixels whose samples see one primitive: shaded at their centres, up to four neighbours of one
+            // primitive at a time.
+            let semantic = &mut out.semantic[labels];
+            let mut x = 0;
+            while x < w {
+                let prim = row_prim[x];
+                if prim == EDGE {
+                    x += 1;
+                    continue;
+                }
+                let mut end = x + 1;
+                while end < w && end - x < 4 && row_prim[end] == prim {
+                    end += 1;
+                }
+                let n = end - x;
+                let key = f32x4::new(std::array::from_fn(|i| row_key[x + i.min(n - 1)]));
+                let u = f32x4::splat(x as f32 + 0.5) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
+                let (colour, tags) = self.shade4(&ctx, &view, prim, key, u, v_centre);
+                for (i, c) in colour.lanes().iter().take(n).enumerate() {
+                    linear[(x + i) * 3..(x + i) * 3 + 3].copy_from_slice(&c.to_array());
+                    semantic[x + i] = tags[i];
+                }
+                x = end;
+            }
+            // Edge samples, up to four of one primitive at a time.
+            edges.sort_unstable_by_key(|s| (s.prim, s.slot));
+            for group in edges.chunk_by(|a, b| a.prim == b.prim) {
+                for chunk in group.chunks(4) {
+                    let lane =
+                        |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(&chunk[i.min(chunk.len() - 1)])));
+                    let (colour, tags) = self.shade4(
+                        &ctx,
+                        &view,
+                        chunk[0].prim,
+                        lane(|s| s.key),
+                        lane(|s| s.u),
+                        lane(|s| s.v),
+                    );
+                    for (s, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
+                        edge_colour[s.slot as usize] = c;
+                        edge_tag[s.slot as usize] = t;
+                    }
+                }
+            }
+            // Edge pixels: the mean of their samples' colours, the first sample's tag.
+            let mut e = 0;
+            for (x, _) in row_prim.iter().enumerate().filter(|(_, p)| **p == EDGE) {
+                let c = &edge_colour[e..e + 4];
+                let colour = (c[0] + c[1] + c[2] + c[3]) * 0.25;
+                linear[x * 3..x * 3 + 3].copy_from_slice(&colour.to_array());
+                semantic[x] = edge_tag[e];
+                e += 4;
+            }
+            tone_map(&linear, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
+    }
+
+    /// The fogged colours and the semantic tags of four samples of one primitive (or of the sky) at pixel
+    /// coordinates `(u, v)` with depth keys `key`.
+    #[inline(always)]
+    fn shade4(&self, ctx: &ShadeContext, view: &View, prim: u32, key: f32x4, u: f32x4, v: f32x4) -> (V3, [u8; 4]) {
+        let su = (u - view.cx) * view.inv_f;
+        let sv = (v - view.cy) * view.inv_f;
+        let ray = V3::splat(view.fwd) + V3::splat(view.right).scale(su) + V3::splat(view.down).scale(sv);
+        if prim == EMPTY {
+            let dir = ray.scale(f32x4::ONE / ray.length_squared().sqrt());
+            let sky = self.light.sky4(dir);
+            return (shade::fog4(&self.light, sky, f32x4::splat(1.0e4)), [tag::SKY; 4]);
+        }
+        let prim: &Prim = ctx.frame.prim(ctx.scene, prim);
+        let z = f32x4::ONE / key;
+        let p = V3::splat(view.cam) + ray.scale(z);
+        let ray_len = ray.length_squared().sqrt();
+        // A flat surface turned away from the sun gets none of it whether in shadow or not (bodies shade
+        // with per-point normals).
+        let away =
+            prim.normal.dot(self.light.sun_dir) <= 0.0 && !matches!(prim.material, Material::Body | Material::Head);
+        let shadow = match &self.sun {
+            Some(sun) if !away => sun.sunlit4(&self.shadow.key, p, prim.normal),
+            _ => f32x4::ONE,
+        };
+        let pts = shade::Points {
+            p,
+            ray,
+            ray_len,
+            shadow,
+        };
+        let (colour, semantic) = shade::surface4(ctx, prim, &pts);
+        (shade::fog4(&self.light, colour, ray_len * z), semantic)
     }
 
     /// Rain: thin, slanted, semi-transparent streaks at seeded places, brighter against dark backgrounds.
@@ -466,23 +587,6 @@ impl Renderer {
             }
         }
     }
-}
-
-/// Percentage-closer filtering of a [`SHADOW_PX`]-square shadow map at texel coordinates `(x, y)` (texel
-/// centres at integers) for a point at depth key `depth`: 1 lit, 0 in shadow, bilinear between.
-#[inline]
-fn pcf(key: &[f32], x: f32, y: f32, depth: f32) -> f32 {
-    let (x0, y0) = (shade::floor_i32(x), shade::floor_i32(y));
-    let last = (SHADOW_PX - 1) as i32;
-    if x0 < 0 || y0 < 0 || x0 >= last || y0 >= last {
-        return 1.0;
-    }
-    let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-    let i = y0 as usize * SHADOW_PX + x0 as usize;
-    let lit = |k: usize| if key[k] > depth { 0.0 } else { 1.0 };
-    let a = lit(i) + (lit(i + 1) - lit(i)) * fx;
-    let b = lit(i + SHADOW_PX) + (lit(i + SHADOW_PX + 1) - lit(i + SHADOW_PX)) * fx;
-    a + (b - a) * fy
 }
 
 /// Maps linear colour values to sRGB bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`,

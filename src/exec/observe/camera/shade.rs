@@ -4,9 +4,12 @@
 //! lighting.
 
 use glam::{Vec2, Vec3};
+use std::ops::{Add, Mul, Sub};
+use wide::f32x4;
 
+use super::lanes::{V3, exp4, floor_i32x4};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
-use crate::exec::observe::scene::{FrameScene, Material, Prim, StaticScene, road_paint, tag};
+use crate::exec::observe::scene::{FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, tag};
 use crate::mix::splitmix64;
 
 /// `x.floor()` without the call into libm that `f32::floor` compiles to on x86-64 without SSE4.1 (a hot
@@ -68,6 +71,29 @@ impl Noise {
         a + (b - a) * ty
     }
 
+    /// [`Noise::sample`] at four places `(qx, qy)`, lane by lane the same values.
+    #[inline(always)]
+    pub fn sample4(&self, qx: f32x4, qy: f32x4) -> f32x4 {
+        let (ix, iy) = (floor_i32x4(qx), floor_i32x4(qy));
+        let (tx, ty) = (qx - ix.round_float(), qy - iy.round_float());
+        let m = (NOISE_SIZE - 1) as i32;
+        let (xa, ya) = (ix.to_array(), iy.to_array());
+        let mut c = [[0.0f32; 4]; 4];
+        for i in 0..4 {
+            let (x0, y0) = ((xa[i] & m) as usize, (ya[i] & m) as usize);
+            let (x1, y1) = ((x0 + 1) & m as usize, (y0 + 1) & m as usize);
+            let v = |x: usize, y: usize| self.values[y * NOISE_SIZE + x];
+            c[0][i] = v(x0, y0);
+            c[1][i] = v(x1, y0);
+            c[2][i] = v(x0, y1);
+            c[3][i] = v(x1, y1);
+        }
+        let [v00, v10, v01, v11] = c.map(f32x4::new);
+        let a = v00 + (v10 - v00) * tx;
+        let b = v01 + (v11 - v01) * tx;
+        a + (b - a) * ty
+    }
+
     /// A cell hash in [0, 1).
     #[inline]
     pub fn cell(&self, x: i32, y: i32, salt: u32) -> f32 {
@@ -99,168 +125,251 @@ pub struct ShadeContext<'a> {
     pub lights: &'a ActiveLights,
 }
 
-/// The shaded colour of a surface point, before fog, and its semantic tag (road paint turns road into road
-/// line): `p` scene-relative, `(ray, ray_len)` the camera's ray to it and its length (the view direction is
-/// worked out only where a reflection needs it), `shadow` the sun's visibility (0–1).
+/// Four surface points of one primitive, as the camera sees them.
+#[derive(Clone, Copy, Debug)]
+pub struct Points {
+    /// The points, scene-relative.
+    pub p: V3,
+    /// The camera's rays to them (not unit: `forward + right·x + down·y`).
+    pub ray: V3,
+    /// The rays' lengths.
+    pub ray_len: f32x4,
+    /// The sun's visibility at each (0–1).
+    pub shadow: f32x4,
+}
+
+/// A noise value per lane, scaled: `1 + amp × noise(q)`.
 #[inline(always)]
-pub fn surface(ctx: &ShadeContext, prim: &Prim, p: Vec3, (ray, ray_len): (Vec3, f32), shadow: f32) -> (Vec3, u8) {
+fn grain(nz: &Noise, qx: f32x4, qy: f32x4, amp: f32) -> f32x4 {
+    f32x4::ONE + f32x4::splat(amp) * nz.sample4(qx, qy)
+}
+
+/// The shaded colours of four points of one primitive, before fog, and their semantic tags (road paint
+/// turns road into road line): textures, then the light each point receives (sun with shadows, sky and
+/// ground ambient, street lamps, headlights) and reflections where the surface is glossy.
+#[inline(always)]
+pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) {
     let l = ctx.light;
     let nz = ctx.noise;
-    let xy = p.truncate();
-    let mut normal = prim.normal;
-    let mut albedo = prim.albedo;
-    let mut emissive = Vec3::ZERO;
+    let p = pts.p;
+    let (x, y, z) = (p.x, p.y, p.z);
+    let one = f32x4::ONE;
+    let mut normal = V3::splat(prim.normal);
+    let mut albedo = V3::splat(prim.albedo);
+    let mut emissive = V3::ZERO;
     // Mirror-like reflection share (wet ground, glass, paint).
-    let mut gloss = 0.0f32;
+    let mut gloss = f32x4::ZERO;
     let mut ground = false;
-    let mut semantic = prim.tag;
+    let mut semantic = [prim.tag; 4];
     match prim.material {
         Material::Road => {
             ground = true;
-            let grain = 1.0 + 0.16 * nz.sample(xy * 1.3) + 0.08 * nz.sample(xy * 6.1 + 37.0);
-            albedo *= grain;
-            if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
-                && let Some((paint, paint_tag)) = road_paint(ctx.scene, piece, xy)
-            {
-                albedo = paint * (0.92 + 0.08 * nz.sample(xy * 9.0));
-                if prim.tag == tag::ROAD {
-                    semantic = paint_tag;
+            let g = f32x4::ONE
+                + f32x4::splat(0.16) * nz.sample4(x * 1.3, y * 1.3)
+                + f32x4::splat(0.08) * nz.sample4(x * 6.1 + 37.0, y * 6.1 + 37.0);
+            albedo = albedo.scale(g);
+            if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize) {
+                let (xs, ys) = (x.to_array(), y.to_array());
+                let mut painted = None;
+                for i in 0..4 {
+                    let xy = Vec2::new(xs[i], ys[i]);
+                    if let Some((paint, paint_tag)) = road_paint(ctx.scene, piece, xy) {
+                        let lanes = painted.get_or_insert_with(|| albedo.lanes());
+                        lanes[i] = paint * (0.92 + 0.08 * nz.sample(xy * 9.0));
+                        if prim.tag == tag::ROAD {
+                            semantic[i] = paint_tag;
+                        }
+                    }
+                }
+                if let Some(lanes) = painted {
+                    albedo = V3::from_lanes(lanes);
                 }
             }
         }
         Material::Sidewalk => {
             ground = true;
             if prim.tag == tag::SIDEWALK {
-                let g = xy / 0.6;
-                let (ix, iy) = (floor_i32(g.x), floor_i32(g.y));
-                let f = g - Vec2::new(ix as f32, iy as f32);
-                albedo *= if f.x < 0.05 || f.y < 0.05 {
-                    0.62
-                } else {
-                    0.88 + 0.2 * nz.cell(ix, iy, 7)
-                };
+                let (gx, gy) = (x / 0.6, y / 0.6);
+                let (ix, iy) = (floor_i32x4(gx), floor_i32x4(gy));
+                let (fx, fy) = (gx - ix.round_float(), gy - iy.round_float());
+                let joint = fx.simd_lt(f32x4::splat(0.05)) | fy.simd_lt(f32x4::splat(0.05));
+                let (ixs, iys) = (ix.to_array(), iy.to_array());
+                let cell = f32x4::new(std::array::from_fn(|i| nz.cell(ixs[i], iys[i], 7)));
+                let tile = f32x4::splat(0.88) + f32x4::splat(0.2) * cell;
+                albedo = albedo.scale(joint.select(f32x4::splat(0.62), tile));
             }
-            albedo *= 1.0 + 0.08 * nz.sample(xy * 3.7);
+            albedo = albedo.scale(grain(nz, x * 3.7, y * 3.7, 0.08));
         }
         Material::Curb => {
             ground = true;
-            albedo *= 1.0 + 0.1 * nz.sample(xy * 4.0 + p.z);
+            albedo = albedo.scale(grain(nz, x * 4.0 + z, y * 4.0 + z, 0.1));
         }
         Material::Terrain => {
             ground = true;
-            let patch = nz.sample(xy * 0.21);
-            albedo = albedo.lerp(Vec3::new(0.11, 0.09, 0.05), (0.5 + 0.6 * patch).clamp(0.0, 1.0));
-            albedo *= 1.0 + 0.2 * nz.sample(xy * 2.9);
+            let patch = nz.sample4(x * 0.21, y * 0.21);
+            let s = (f32x4::splat(0.5) + f32x4::splat(0.6) * patch)
+                .max(f32x4::ZERO)
+                .min(one);
+            albedo = V3::lerp(prim.albedo, Vec3::new(0.11, 0.09, 0.05), s);
+            albedo = albedo.scale(grain(nz, x * 2.9, y * 2.9, 0.2));
         }
         Material::Wall => {
-            let along_dir = Vec2::new(-normal.y, normal.x);
-            let a = xy.dot(along_dir) / 2.8;
-            let z = p.z / 3.2;
-            let (cell_a, cell_z) = (floor_i32(a), floor_i32(z));
-            let (fa, fz) = (a - cell_a as f32, z - cell_z as f32);
-            if fa > 0.22 && fa < 0.78 && fz > 0.3 && fz < 0.82 && p.z > 1.2 {
-                let lit = nz.cell(cell_a, cell_z, prim.aux) < 0.22;
-                albedo = Vec3::new(0.03, 0.035, 0.045);
-                gloss = 0.35;
-                if lit {
-                    emissive = Vec3::new(0.9, 0.7, 0.42) * (0.35 * l.night);
-                }
-            } else if fz < 0.04 {
-                albedo *= 0.7;
-            } else {
-                albedo *= 1.0 + 0.07 * nz.sample(Vec2::new(a * 4.0, p.z * 2.0));
+            let n = prim.normal;
+            let a = (x * -n.y + y * n.x) / 2.8;
+            let zz = z / 3.2;
+            let (cell_a, cell_z) = (floor_i32x4(a), floor_i32x4(zz));
+            let (fa, fz) = (a - cell_a.round_float(), zz - cell_z.round_float());
+            let window = fa.simd_gt(f32x4::splat(0.22))
+                & fa.simd_lt(f32x4::splat(0.78))
+                & fz.simd_gt(f32x4::splat(0.3))
+                & fz.simd_lt(f32x4::splat(0.82))
+                & z.simd_gt(f32x4::splat(1.2));
+            let plain = albedo.scale(grain(nz, a * 4.0, z * 2.0, 0.07));
+            let floor_line = fz.simd_lt(f32x4::splat(0.04));
+            let wall = V3::select(floor_line, albedo.scale(f32x4::splat(0.7)), plain);
+            albedo = V3::select(window, V3::splat(Vec3::new(0.03, 0.035, 0.045)), wall);
+            gloss = window.select(f32x4::splat(0.35), f32x4::ZERO);
+            if window.any() && l.night > 0.0 {
+                let (ca, cz, win) = (cell_a.to_array(), cell_z.to_array(), window.to_bitmask());
+                let lit = f32x4::new(std::array::from_fn(|i| {
+                    if win & (1 << i) != 0 && nz.cell(ca[i], cz[i], prim.aux) < 0.22 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                }));
+                emissive = V3::splat(Vec3::new(0.9, 0.7, 0.42) * (0.35 * l.night)).scale(lit);
             }
         }
         Material::Roof | Material::Metal | Material::Tyre => {}
-        Material::LampHead => emissive = Vec3::new(3.0, 2.5, 1.8) * l.night,
-        Material::Trunk => albedo *= 1.0 + 0.2 * nz.sample(Vec2::new(xy.x * 9.0, p.z * 3.0)),
-        Material::Foliage => albedo *= 0.8 + 0.45 * nz.sample(Vec2::new(xy.x * 2.2 + p.z, xy.y * 2.2 - p.z)),
-        Material::CarPaint => gloss = 0.18,
-        Material::CarGlass => gloss = 0.12,
-        Material::HeadLamp => emissive = Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night),
-        Material::TailLamp => emissive = Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night),
-        Material::Beacon => emissive = prim.albedo * (1.5 + 2.0 * l.night),
+        Material::LampHead => emissive = V3::splat(Vec3::new(3.0, 2.5, 1.8) * l.night),
+        Material::Trunk => albedo = albedo.scale(grain(nz, x * 9.0, z * 3.0, 0.2)),
+        Material::Foliage => {
+            let f = f32x4::splat(0.8) + f32x4::splat(0.45) * nz.sample4(x * 2.2 + z, y * 2.2 - z);
+            albedo = albedo.scale(f);
+        }
+        Material::CarPaint => gloss = f32x4::splat(0.18),
+        Material::CarGlass => gloss = f32x4::splat(0.12),
+        Material::HeadLamp => emissive = V3::splat(Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night)),
+        Material::TailLamp => emissive = V3::splat(Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night)),
+        Material::Beacon => emissive = V3::splat(prim.albedo * (1.5 + 2.0 * l.night)),
         Material::Body | Material::Head => {
             if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
-                normal = c.normal(p);
+                normal = capsule_normal4(c, p);
             }
-            if prim.material == Material::Head && (normal.z > 0.25 || normal.dot(prim.normal) < -0.3) {
-                albedo = prim.albedo2;
+            if prim.material == Material::Head {
+                let hair = normal.z.simd_gt(f32x4::splat(0.25)) | normal.dot_v(prim.normal).simd_lt(f32x4::splat(-0.3));
+                albedo = V3::select(hair, V3::splat(prim.albedo2), albedo);
             }
-            albedo *= 1.0 + 0.06 * nz.sample(Vec2::new(p.z * 23.0, xy.x * 7.0 + xy.y * 5.0));
+            albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06));
         }
     }
     if ground && l.wet > 0.0 {
         // Darker when wet, and puddles (a low-frequency noise mask) that mirror the sky and the lights.
-        let puddle = ((nz.sample(xy * 0.35) - 0.15) * 4.0).clamp(0.0, 1.0) * l.wet;
-        albedo *= 1.0 - 0.4 * l.wet - 0.2 * puddle;
-        gloss = gloss.max(l.wet * 0.25 + 0.6 * puddle);
+        let mask = (nz.sample4(x * 0.35, y * 0.35) - 0.15) * 4.0;
+        let puddle = mask.max(f32x4::ZERO).min(one) * l.wet;
+        albedo = albedo.scale(f32x4::splat(1.0 - 0.4 * l.wet) - f32x4::splat(0.2) * puddle);
+        gloss = gloss.max(f32x4::splat(l.wet * 0.25) + f32x4::splat(0.6) * puddle);
     }
+    let glossy = gloss.simd_gt(f32x4::ZERO).any();
 
-    // The unit vector from the point to the camera, for reflections (glossy surfaces only).
-    let view = if gloss > 0.0 { -ray / ray_len } else { Vec3::ZERO };
+    // The unit vectors from the points to the camera, for reflections (glossy surfaces only).
+    let view = if glossy {
+        pts.ray.scale(-(one / pts.ray_len))
+    } else {
+        V3::ZERO
+    };
 
     // Light received.
-    let ndl = normal.dot(l.sun_dir).max(0.0);
-    let mut light = l.ground_ambient.lerp(l.sky_ambient, 0.5 + 0.5 * normal.z) + l.sun * (ndl * shadow);
-    let mut glints = Vec3::ZERO;
+    let ndl = normal.dot_v(l.sun_dir).max(f32x4::ZERO);
+    let up = f32x4::splat(0.5) + f32x4::splat(0.5) * normal.z;
+    let mut light = V3::lerp(l.ground_ambient, l.sky_ambient, up).add(V3::splat(l.sun).scale(ndl * pts.shadow));
+    let mut glints = V3::ZERO;
     if l.night > 0.0 {
         for &lamp in &ctx.lights.lamps {
-            let d = lamp - p;
+            let d = V3::splat(lamp).sub(p);
             let d2 = d.length_squared();
-            if d2 > 1600.0 {
+            let near = d2.simd_le(f32x4::splat(1600.0));
+            if !near.any() {
                 continue;
             }
-            let inv = d2.sqrt().recip();
-            let dir = d * inv;
-            let fall = LAMP_INTENSITY * l.night / (d2 + 1.0);
+            let inv = one / d2.sqrt();
+            let dir = d.scale(inv);
+            let fall = f32x4::splat(LAMP_INTENSITY * l.night) / (d2 + 1.0);
             // The lamp shines downwards: light falls off away from below it.
-            light += Vec3::new(1.0, 0.78, 0.5) * (fall * normal.dot(dir).max(0.0) * dir.z.max(0.0));
-            if gloss > 0.0 {
-                let h = (dir + view).normalize_or_zero();
-                let s = normal.dot(h).max(0.0);
+            let k = fall * normal.dot(dir).max(f32x4::ZERO) * dir.z.max(f32x4::ZERO);
+            light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, f32x4::ZERO)));
+            if glossy {
+                let h = dir.add(view).normalize_or_zero();
+                let s = normal.dot(h).max(f32x4::ZERO);
                 let s2 = s * s;
                 let s8 = s2 * s2 * s2 * s2;
-                glints += Vec3::new(1.0, 0.78, 0.5) * (fall * 6.0 * gloss * s8 * s8 * s8 * s8);
+                let g = fall * 6.0 * gloss * s8 * s8 * s8 * s8;
+                glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, f32x4::ZERO)));
             }
         }
         for &(pos, axis) in &ctx.lights.heads {
-            let d = p - pos;
+            let d = p.sub(V3::splat(pos));
             let d2 = d.length_squared();
-            if !(1e-4..=3600.0).contains(&d2) {
-                continue;
-            }
             // A low beam: wide sideways, cut off just above the lamp's horizontal.
-            let ahead = d.truncate().dot(axis.truncate());
-            if ahead <= 0.1 {
+            let ahead = d.x * axis.x + d.y * axis.y;
+            let mut on =
+                d2.simd_ge(f32x4::splat(1e-4)) & d2.simd_le(f32x4::splat(3600.0)) & ahead.simd_gt(f32x4::splat(0.1));
+            if !on.any() {
                 continue;
             }
-            let side = (d.truncate().perp_dot(axis.truncate()) / ahead / 0.7).abs();
+            let side = ((d.x * axis.y - d.y * axis.x) / ahead / 0.7).abs();
             let up = d.z / ahead;
-            let beam = (1.0 - side * side).max(0.0) * ((0.02 - up) / 0.04).clamp(0.0, 1.0);
-            if beam > 0.0 {
-                let dir = d * d2.sqrt().recip();
-                let fall = HEADLAMP_INTENSITY * l.night * beam / (d2 + 30.0);
-                light += Vec3::new(1.0, 0.97, 0.9) * (fall * normal.dot(-dir).max(0.0));
+            let cut = ((f32x4::splat(0.02) - up) / 0.04).max(f32x4::ZERO).min(one);
+            let beam = (one - side * side).max(f32x4::ZERO) * cut;
+            on &= beam.simd_gt(f32x4::ZERO);
+            if !on.any() {
+                continue;
             }
+            let dir = d.scale(one / d2.sqrt());
+            let fall = f32x4::splat(HEADLAMP_INTENSITY * l.night) * beam / (d2 + 30.0);
+            let k = fall * (-normal.dot(dir)).max(f32x4::ZERO);
+            light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, f32x4::ZERO)));
         }
     }
-    let mut colour = albedo * light + emissive + glints;
-    if gloss > 0.0 {
-        let r = view.reflect(normal) * -1.0;
-        let r = Vec3::new(r.x, r.y, r.z.abs());
-        let cos = normal.dot(view).max(0.0);
-        let fresnel = 0.04 + 0.96 * (1.0 - cos).powi(5);
-        colour += l.sky(r) * (gloss * (0.08 + 0.92 * fresnel));
+    let mut colour = albedo.mul(light).add(emissive).add(glints);
+    if glossy {
+        let r = normal.scale(f32x4::splat(2.0) * view.dot(normal)).sub(view);
+        let r = V3 { z: r.z.abs(), ..r };
+        let cos = normal.dot(view).max(f32x4::ZERO);
+        let c5 = {
+            let m = one - cos;
+            let m2 = m * m;
+            m2 * m2 * m
+        };
+        let fresnel = f32x4::splat(0.04) + f32x4::splat(0.96) * c5;
+        colour = colour.add(
+            l.sky4(r)
+                .scale(gloss * (f32x4::splat(0.08) + f32x4::splat(0.92) * fresnel)),
+        );
     }
     (colour, semantic)
 }
 
-/// Applies fog over a distance.
-#[inline]
-pub fn fog(light: &Lighting, colour: Vec3, dist_m: f32) -> Vec3 {
-    let f = (-light.fog_per_m * dist_m).exp();
-    colour * f + light.fog * (1.0 - f)
+/// The outward unit normals of a body capsule at four surface points (`+z` where a point is on the axis).
+#[inline(always)]
+fn capsule_normal4(c: &SceneCapsule, p: V3) -> V3 {
+    let d = c.b - c.a;
+    let rel = p.sub(V3::splat(c.a));
+    let t = (rel.dot_v(d) / d.length_squared().max(1e-12))
+        .max(f32x4::ZERO)
+        .min(f32x4::ONE);
+    let off = rel.sub(V3::splat(d).scale(t));
+    let len2 = off.length_squared();
+    let ok = len2.simd_gt(f32x4::ZERO) & len2.is_finite();
+    V3::select(ok, off.scale(f32x4::ONE / len2.sqrt()), V3::splat(Vec3::Z))
+}
+
+/// Applies fog over four distances.
+#[inline(always)]
+pub fn fog4(light: &Lighting, colour: V3, dist_m: f32x4) -> V3 {
+    let f = exp4(f32x4::splat(-light.fog_per_m) * dist_m);
+    colour.scale(f).add(V3::splat(light.fog).scale(f32x4::ONE - f))
 }
 
 #[cfg(test)]
@@ -276,6 +385,17 @@ mod tests {
                 if v.abs() < 2.0e9 {
                     prop_assert_eq!(floor_i32(v) as f32, v.floor(), "{}", v);
                 }
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn four_noise_samples_equal_four_single_ones(x in proptest::array::uniform4(-3.0e3f32..3.0e3), y in proptest::array::uniform4(-3.0e3f32..3.0e3)) {
+            let nz = Noise::new(17);
+            let got = nz.sample4(f32x4::new(x), f32x4::new(y)).to_array();
+            for i in 0..4 {
+                prop_assert_eq!(got[i], nz.sample(Vec2::new(x[i], y[i])));
             }
         }
     }
