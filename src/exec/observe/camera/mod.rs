@@ -24,13 +24,14 @@ use glam::{DAffine3, DVec3, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use std::sync::Mutex;
 
 use super::rig::{Camera, CameraPose};
 use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
 use crate::mix::splitmix64;
 use lanes::{V3, floor_i32x4};
 use light::Lighting;
-use raster::{EMPTY, Raster, clip_near};
+use raster::{EMPTY, Raster, Setup, clip_near};
 use shade::{ActiveLights, Noise, ShadeContext};
 use wide::f32x4;
 
@@ -67,7 +68,7 @@ pub struct CameraImages {
 const EDGE: u32 = EMPTY - 1;
 
 /// Rows of the images resolved as one task.
-const BAND_ROWS: usize = 16;
+const BAND_ROWS: usize = 8;
 
 /// Rows `y0..` of the images (as many as the slices hold).
 struct Band<'a> {
@@ -76,6 +77,16 @@ struct Band<'a> {
     depth_m: &'a mut [f32],
     semantic: &'a mut [u8],
     instance: &'a mut [u16],
+}
+
+/// Band visibility buffers not in use (a clone starts without any).
+#[derive(Debug, Default)]
+struct BandBuffers(Mutex<Vec<Raster>>);
+
+impl Clone for BandBuffers {
+    fn clone(&self) -> BandBuffers {
+        BandBuffers::default()
+    }
 }
 
 /// The orthographic sun camera of the shadow map.
@@ -165,7 +176,12 @@ pub struct Renderer {
     camera: Camera,
     light: Lighting,
     noise: Noise,
-    vis: Raster,
+    /// The frame's projected triangles, in drawing order, and per band of rows the ones that reach it.
+    tris: Vec<Setup>,
+    bins: Vec<Vec<u32>>,
+    /// Visibility buffers of one band each (one per worker at a time): a band is drawn and resolved while
+    /// its buffer is in cache.
+    band_buffers: BandBuffers,
     shadow: Raster,
     sun: Option<SunView>,
     lights: ActiveLights,
@@ -209,12 +225,14 @@ fn build_lut() -> Box<[u8; LUT_LEN]> {
 impl Renderer {
     /// A renderer for a camera, a clip's lighting and its texture seed.
     pub fn new(camera: &Camera, light: Lighting, seed: u64) -> Renderer {
-        let (w, h) = (camera.width_px as usize, camera.height_px as usize);
+        let h = camera.height_px as usize;
         Renderer {
             camera: *camera,
             light,
             noise: Noise::new(seed ^ 0x7e57_0000),
-            vis: Raster::new(w * SS, h * SS),
+            tris: Vec::new(),
+            bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
+            band_buffers: BandBuffers::default(),
             shadow: Raster::new(SHADOW_PX, SHADOW_PX),
             sun: None,
             lights: ActiveLights::default(),
@@ -264,8 +282,9 @@ impl Renderer {
         // Frustum side slopes (|x| ≤ z·sx, |y| ≤ z·sy) with the corners' secants for the sphere test.
         let (sx, sy) = (cx / f, cy / f);
         let (kx, ky) = ((1.0 + sx * sx).sqrt(), (1.0 + sy * sy).sqrt());
-        self.vis.clear(0.0);
-        let vis = &mut self.vis;
+        let (sw, sh) = (c.width_px as usize * SS, c.height_px as usize * SS);
+        self.tris.clear();
+        let tris = &mut self.tris;
         let mut draw = |tri: &super::scene::Tri| {
             let v = tri.v.map(|p| m * p + t);
             if v.iter().all(|p| p.z < NEAR_M) {
@@ -282,7 +301,8 @@ impl Renderer {
                 )
             };
             for k in 1..n.saturating_sub(1) {
-                vis.draw([proj(poly[0]), proj(poly[k]), proj(poly[k + 1])], tri.prim);
+                let v = [proj(poly[0]), proj(poly[k]), proj(poly[k + 1])];
+                tris.extend(Setup::new(v, tri.prim, sw, sh));
             }
         };
         for cl in &scene.clusters {
@@ -302,6 +322,16 @@ impl Renderer {
         }
         for tri in &frame.mesh.tris {
             draw(tri);
+        }
+        // Each triangle into the bands of rows it reaches, in drawing order.
+        let band_samples = BAND_ROWS * SS;
+        for bin in &mut self.bins {
+            bin.clear();
+        }
+        for (i, t) in self.tris.iter().enumerate() {
+            for bin in &mut self.bins[t.row0 as usize / band_samples..=t.row1 as usize / band_samples] {
+                bin.push(i as u32);
+            }
         }
     }
 
@@ -414,6 +444,14 @@ impl Renderer {
         };
         let sw = w * SS;
         let inv_ss = 1.0 / SS as f32;
+        // The band's visibility buffer: its triangles drawn in order.
+        let mut taken = self.band_buffers.0.lock().map_or(None, |mut b| b.pop());
+        let vis = taken.get_or_insert_with(|| Raster::new(sw, BAND_ROWS * SS));
+        vis.clear(0.0);
+        let origin = y0 * SS;
+        for &i in &self.bins[y0 / BAND_ROWS] {
+            vis.draw_rows(&self.tris[i as usize], origin..=origin + h * SS - 1, origin);
+        }
         // Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
         let mut row_prim = vec![EMPTY; w];
         let mut row_key = vec![0.0f32; w];
@@ -435,10 +473,10 @@ impl Renderer {
                 .zip(&mut out.instance[labels.clone()])
                 .enumerate()
             {
-                let s0 = (y * SS) * sw + x * SS;
+                let s0 = (row * SS) * sw + x * SS;
                 let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
-                let prims = ids.map(|i| self.vis.prim[i]);
-                let keys = ids.map(|i| self.vis.key[i]);
+                let prims = ids.map(|i| vis.prim[i]);
+                let keys = ids.map(|i| vis.key[i]);
                 // Labels: the first sample's primitive (its semantic tag comes with the colour).
                 if prims[0] == EMPTY {
                     *depth = SKY_DEPTH_M;
@@ -518,6 +556,9 @@ impl Renderer {
                 e += 4;
             }
             tone_map(&linear, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
+        }
+        if let (Ok(mut pool), Some(vis)) = (self.band_buffers.0.lock(), taken) {
+            pool.push(vis);
         }
     }
 

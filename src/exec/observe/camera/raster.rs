@@ -45,50 +45,28 @@ impl Raster {
 
     /// Draws a projected triangle: vertices `(x, y, key)`.
     pub fn draw(&mut self, v: [DVec3; 3], prim: u32) {
-        let [a, b, c] = v;
-        let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-        if !area.is_finite() || area.abs() < 1e-12 {
-            return;
+        if let Some(t) = Setup::new(v, prim, self.width, self.height) {
+            self.draw_rows(&t, t.row0 as usize..=t.row1 as usize, 0);
         }
-        // Edge functions oriented so that the interior is positive.
-        let sign = area.signum();
-        let edge = |p: DVec3, q: DVec3| {
-            // E(x, y) = (q.x − p.x)(y − p.y) − (q.y − p.y)(x − p.x), times the orientation.
-            let ex = -(q.y - p.y) * sign;
-            let ey = (q.x - p.x) * sign;
-            let e0 = -(ex * p.x + ey * p.y);
-            (ex, ey, e0)
-        };
-        let edges = [edge(a, b), edge(b, c), edge(c, a)];
-        // The depth key's plane: k = kx·x + ky·y + k0.
-        let inv = 1.0 / area;
-        let kx = ((b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y)) * inv;
-        let ky = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) * inv;
-        let k0 = a.z - kx * a.x - ky * a.y;
+    }
 
-        let (w, h) = (self.width as f64, self.height as f64);
-        let min_y = a.y.min(b.y).min(c.y).max(0.0);
-        let max_y = a.y.max(b.y).max(c.y).min(h);
-        let min_x = a.x.min(b.x).min(c.x).max(0.0);
-        let max_x = a.x.max(b.x).max(c.x).min(w);
-        if min_y >= max_y || min_x >= max_x {
-            return;
-        }
-        let row0 = (min_y - 0.5).ceil().max(0.0) as usize;
-        let row1 = ((max_y - 0.5).floor() as usize).min(self.height - 1);
-        // Coverage tolerance: a hair of overlap between neighbours rather than a crack.
-        let tol = 1e-7 * (1.0 + w.max(h));
-        for row in row0..=row1 {
+    /// Draws the sample rows `rows` of a set-up triangle into this buffer, which holds the rows from
+    /// `origin_row` on (a band of a larger image; rows outside it are skipped).
+    pub fn draw_rows(&mut self, t: &Setup, rows: std::ops::RangeInclusive<usize>, origin_row: usize) {
+        let first = (*rows.start()).max(t.row0 as usize).max(origin_row);
+        let last = (*rows.end()).min(t.row1 as usize).min(origin_row + self.height - 1);
+        let w = t.width;
+        for row in first..=last {
             let y = row as f64 + 0.5;
-            let (mut lo, mut hi) = (min_x - 0.5, max_x - 0.5);
+            let (mut lo, mut hi) = (t.min_x - 0.5, t.max_x - 0.5);
             let mut empty = false;
-            for &(ex, ey, e0) in &edges {
+            for &(ex, ey, e0) in &t.edges {
                 let rest = ey * y + e0;
                 if ex > 0.0 {
-                    lo = lo.max((-rest - tol) / ex - 0.5);
+                    lo = lo.max((-rest - t.tol) / ex - 0.5);
                 } else if ex < 0.0 {
-                    hi = hi.min((-rest - tol) / ex - 0.5);
-                } else if rest < -tol {
+                    hi = hi.min((-rest - t.tol) / ex - 0.5);
+                } else if rest < -t.tol {
                     empty = true;
                 }
             }
@@ -100,13 +78,89 @@ impl Raster {
             if x1 < x0 as isize {
                 continue;
             }
-            let base = row * self.width;
-            let k_row = (ky * y + k0 + kx * 0.5) as f32;
-            let kxf = kx as f32;
+            let base = (row - origin_row) * self.width;
+            let k_row = (t.ky * y + t.k0 + t.kx * 0.5) as f32;
             let keys = &mut self.key[base + x0..=base + x1 as usize];
             let prims = &mut self.prim[base + x0..=base + x1 as usize];
-            depth_test_span(keys, prims, k_row, kxf, x0 as f32, prim);
+            depth_test_span(keys, prims, k_row, t.kx as f32, x0 as f32, t.prim);
         }
+    }
+}
+
+/// A projected triangle set up for drawing in a `width × height`-sample image: its edge functions, the
+/// plane of its depth key and its bounds. Setup is in `f64` (large coordinates after near-plane clipping).
+#[derive(Clone, Copy, Debug)]
+pub struct Setup {
+    /// Edge functions `(ex, ey, e0)`: `ex·x + ey·y + e0 ≥ 0` inside.
+    edges: [(f64, f64, f64); 3],
+    /// The depth key's plane: `k = kx·x + ky·y + k0`.
+    kx: f64,
+    ky: f64,
+    k0: f64,
+    /// Horizontal bounds, samples (clamped to the image).
+    min_x: f64,
+    max_x: f64,
+    /// Image width, samples.
+    width: f64,
+    /// Coverage tolerance: a hair of overlap between neighbours rather than a crack.
+    tol: f64,
+    /// First and last sample rows covered.
+    pub row0: u32,
+    /// Last sample row covered.
+    pub row1: u32,
+    /// Primitive id.
+    pub prim: u32,
+}
+
+impl Setup {
+    /// Sets a triangle up (`None` where it is degenerate or outside the image).
+    pub fn new(v: [DVec3; 3], prim: u32, width: usize, height: usize) -> Option<Setup> {
+        let [a, b, c] = v;
+        let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+        if !area.is_finite() || area.abs() < 1e-12 {
+            return None;
+        }
+        // Edge functions oriented so that the interior is positive.
+        let sign = area.signum();
+        let edge = |p: DVec3, q: DVec3| {
+            // E(x, y) = (q.x − p.x)(y − p.y) − (q.y − p.y)(x − p.x), times the orientation.
+            let ex = -(q.y - p.y) * sign;
+            let ey = (q.x - p.x) * sign;
+            let e0 = -(ex * p.x + ey * p.y);
+            (ex, ey, e0)
+        };
+        let edges = [edge(a, b), edge(b, c), edge(c, a)];
+        let inv = 1.0 / area;
+        let kx = ((b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y)) * inv;
+        let ky = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) * inv;
+        let k0 = a.z - kx * a.x - ky * a.y;
+
+        let (w, h) = (width as f64, height as f64);
+        let min_y = a.y.min(b.y).min(c.y).max(0.0);
+        let max_y = a.y.max(b.y).max(c.y).min(h);
+        let min_x = a.x.min(b.x).min(c.x).max(0.0);
+        let max_x = a.x.max(b.x).max(c.x).min(w);
+        if min_y >= max_y || min_x >= max_x {
+            return None;
+        }
+        let row0 = (min_y - 0.5).ceil().max(0.0) as usize;
+        let row1 = ((max_y - 0.5).floor() as usize).min(height - 1);
+        if row1 < row0 {
+            return None;
+        }
+        Some(Setup {
+            edges,
+            kx,
+            ky,
+            k0,
+            min_x,
+            max_x,
+            width: w,
+            tol: 1e-7 * (1.0 + w.max(h)),
+            row0: row0 as u32,
+            row1: row1 as u32,
+            prim,
+        })
     }
 }
 
