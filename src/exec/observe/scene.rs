@@ -977,6 +977,34 @@ impl StaticScene {
     }
 }
 
+/// Whether [`road_paint`] can find paint anywhere in the box `lo..=hi` (scene-relative): `false` where the
+/// box misses the piece's crosswalk and every marking's bounding box grown by the mark's half width, so that
+/// a run of points can skip the per-point test.
+pub fn road_paint_near(scene: &StaticScene, piece: &PieceSurface, lo: Vec2, hi: Vec2) -> bool {
+    let overlaps = |a: Vec2, b: Vec2| lo.x <= b.x && hi.x >= a.x && lo.y <= b.y && hi.y >= a.y;
+    if let Some(cw) = piece.crosswalk {
+        let poly = &scene.crosswalks[cw as usize];
+        let (a, b) = poly.iter().fold(
+            (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY)),
+            |(a, b), &q| (a.min(q), b.max(q)),
+        );
+        if overlaps(a, b) {
+            return true;
+        }
+    }
+    [(piece.inner, piece.marks[0]), (piece.outer, piece.marks[1])]
+        .into_iter()
+        .any(|([a, b], mark)| {
+            // As in `road_paint`: the mark's half width and a millimetre.
+            let reach = match mark {
+                Mark::None => return false,
+                Mark::Centre => MARK_WIDTH_M * 0.5,
+                _ => MARK_WIDTH_M,
+            } + 1e-3;
+            overlaps(a.min(b) - reach, a.max(b) + reach)
+        })
+}
+
 /// The paint of a road point: `Some((colour, tag))` for a marking or a crosswalk stripe, `None` for bare
 /// asphalt. `p` is scene-relative.
 pub fn road_paint(scene: &StaticScene, piece: &PieceSurface, p: Vec2) -> Option<(Vec3, u8)> {

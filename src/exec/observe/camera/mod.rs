@@ -160,11 +160,10 @@ struct View {
     inv_f: f32,
 }
 
-/// One sample of an edge pixel to shade; `slot` is where its colour goes.
+/// One sample of an edge pixel to shade.
 #[derive(Clone, Copy, Debug)]
 struct Sample {
     prim: u32,
-    slot: u32,
     key: f32,
     u: f32,
     v: f32,
@@ -455,46 +454,60 @@ impl Renderer {
         // Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
         let mut row_prim = vec![EMPTY; w];
         let mut row_key = vec![0.0f32; w];
-        // The samples of the row's edge pixels (four per pixel, in pixel order), and their shaded colours
-        // and tags by slot (the sample's index in that list).
+        // The samples of the row's edge pixels (four per pixel, in pixel order) and their shaded colours
+        // and tags, by the sample's index in that list; their order of shading (primitive, index).
         let mut edges: Vec<Sample> = Vec::with_capacity(w * SS * SS);
+        let mut order: Vec<u64> = Vec::with_capacity(w * SS * SS);
         let mut edge_colour = vec![Vec3::ZERO; w * SS * SS];
         let mut edge_tag = vec![0u8; w * SS * SS];
-        let mut linear = vec![0.0f32; w * 3];
+        // The row's linear colours, one channel each (three lanes of slack for four-lane stores).
+        let mut rgb = [vec![0.0f32; w + 3], vec![0.0f32; w + 3], vec![0.0f32; w + 3]];
         for row in 0..h {
             let y = y0 + row;
             let v_centre = f32x4::splat(y as f32 + 0.5);
             let labels = row * w..(row + 1) * w;
+            let top = row * SS * sw..(row * SS + 1) * sw;
+            let bottom = (row * SS + 1) * sw..(row * SS + 2) * sw;
+            let (prim_top, prim_bottom) = (&vis.prim[top.clone()], &vis.prim[bottom.clone()]);
+            let (key_top, key_bottom) = (&vis.key[top], &vis.key[bottom]);
+            // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
+            for (d, k) in out.depth_m[labels.clone()].iter_mut().zip(key_top.chunks_exact(SS)) {
+                *d = (1.0 / k[0]).min(SKY_DEPTH_M);
+            }
+            let mut last = (EMPTY, 0u16);
+            for (i, p) in out.instance[labels.clone()].iter_mut().zip(prim_top.chunks_exact(SS)) {
+                if p[0] != last.0 {
+                    last = (
+                        p[0],
+                        if p[0] == EMPTY {
+                            0
+                        } else {
+                            frame.prim(scene, p[0]).instance
+                        },
+                    );
+                }
+                *i = last.1;
+            }
             edges.clear();
-            for (x, (((prim_out, key_out), depth), instance)) in row_prim
+            for (x, ((((prim_out, key_out), pt), pb), (kt, kb))) in row_prim
                 .iter_mut()
                 .zip(row_key.iter_mut())
-                .zip(&mut out.depth_m[labels.clone()])
-                .zip(&mut out.instance[labels.clone()])
+                .zip(prim_top.chunks_exact(SS))
+                .zip(prim_bottom.chunks_exact(SS))
+                .zip(key_top.chunks_exact(SS).zip(key_bottom.chunks_exact(SS)))
                 .enumerate()
             {
-                let s0 = (row * SS) * sw + x * SS;
-                let ids = [s0, s0 + 1, s0 + sw, s0 + sw + 1];
-                let prims = ids.map(|i| vis.prim[i]);
-                let keys = ids.map(|i| vis.key[i]);
-                // Labels: the first sample's primitive (its semantic tag comes with the colour).
-                if prims[0] == EMPTY {
-                    *depth = SKY_DEPTH_M;
-                    *instance = 0;
-                } else {
-                    *depth = (1.0 / keys[0]).min(SKY_DEPTH_M);
-                    *instance = frame.prim(scene, prims[0]).instance;
-                }
-                if prims[1] == prims[0] && prims[2] == prims[0] && prims[3] == prims[0] {
-                    *prim_out = prims[0];
-                    *key_out = (keys[0] + keys[1] + keys[2] + keys[3]) * 0.25;
+                let p0 = pt[0];
+                if pt[1] == p0 && pb[0] == p0 && pb[1] == p0 {
+                    *prim_out = p0;
+                    *key_out = (kt[0] + kt[1] + kb[0] + kb[1]) * 0.25;
                 } else {
                     *prim_out = EDGE;
-                    for (k, (&prim, &key)) in prims.iter().zip(&keys).enumerate() {
+                    let samples = [(pt[0], kt[0]), (pt[1], kt[1]), (pb[0], kb[0]), (pb[1], kb[1])];
+                    for (k, (prim, key)) in samples.into_iter().enumerate() {
                         let (sx, sy) = ((k % SS) as f32, (k / SS) as f32);
                         edges.push(Sample {
                             prim,
-                            slot: edges.len() as u32,
                             key,
                             u: x as f32 + (sx + 0.5) * inv_ss,
                             v: y as f32 + (sy + 0.5) * inv_ss,
@@ -520,29 +533,31 @@ impl Renderer {
                 let key = f32x4::new(std::array::from_fn(|i| row_key[x + i.min(n - 1)]));
                 let u = f32x4::splat(x as f32 + 0.5) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
                 let (colour, tags) = self.shade4(&ctx, &view, prim, key, u, v_centre);
-                for (i, c) in colour.lanes().iter().take(n).enumerate() {
-                    linear[(x + i) * 3..(x + i) * 3 + 3].copy_from_slice(&c.to_array());
-                    semantic[x + i] = tags[i];
+                // All four lanes are stored: those past `n` are overwritten by the pixels they fall on.
+                for (channel, lanes) in rgb.iter_mut().zip([colour.x, colour.y, colour.z]) {
+                    channel[x..x + 4].copy_from_slice(&lanes.to_array());
                 }
+                semantic[x..end].copy_from_slice(&tags[..n]);
                 x = end;
             }
             // Edge samples, up to four of one primitive at a time.
-            edges.sort_unstable_by_key(|s| (s.prim, s.slot));
-            for group in edges.chunk_by(|a, b| a.prim == b.prim) {
+            order.clear();
+            order.extend(
+                edges
+                    .iter()
+                    .enumerate()
+                    .map(|(i, s)| (u64::from(s.prim) << 32) | i as u64),
+            );
+            order.sort_unstable();
+            for group in order.chunk_by(|a, b| a >> 32 == b >> 32) {
                 for chunk in group.chunks(4) {
-                    let lane =
-                        |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(&chunk[i.min(chunk.len() - 1)])));
-                    let (colour, tags) = self.shade4(
-                        &ctx,
-                        &view,
-                        chunk[0].prim,
-                        lane(|s| s.key),
-                        lane(|s| s.u),
-                        lane(|s| s.v),
-                    );
-                    for (s, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
-                        edge_colour[s.slot as usize] = c;
-                        edge_tag[s.slot as usize] = t;
+                    let at = |i: usize| &edges[(chunk[i.min(chunk.len() - 1)] & 0xffff_ffff) as usize];
+                    let lane = |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(at(i))));
+                    let (colour, tags) =
+                        self.shade4(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
+                    for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
+                        edge_colour[(o & 0xffff_ffff) as usize] = c;
+                        edge_tag[(o & 0xffff_ffff) as usize] = t;
                     }
                 }
             }
@@ -551,11 +566,13 @@ impl Renderer {
             for (x, _) in row_prim.iter().enumerate().filter(|(_, p)| **p == EDGE) {
                 let c = &edge_colour[e..e + 4];
                 let colour = (c[0] + c[1] + c[2] + c[3]) * 0.25;
-                linear[x * 3..x * 3 + 3].copy_from_slice(&colour.to_array());
+                for (channel, v) in rgb.iter_mut().zip(colour.to_array()) {
+                    channel[x] = v;
+                }
                 semantic[x] = edge_tag[e];
                 e += 4;
             }
-            tone_map(&linear, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
+            tone_map(&rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
         if let (Ok(mut pool), Some(vis)) = (self.band_buffers.0.lock(), taken) {
             pool.push(vis);
@@ -630,24 +647,26 @@ impl Renderer {
     }
 }
 
-/// Maps linear colour values to sRGB bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`,
-/// the square roots four at a time (`wide`: SSE where it is there; correctly rounded either way, so the same
-/// values as one at a time).
-fn tone_map(linear: &[f32], lut: &[u8; LUT_LEN], out: &mut [u8]) {
-    // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
-    // (`floor_i32`: the truncation of a non-negative value without a saturating conversion.)
-    let index = |s: f32| shade::floor_i32(s * (LUT_LEN - 1) as f32) as usize & (LUT_LEN - 1);
-    let scaled = |v: f32| (v.max(0.0) * (1.0 / LUT_MAX)).min(1.0);
-    let n = linear.len().min(out.len());
-    let whole = n / 4 * 4;
-    for (src, dst) in linear[..whole].chunks_exact(4).zip(out[..whole].chunks_exact_mut(4)) {
-        let s = wide::f32x4::new([scaled(src[0]), scaled(src[1]), scaled(src[2]), scaled(src[3])]).sqrt();
-        for (d, s) in dst.iter_mut().zip(s.to_array()) {
-            *d = lut[index(s)];
+/// Maps a row of linear colours (one slice per channel, at least as long as the row) to interleaved sRGB
+/// bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`, four pixels at a time (`wide`:
+/// SSE square roots, correctly rounded, and truncations, so the same values as one at a time).
+fn tone_map(rgb: &[Vec<f32>; 3], lut: &[u8; LUT_LEN], out: &mut [u8]) {
+    let w = out.len() / 3;
+    let index = |v: f32x4| {
+        let s = (v.max(f32x4::ZERO) * (1.0 / LUT_MAX)).min(f32x4::ONE).sqrt();
+        // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
+        (s * (LUT_LEN - 1) as f32)
+            .fast_trunc_int()
+            .to_array()
+            .map(|i| i as usize & (LUT_LEN - 1))
+    };
+    let load = |c: &[f32], x: usize| f32x4::new([c[x], c[x + 1], c[x + 2], c[x + 3]]);
+    for (quad, px) in out.chunks_mut(12).enumerate() {
+        let x = quad * 4;
+        let [r, g, b] = rgb.each_ref().map(|c| index(load(c, x)));
+        for (i, o) in px.chunks_exact_mut(3).take(w - x).enumerate() {
+            o.copy_from_slice(&[lut[r[i]], lut[g[i]], lut[b[i]]]);
         }
-    }
-    for (d, &v) in out[whole..n].iter_mut().zip(&linear[whole..n]) {
-        *d = lut[index(scaled(v).sqrt())];
     }
 }
 
@@ -669,26 +688,25 @@ mod tests {
     fn the_row_tone_map_equals_the_per_value_formula() {
         let lut = build_lut();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        // Every length up to 13 (the SIMD part and its tail), values below 0, in range and beyond LUT_MAX.
+        // Every row length up to 13 (whole quads and a rest), values below 0, in range and beyond LUT_MAX.
         for n in 0..=13 {
-            let linear: Vec<f32> = (0..n)
-                .map(|i| match i % 4 {
-                    0 => rng.random_range(-1.0..0.0),
-                    1 => rng.random_range(0.0..0.01),
-                    2 => rng.random_range(0.0..LUT_MAX),
-                    _ => rng.random_range(LUT_MAX..20.0),
-                })
-                .collect();
-            let mut out = vec![0u8; n];
-            tone_map(&linear, &lut, &mut out);
-            let expected: Vec<u8> = linear
-                .iter()
-                .map(|&v| {
+            let mut value = |i: usize| match i % 4 {
+                0 => rng.random_range(-1.0..0.0),
+                1 => rng.random_range(0.0..0.01),
+                2 => rng.random_range(0.0..LUT_MAX),
+                _ => rng.random_range(LUT_MAX..20.0),
+            };
+            let rgb: [Vec<f32>; 3] = std::array::from_fn(|c| (0..n + 3).map(|i| value(i + c)).collect());
+            let mut out = vec![0u8; n * 3];
+            tone_map(&rgb, &lut, &mut out);
+            let expected: Vec<u8> = (0..n * 3)
+                .map(|i| {
+                    let v: f32 = rgb[i % 3][i / 3];
                     let s = (v.max(0.0) * (1.0 / LUT_MAX)).min(1.0).sqrt();
                     lut[(s * (LUT_LEN - 1) as f32) as usize]
                 })
                 .collect();
-            assert_eq!(out, expected, "{linear:?}");
+            assert_eq!(out, expected, "{rgb:?}");
         }
     }
 }

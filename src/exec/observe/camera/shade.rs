@@ -9,7 +9,9 @@ use wide::f32x4;
 
 use super::lanes::{V3, exp4, floor_i32x4};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
-use crate::exec::observe::scene::{FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, tag};
+use crate::exec::observe::scene::{
+    FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, road_paint_near, tag,
+};
 use crate::mix::splitmix64;
 
 /// `x.floor()` without the call into libm that `f32::floor` compiles to on x86-64 without SSE4.1 (a hot
@@ -168,7 +170,14 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
                 + f32x4::splat(0.16) * nz.sample4(x * 1.3, y * 1.3)
                 + f32x4::splat(0.08) * nz.sample4(x * 6.1 + 37.0, y * 6.1 + 37.0);
             albedo = albedo.scale(g);
-            if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize) {
+            if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
+                && road_paint_near(
+                    ctx.scene,
+                    piece,
+                    Vec2::new(lane_min(x), lane_min(y)),
+                    Vec2::new(lane_max(x), lane_max(y)),
+                )
+            {
                 let (xs, ys) = (x.to_array(), y.to_array());
                 let mut painted = None;
                 for i in 0..4 {
@@ -349,6 +358,20 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
         );
     }
     (colour, semantic)
+}
+
+/// The least of four lanes.
+#[inline(always)]
+fn lane_min(v: f32x4) -> f32 {
+    let a = v.to_array();
+    a[0].min(a[1]).min(a[2].min(a[3]))
+}
+
+/// The greatest of four lanes.
+#[inline(always)]
+fn lane_max(v: f32x4) -> f32 {
+    let a = v.to_array();
+    a[0].max(a[1]).max(a[2].max(a[3]))
 }
 
 /// The outward unit normals of a body capsule at four surface points (`+z` where a point is on the axis).
