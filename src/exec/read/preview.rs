@@ -442,7 +442,15 @@ pub fn preview(dir: &Path, options: &PreviewOptions) -> Result<String, Error> {
                 sheet[o..o + tw * 3].copy_from_slice(src);
             }
         }
-        png_bytes(sw, sh, png::ColorType::Rgb, png::BitDepth::Eight, &sheet, None)?
+        png_bytes(
+            sw,
+            sh,
+            png::ColorType::Rgb,
+            png::BitDepth::Eight,
+            &sheet,
+            png::Filter::Adaptive,
+            None,
+        )?
     };
     write_atomically(&options.out, &bytes).map_err(|e| Error::write(&options.out, e))?;
     Ok(format!(

@@ -89,13 +89,15 @@ impl std::fmt::Debug for ClipSensorWriter<'_> {
     }
 }
 
-/// PNG bytes of an image.
+/// PNG bytes of an image: fast deflate, and one row filter for the whole image (`Adaptive` tries all five per
+/// row; the streams' fixed choices below were measured on rendered frames: see BENCHMARKS.md).
 pub fn png_bytes(
     width: usize,
     height: usize,
     colour: png::ColorType,
     depth: png::BitDepth,
     data: &[u8],
+    filter: png::Filter,
     palette: Option<&[u8]>,
 ) -> Result<Vec<u8>, Error> {
     let mut out = Vec::with_capacity(data.len() / 2 + 1024);
@@ -105,6 +107,7 @@ pub fn png_bytes(
         enc.set_color(colour);
         enc.set_depth(depth);
         enc.set_compression(png::Compression::Fast);
+        enc.set_filter(filter);
         if let Some(p) = palette {
             enc.set_palette(p.to_vec());
         }
@@ -136,6 +139,7 @@ pub fn rgb_png(img: &CameraImages) -> Result<Vec<u8>, Error> {
         png::ColorType::Rgb,
         png::BitDepth::Eight,
         &img.rgb,
+        png::Filter::Paeth,
         None,
     )
 }
@@ -148,6 +152,7 @@ pub fn semantic_png(img: &CameraImages) -> Result<Vec<u8>, Error> {
         png::ColorType::Indexed,
         png::BitDepth::Eight,
         &img.semantic,
+        png::Filter::Sub,
         Some(&SEMANTIC_PALETTE),
     )
 }
@@ -169,9 +174,11 @@ pub fn carla_depth_rgb(depth_m: f32) -> [u8; 3] {
     [(v & 0xff) as u8, ((v >> 8) & 0xff) as u8, ((v >> 16) & 0xff) as u8]
 }
 
-/// Depth in millimetres, saturated at 65535.
+/// Depth in millimetres, rounded half up and saturated at 65535 (0 for NaN and below 0). Exact: an `f32`
+/// times 1000 fits an `f64`, and so does adding one half below 65536.
+#[inline]
 pub fn depth_mm(depth_m: f32) -> u16 {
-    round_non_negative(f64::from(depth_m) * 1000.0).min(65535) as u16
+    ((f64::from(depth_m) * 1000.0).clamp(0.0, 65535.0) + 0.5) as u16
 }
 
 /// 16-bit samples as the big-endian bytes a 16-bit PNG holds.
@@ -223,17 +230,41 @@ impl Still {
             Still::Depth => match output.depth_encoding {
                 DepthEncoding::MillimetresU16 => {
                     let raw = be_bytes(img.depth_m.iter().map(|d| depth_mm(*d)), img.depth_m.len());
-                    png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &raw, None)
+                    png_bytes(
+                        w,
+                        h,
+                        png::ColorType::Grayscale,
+                        png::BitDepth::Sixteen,
+                        &raw,
+                        png::Filter::Paeth,
+                        None,
+                    )
                 }
                 DepthEncoding::CarlaRgb24 => {
                     let raw: Vec<u8> = img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)).collect();
-                    png_bytes(w, h, png::ColorType::Rgb, png::BitDepth::Eight, &raw, None)
+                    png_bytes(
+                        w,
+                        h,
+                        png::ColorType::Rgb,
+                        png::BitDepth::Eight,
+                        &raw,
+                        png::Filter::Paeth,
+                        None,
+                    )
                 }
             },
             Still::Semantic => semantic_png(img),
             Still::Instance => {
                 let raw = be_bytes(img.instance.iter().copied(), img.instance.len());
-                png_bytes(w, h, png::ColorType::Grayscale, png::BitDepth::Sixteen, &raw, None)
+                png_bytes(
+                    w,
+                    h,
+                    png::ColorType::Grayscale,
+                    png::BitDepth::Sixteen,
+                    &raw,
+                    png::Filter::Up,
+                    None,
+                )
             }
         }
     }
@@ -441,6 +472,16 @@ mod tests {
                 proptest::prop_assert_eq!(round_non_negative(v), v.round() as u64, "{}", v);
             }
         }
+
+        #[test]
+        fn millimetres_are_the_rounded_depth(d in -1.0f32..80.0, k in 0u32..70_000) {
+            // Any depth, and depths exactly half a millimetre off a whole one.
+            let half = (k as f32 + 0.5) / 1000.0;
+            for v in [d, half, f32::from_bits(half.to_bits() + 1), f32::from_bits(half.to_bits() - 1)] {
+                let want = (f64::from(v) * 1000.0).round().clamp(0.0, 65535.0) as u16;
+                proptest::prop_assert_eq!(depth_mm(v), want, "{}", v);
+            }
+        }
     }
 
     #[test]
@@ -451,6 +492,8 @@ mod tests {
         assert_eq!(round_non_negative(2.5), 3);
         assert_eq!(round_non_negative(f64::INFINITY), 1 << 52);
         assert_eq!(depth_mm(f32::INFINITY), 65535);
+        assert_eq!(depth_mm(f32::NAN), 0);
+        assert_eq!(depth_mm(-2.0), 0);
         assert_eq!(depth_mm(1.2345), 1235);
     }
 
