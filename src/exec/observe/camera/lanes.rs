@@ -46,12 +46,6 @@ impl V3 {
         }
     }
 
-    /// Lane `i` (0–3).
-    #[inline(always)]
-    pub fn lane(&self, i: usize) -> Vec3 {
-        Vec3::new(self.x.to_array()[i], self.y.to_array()[i], self.z.to_array()[i])
-    }
-
     /// The four lanes.
     #[inline(always)]
     pub fn lanes(&self) -> [Vec3; 4] {
@@ -84,16 +78,6 @@ impl V3 {
             x: self.x * s,
             y: self.y * s,
             z: self.z * s,
-        }
-    }
-
-    /// Multiplies component-wise by one vector.
-    #[inline(always)]
-    pub fn mul_v(self, v: Vec3) -> V3 {
-        V3 {
-            x: self.x * v.x,
-            y: self.y * v.y,
-            z: self.z * v.z,
         }
     }
 
