@@ -181,13 +181,21 @@ pub fn depth_mm(depth_m: f32) -> u16 {
     ((f64::from(depth_m) * 1000.0).clamp(0.0, 65535.0) + 0.5) as u16
 }
 
-/// 16-bit samples as the big-endian bytes a 16-bit PNG holds.
-fn be_bytes(samples: impl Iterator<Item = u16>, len: usize) -> Vec<u8> {
-    let mut raw = vec![0u8; len * 2];
+/// A 16-bit greyscale PNG of `w × h` samples (row-major), stored big-endian as PNG holds them.
+fn gray16_png(w: usize, h: usize, samples: impl Iterator<Item = u16>, filter: png::Filter) -> Result<Vec<u8>, Error> {
+    let mut raw = vec![0u8; w * h * 2];
     for (out, v) in raw.chunks_exact_mut(2).zip(samples) {
         out.copy_from_slice(&v.to_be_bytes());
     }
-    raw
+    png_bytes(
+        w,
+        h,
+        png::ColorType::Grayscale,
+        png::BitDepth::Sixteen,
+        &raw,
+        filter,
+        None,
+    )
 }
 
 /// A stream written as one image file per frame.
@@ -229,16 +237,7 @@ impl Still {
             },
             Still::Depth => match output.depth_encoding {
                 DepthEncoding::MillimetresU16 => {
-                    let raw = be_bytes(img.depth_m.iter().map(|d| depth_mm(*d)), img.depth_m.len());
-                    png_bytes(
-                        w,
-                        h,
-                        png::ColorType::Grayscale,
-                        png::BitDepth::Sixteen,
-                        &raw,
-                        png::Filter::Paeth,
-                        None,
-                    )
+                    gray16_png(w, h, img.depth_m.iter().map(|d| depth_mm(*d)), png::Filter::Paeth)
                 }
                 DepthEncoding::CarlaRgb24 => {
                     let raw: Vec<u8> = img.depth_m.iter().flat_map(|d| carla_depth_rgb(*d)).collect();
@@ -254,18 +253,7 @@ impl Still {
                 }
             },
             Still::Semantic => semantic_png(img),
-            Still::Instance => {
-                let raw = be_bytes(img.instance.iter().copied(), img.instance.len());
-                png_bytes(
-                    w,
-                    h,
-                    png::ColorType::Grayscale,
-                    png::BitDepth::Sixteen,
-                    &raw,
-                    png::Filter::Up,
-                    None,
-                )
-            }
+            Still::Instance => gray16_png(w, h, img.instance.iter().copied(), png::Filter::Up),
         }
     }
 }

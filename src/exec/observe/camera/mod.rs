@@ -79,9 +79,44 @@ struct Band<'a> {
     instance: &'a mut [u16],
 }
 
-/// Band visibility buffers not in use (a clone starts without any).
+/// Band buffers not in use (a clone starts without any).
 #[derive(Debug, Default)]
-struct BandBuffers(Mutex<Vec<Raster>>);
+struct BandBuffers(Mutex<Vec<BandScratch>>);
+
+/// What resolving a band needs besides the images: its visibility buffer and a row's scratch, kept from band to
+/// band (one set per worker at a time) so that a frame allocates nothing. Every row rewrites what it reads.
+#[derive(Debug)]
+struct BandScratch {
+    /// The band's visibility buffer.
+    vis: Raster,
+    /// Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
+    row_prim: Vec<u32>,
+    row_key: Vec<f32>,
+    /// The samples of the row's edge pixels (four per pixel, in pixel order) and their shaded colours and
+    /// tags, by the sample's index in that list; their order of shading (primitive, index).
+    edges: Vec<Sample>,
+    order: Vec<u64>,
+    edge_colour: Vec<Vec3>,
+    edge_tag: Vec<u8>,
+    /// The row's linear colours, one channel each (three lanes of slack for four-lane stores).
+    rgb: [Vec<f32>; 3],
+}
+
+impl BandScratch {
+    /// Buffers for bands of a `w`-pixel-wide image.
+    fn new(w: usize) -> BandScratch {
+        BandScratch {
+            vis: Raster::new(w * SS, BAND_ROWS * SS),
+            row_prim: vec![EMPTY; w],
+            row_key: vec![0.0; w],
+            edges: Vec::with_capacity(w * SS * SS),
+            order: Vec::with_capacity(w * SS * SS),
+            edge_colour: vec![Vec3::ZERO; w * SS * SS],
+            edge_tag: vec![0; w * SS * SS],
+            rgb: [vec![0.0; w + 3], vec![0.0; w + 3], vec![0.0; w + 3]],
+        }
+    }
+}
 
 impl Clone for BandBuffers {
     fn clone(&self) -> BandBuffers {
@@ -443,25 +478,23 @@ impl Renderer {
         };
         let sw = w * SS;
         let inv_ss = 1.0 / SS as f32;
-        // The band's visibility buffer: its triangles drawn in order.
         let mut taken = self.band_buffers.0.lock().map_or(None, |mut b| b.pop());
-        let vis = taken.get_or_insert_with(|| Raster::new(sw, BAND_ROWS * SS));
+        let BandScratch {
+            vis,
+            row_prim,
+            row_key,
+            edges,
+            order,
+            edge_colour,
+            edge_tag,
+            rgb,
+        } = taken.get_or_insert_with(|| BandScratch::new(w));
+        // The band's visibility buffer: its triangles drawn in order.
         vis.clear(0.0);
         let origin = y0 * SS;
         for &i in &self.bins[y0 / BAND_ROWS] {
             vis.draw_rows(&self.tris[i as usize], origin..=origin + h * SS - 1, origin);
         }
-        // Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
-        let mut row_prim = vec![EMPTY; w];
-        let mut row_key = vec![0.0f32; w];
-        // The samples of the row's edge pixels (four per pixel, in pixel order) and their shaded colours
-        // and tags, by the sample's index in that list; their order of shading (primitive, index).
-        let mut edges: Vec<Sample> = Vec::with_capacity(w * SS * SS);
-        let mut order: Vec<u64> = Vec::with_capacity(w * SS * SS);
-        let mut edge_colour = vec![Vec3::ZERO; w * SS * SS];
-        let mut edge_tag = vec![0u8; w * SS * SS];
-        // The row's linear colours, one channel each (three lanes of slack for four-lane stores).
-        let mut rgb = [vec![0.0f32; w + 3], vec![0.0f32; w + 3], vec![0.0f32; w + 3]];
         for row in 0..h {
             let y = y0 + row;
             let v_centre = f32x4::splat(y as f32 + 0.5);
@@ -572,10 +605,10 @@ impl Renderer {
                 semantic[x] = edge_tag[e];
                 e += 4;
             }
-            tone_map(&rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
+            tone_map(rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
-        if let (Ok(mut pool), Some(vis)) = (self.band_buffers.0.lock(), taken) {
-            pool.push(vis);
+        if let (Ok(mut pool), Some(scratch)) = (self.band_buffers.0.lock(), taken) {
+            pool.push(scratch);
         }
     }
 
