@@ -43,20 +43,44 @@ pub fn floor_i32(x: f32) -> i32 {
 }
 
 /// A seeded tileable value-noise table, sampled bilinearly (values in [−1, 1]).
+///
+/// Stored as the four corners of each cell (`(x, y)`, `(x + 1, y)`, `(x, y + 1)`, `(x + 1, y + 1)`, wrapped), so
+/// that a bilinear sample reads one 16-byte entry instead of four scattered values, from a table whose size
+/// the index cannot exceed (no bounds checks).
 #[derive(Clone, Debug)]
 pub struct Noise {
-    values: Vec<f32>,
+    cells: Box<[[f32; 4]; NOISE_CELLS]>,
 }
 
 const NOISE_SIZE: usize = 256;
+const NOISE_CELLS: usize = NOISE_SIZE * NOISE_SIZE;
 
 impl Noise {
     /// The noise table of a seed.
     pub fn new(seed: u64) -> Noise {
-        let values = (0..NOISE_SIZE * NOISE_SIZE)
-            .map(|i| (splitmix64(seed ^ splitmix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0)
+        let value = |x: usize, y: usize| {
+            let i = (y % NOISE_SIZE) * NOISE_SIZE + x % NOISE_SIZE;
+            (splitmix64(seed ^ splitmix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0
+        };
+        let cells: Vec<[f32; 4]> = (0..NOISE_CELLS)
+            .map(|i| {
+                let (x, y) = (i % NOISE_SIZE, i / NOISE_SIZE);
+                [value(x, y), value(x + 1, y), value(x, y + 1), value(x + 1, y + 1)]
+            })
             .collect();
-        Noise { values }
+        // Built on the heap (a 1 MiB array would pass through the stack of a worker thread).
+        let cells = cells
+            .into_boxed_slice()
+            .try_into()
+            .unwrap_or_else(|_| unreachable!("NOISE_CELLS cells"));
+        Noise { cells }
+    }
+
+    /// The corners of the cell `(ix, iy)` (wrapped).
+    #[inline(always)]
+    fn corners(&self, ix: i32, iy: i32) -> [f32; 4] {
+        let m = (NOISE_SIZE - 1) as i32;
+        self.cells[((iy & m) as usize) << 8 | (ix & m) as usize]
     }
 
     /// Bilinear sample at `p` (one cell per unit).
@@ -64,12 +88,9 @@ impl Noise {
     pub fn sample(&self, p: Vec2) -> f32 {
         let (ix, iy) = (floor_i32(p.x), floor_i32(p.y));
         let (tx, ty) = (p.x - ix as f32, p.y - iy as f32);
-        let m = NOISE_SIZE - 1;
-        let (x0, y0) = ((ix as usize) & m, (iy as usize) & m);
-        let (x1, y1) = ((x0 + 1) & m, (y0 + 1) & m);
-        let v = |x: usize, y: usize| self.values[y * NOISE_SIZE + x];
-        let a = v(x0, y0) + (v(x1, y0) - v(x0, y0)) * tx;
-        let b = v(x0, y1) + (v(x1, y1) - v(x0, y1)) * tx;
+        let [v00, v10, v01, v11] = self.corners(ix, iy);
+        let a = v00 + (v10 - v00) * tx;
+        let b = v01 + (v11 - v01) * tx;
         a + (b - a) * ty
     }
 
@@ -78,19 +99,8 @@ impl Noise {
     pub fn sample4(&self, qx: f32x4, qy: f32x4) -> f32x4 {
         let (ix, iy) = (floor_i32x4(qx), floor_i32x4(qy));
         let (tx, ty) = (qx - ix.round_float(), qy - iy.round_float());
-        let m = (NOISE_SIZE - 1) as i32;
         let (xa, ya) = (ix.to_array(), iy.to_array());
-        let mut c = [[0.0f32; 4]; 4];
-        for i in 0..4 {
-            let (x0, y0) = ((xa[i] & m) as usize, (ya[i] & m) as usize);
-            let (x1, y1) = ((x0 + 1) & m as usize, (y0 + 1) & m as usize);
-            let v = |x: usize, y: usize| self.values[y * NOISE_SIZE + x];
-            c[0][i] = v(x0, y0);
-            c[1][i] = v(x1, y0);
-            c[2][i] = v(x0, y1);
-            c[3][i] = v(x1, y1);
-        }
-        let [v00, v10, v01, v11] = c.map(f32x4::new);
+        let [v00, v10, v01, v11] = f32x4::transpose(std::array::from_fn(|i| f32x4::new(self.corners(xa[i], ya[i]))));
         let a = v00 + (v10 - v00) * tx;
         let b = v01 + (v11 - v01) * tx;
         a + (b - a) * ty
