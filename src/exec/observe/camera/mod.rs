@@ -271,7 +271,7 @@ impl Renderer {
             tris: Vec::new(),
             bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
             band_buffers: BandBuffers::default(),
-            shadow: Raster::new(SHADOW_PX, SHADOW_PX),
+            shadow: Raster::depth_only(SHADOW_PX, SHADOW_PX),
             sun: None,
             lights: ActiveLights::default(),
             nearby: Vec::new(),

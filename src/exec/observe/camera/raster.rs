@@ -37,6 +37,17 @@ impl Raster {
         }
     }
 
+    /// A buffer of depth keys only (`prim` stays empty: a shadow map needs no primitive ids, and drawing
+    /// into it then writes half as much).
+    pub fn depth_only(width: usize, height: usize) -> Raster {
+        Raster {
+            width,
+            height,
+            key: vec![0.0; width * height],
+            prim: Vec::new(),
+        }
+    }
+
     /// Empties the buffer (depth keys below every drawable key).
     pub fn clear(&mut self, empty_key: f32) {
         self.key.fill(empty_key);
@@ -81,8 +92,10 @@ impl Raster {
             let base = (row - origin_row) * self.width;
             let k_row = (t.ky * y + t.k0 + t.kx * 0.5) as f32;
             let keys = &mut self.key[base + x0..=base + x1 as usize];
-            let prims = &mut self.prim[base + x0..=base + x1 as usize];
-            depth_test_span(keys, prims, k_row, t.kx as f32, x0 as f32, t.prim);
+            match self.prim.get_mut(base + x0..=base + x1 as usize) {
+                Some(prims) => depth_test_span(keys, prims, k_row, t.kx as f32, x0 as f32, t.prim),
+                None => depth_test_span_keys(keys, k_row, t.kx as f32, x0 as f32),
+            }
         }
     }
 }
@@ -204,6 +217,28 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
     }
 }
 
+/// [`depth_test_span`] for a buffer of keys only: the greater key stays.
+#[inline]
+fn depth_test_span_keys(keys: &mut [f32], k_row: f32, kx: f32, x0: f32) {
+    let whole = keys.len() / 4 * 4;
+    let lane = Vec4::new(0.0, 1.0, 2.0, 3.0);
+    for (start, kk) in keys[..whole]
+        .chunks_exact_mut(4)
+        .enumerate()
+        .map(|(c, chunk)| (c * 4, chunk))
+    {
+        let k = Vec4::splat(k_row) + Vec4::splat(kx) * (Vec4::splat(x0 + start as f32) + lane);
+        let old_k = Vec4::from_slice(kk);
+        Vec4::select(k.cmpgt(old_k), k, old_k).write_to_slice(kk);
+    }
+    for (i, key) in keys.iter_mut().enumerate().skip(whole) {
+        let k = k_row + kx * (x0 + i as f32);
+        if k > *key {
+            *key = k;
+        }
+    }
+}
+
 /// Clips a triangle (optical frame: z forward) against the plane `z = near`; the result is a convex polygon
 /// of 0, 3 or 4 vertices written into `out`, whose count is returned.
 pub fn clip_near(v: [Vec3; 3], near: f32, out: &mut [Vec3; 4]) -> usize {
@@ -310,6 +345,12 @@ mod tests {
                 assert_eq!(p1, p2, "n {n} k_row {k_row} kx {kx}");
                 assert_eq!(
                     k1.iter().map(|k| k.to_bits()).collect::<Vec<_>>(),
+                    k2.iter().map(|k| k.to_bits()).collect::<Vec<_>>()
+                );
+                let mut k3 = keys.clone();
+                depth_test_span_keys(&mut k3, k_row, kx, 3.0);
+                assert_eq!(
+                    k3.iter().map(|k| k.to_bits()).collect::<Vec<_>>(),
                     k2.iter().map(|k| k.to_bits()).collect::<Vec<_>>()
                 );
             }
