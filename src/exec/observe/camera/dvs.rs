@@ -96,7 +96,7 @@ impl Esim {
                 // Four pixels at a time, the rest one by one.
                 let whole = ls.len() / 4 * 4;
                 for (l, px) in ls[..whole].chunks_exact_mut(4).zip(pxs.chunks_exact(12)) {
-                    let c = |o: usize| f32x4::new([o, o + 3, o + 6, o + 9].map(|k| f32::from(px[k])));
+                    let c = |o: usize| f32x4::new([px[o], px[o + 3], px[o + 6], px[o + 9]].map(f32::from));
                     l.copy_from_slice(&log_intensity4(params, c(0), c(1), c(2)).to_array());
                 }
                 for (l, px) in ls[whole..].iter_mut().zip(pxs[whole * 3..].chunks_exact(3)) {

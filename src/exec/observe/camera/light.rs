@@ -144,8 +144,15 @@ fn horizon_to_zenith(up: f32x4) -> f32x4 {
         .min(wide::i32x4::splat(GRADIENT_STEPS as i32));
     let f = s - i.round_float();
     let ia = i.to_array();
-    let a = f32x4::new(ia.map(|k| table[k as usize]));
-    let b = f32x4::new(ia.map(|k| table[k as usize + 1]));
+    let at = |j: usize| {
+        [
+            table[ia[0] as usize + j],
+            table[ia[1] as usize + j],
+            table[ia[2] as usize + j],
+            table[ia[3] as usize + j],
+        ]
+    };
+    let (a, b) = (f32x4::new(at(0)), f32x4::new(at(1)));
     a + (b - a) * f
 }
 

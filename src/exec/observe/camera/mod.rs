@@ -512,7 +512,11 @@ impl Renderer {
                 // Four pixels at a time (an IEEE division per lane: the same values as one at a time).
                 let first = f32x4::new(std::array::from_fn(|i| k.get(i * SS).copied().unwrap_or(1.0)));
                 let depth = (f32x4::ONE / first).min(f32x4::splat(SKY_DEPTH_M)).to_array();
-                d.copy_from_slice(&depth[..d.len()]);
+                // A fixed-size copy where the chunk is whole (a slice copy of unknown length calls memcpy).
+                match <&mut [f32; 4]>::try_from(&mut *d) {
+                    Ok(d) => *d = depth,
+                    Err(_) => d.copy_from_slice(&depth[..d.len()]),
+                }
             }
             let mut last = (EMPTY, 0u16);
             for (i, p) in out.instance[labels.clone()].iter_mut().zip(prim_top.chunks_exact(SS)) {
@@ -577,7 +581,10 @@ impl Renderer {
                 for (channel, lanes) in rgb.iter_mut().zip([colour.x, colour.y, colour.z]) {
                     channel[x..x + 4].copy_from_slice(&lanes.to_array());
                 }
-                semantic[x..end].copy_from_slice(&tags[..n]);
+                match semantic.get_mut(x..x + 4) {
+                    Some(four) => four.copy_from_slice(&tags),
+                    None => semantic[x..end].copy_from_slice(&tags[..n]),
+                }
                 x = end;
             }
             // Edge samples, up to four of one primitive at a time.
@@ -695,10 +702,15 @@ fn tone_map(rgb: &[Vec<f32>; 3], lut: &[u8; LUT_LEN], out: &mut [u8]) {
     fn index(v: f32x4) -> [usize; 4] {
         let s = (v.max(f32x4::ZERO) * (1.0 / LUT_MAX)).min(f32x4::ONE).sqrt();
         // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
-        (s * (LUT_LEN - 1) as f32)
-            .fast_trunc_int()
-            .to_array()
-            .map(|i| i as usize & (LUT_LEN - 1))
+        let i = (s * (LUT_LEN - 1) as f32).fast_trunc_int().to_array();
+        let m = LUT_LEN - 1;
+        // Spelled out: `array::map` is not always inlined here.
+        [
+            i[0] as usize & m,
+            i[1] as usize & m,
+            i[2] as usize & m,
+            i[3] as usize & m,
+        ]
     }
     let w = out.len() / 3;
     let [r, g, b] = rgb.each_ref().map(|c| &c[..w.div_ceil(4) * 4]);
