@@ -508,16 +508,7 @@ impl Renderer {
             let (prim_top, prim_bottom) = (&vis.prim[top.clone()], &vis.prim[bottom.clone()]);
             let (key_top, key_bottom) = (&vis.key[top], &vis.key[bottom]);
             // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
-            for (d, k) in out.depth_m[labels.clone()].chunks_mut(4).zip(key_top.chunks(4 * SS)) {
-                // Four pixels at a time (an IEEE division per lane: the same values as one at a time).
-                let first = f32x4::new(std::array::from_fn(|i| k.get(i * SS).copied().unwrap_or(1.0)));
-                let depth = (f32x4::ONE / first).min(f32x4::splat(SKY_DEPTH_M)).to_array();
-                // A fixed-size copy where the chunk is whole (a slice copy of unknown length calls memcpy).
-                match <&mut [f32; 4]>::try_from(&mut *d) {
-                    Ok(d) => *d = depth,
-                    Err(_) => d.copy_from_slice(&depth[..d.len()]),
-                }
-            }
+            depth_labels(key_top, &mut out.depth_m[labels.clone()]);
             let mut last = (EMPTY, 0u16);
             for (i, p) in out.instance[labels.clone()].iter_mut().zip(prim_top.chunks_exact(SS)) {
                 if p[0] != last.0 {
@@ -694,6 +685,21 @@ impl Renderer {
     }
 }
 
+/// A row's depth labels from its top sample row's keys: each pixel's first sample, `1 / key` metres (the sky's
+/// key 0 gives the far plane). Four pixels at a time: an IEEE division per lane, the same values as one at a
+/// time.
+fn depth_labels(key_top: &[f32], depth_m: &mut [f32]) {
+    for (d, k) in depth_m.chunks_mut(4).zip(key_top.chunks(4 * SS)) {
+        let first = f32x4::new(std::array::from_fn(|i| k.get(i * SS).copied().unwrap_or(1.0)));
+        let depth = (f32x4::ONE / first).min(f32x4::splat(SKY_DEPTH_M)).to_array();
+        // A fixed-size copy where the chunk is whole (a slice copy of unknown length calls memcpy).
+        match <&mut [f32; 4]>::try_from(&mut *d) {
+            Ok(d) => *d = depth,
+            Err(_) => d.copy_from_slice(&depth[..d.len()]),
+        }
+    }
+}
+
 /// Maps a row of linear colours (one slice per channel, at least as long as the row) to interleaved sRGB
 /// bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`, four pixels at a time (`wide`:
 /// SSE square roots, correctly rounded, and truncations, so the same values as one at a time).
@@ -741,6 +747,27 @@ pub fn streak_seed(clip_seed: u64, frame: u32, substep: u32) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn depth_labels_equal_the_per_pixel_formula_for_every_row_length() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for w in 0..=13usize {
+            // Keys of the sky (0), of near and of far surfaces.
+            let keys: Vec<f32> = (0..w * SS)
+                .map(|i| match i % 3 {
+                    0 => 0.0,
+                    1 => rng.random_range(0.001..20.0),
+                    _ => rng.random_range(1.0e-5..0.001),
+                })
+                .collect();
+            let mut got = vec![-1.0f32; w];
+            depth_labels(&keys, &mut got);
+            let expected: Vec<u32> = (0..w)
+                .map(|x| (1.0 / keys[x * SS]).min(SKY_DEPTH_M).to_bits())
+                .collect();
+            assert_eq!(got.iter().map(|d| d.to_bits()).collect::<Vec<_>>(), expected, "w {w}");
+        }
+    }
 
     #[test]
     fn the_row_tone_map_equals_the_per_value_formula() {

@@ -177,6 +177,18 @@ impl Setup {
     }
 }
 
+/// The keys of the four samples `x0 + start ..` of a span (see [`depth_test_span`]).
+#[inline(always)]
+fn span_keys4(k_row: f32, kx: f32, x0: f32, start: usize) -> Vec4 {
+    Vec4::splat(k_row) + Vec4::splat(kx) * (Vec4::splat(x0 + start as f32) + Vec4::new(0.0, 1.0, 2.0, 3.0))
+}
+
+/// The key of the sample `x0 + i` of a span, one at a time (the same value as its lane of [`span_keys4`]).
+#[inline(always)]
+fn span_key(k_row: f32, kx: f32, x0: f32, i: usize) -> f32 {
+    k_row + kx * (x0 + i as f32)
+}
+
 /// The depth test along a span of samples whose keys are `k_row + kx · (x0 + i)`: where the key is
 /// greater, it and `prim` replace the buffer's. Four samples at a time with SIMD selects (glam's `Vec4`;
 /// primitive ids travel as the bit patterns of `f32` lanes, which moves and bitwise selects keep exactly).
@@ -185,7 +197,6 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
     let n = keys.len().min(prims.len());
     let (keys, prims) = (&mut keys[..n], &mut prims[..n]);
     let whole = n / 4 * 4;
-    let lane = Vec4::new(0.0, 1.0, 2.0, 3.0);
     let prim_bits = Vec4::splat(f32::from_bits(prim));
     for (start, (kk, pp)) in keys[..whole]
         .chunks_exact_mut(4)
@@ -193,7 +204,7 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
         .enumerate()
         .map(|(c, chunk)| (c * 4, chunk))
     {
-        let k = Vec4::splat(k_row) + Vec4::splat(kx) * (Vec4::splat(x0 + start as f32) + lane);
+        let k = span_keys4(k_row, kx, x0, start);
         let old_k = Vec4::from_slice(kk);
         let nearer = k.cmpgt(old_k);
         Vec4::select(nearer, k, old_k).write_to_slice(kk);
@@ -209,7 +220,7 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
         }
     }
     for i in whole..n {
-        let k = k_row + kx * (x0 + i as f32);
+        let k = span_key(k_row, kx, x0, i);
         if k > keys[i] {
             keys[i] = k;
             prims[i] = prim;
@@ -221,18 +232,17 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
 #[inline]
 fn depth_test_span_keys(keys: &mut [f32], k_row: f32, kx: f32, x0: f32) {
     let whole = keys.len() / 4 * 4;
-    let lane = Vec4::new(0.0, 1.0, 2.0, 3.0);
     for (start, kk) in keys[..whole]
         .chunks_exact_mut(4)
         .enumerate()
         .map(|(c, chunk)| (c * 4, chunk))
     {
-        let k = Vec4::splat(k_row) + Vec4::splat(kx) * (Vec4::splat(x0 + start as f32) + lane);
+        let k = span_keys4(k_row, kx, x0, start);
         let old_k = Vec4::from_slice(kk);
         Vec4::select(k.cmpgt(old_k), k, old_k).write_to_slice(kk);
     }
     for (i, key) in keys.iter_mut().enumerate().skip(whole) {
-        let k = k_row + kx * (x0 + i as f32);
+        let k = span_key(k_row, kx, x0, i);
         if k > *key {
             *key = k;
         }

@@ -58,10 +58,10 @@ const NOISE_CELLS: usize = NOISE_SIZE * NOISE_SIZE;
 impl Noise {
     /// The noise table of a seed.
     pub fn new(seed: u64) -> Noise {
-        let value = |x: usize, y: usize| {
-            let i = (y % NOISE_SIZE) * NOISE_SIZE + x % NOISE_SIZE;
-            (splitmix64(seed ^ splitmix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        };
+        let values: Vec<f32> = (0..NOISE_CELLS)
+            .map(|i| (splitmix64(seed ^ splitmix64(i as u64)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0)
+            .collect();
+        let value = |x: usize, y: usize| values[(y % NOISE_SIZE) * NOISE_SIZE + x % NOISE_SIZE];
         let cells: Vec<[f32; 4]> = (0..NOISE_CELLS)
             .map(|i| {
                 let (x, y) = (i % NOISE_SIZE, i / NOISE_SIZE);
@@ -80,7 +80,7 @@ impl Noise {
     #[inline(always)]
     fn corners(&self, ix: i32, iy: i32) -> [f32; 4] {
         let m = (NOISE_SIZE - 1) as i32;
-        self.cells[((iy & m) as usize) << 8 | (ix & m) as usize]
+        self.cells[(iy & m) as usize * NOISE_SIZE + (ix & m) as usize]
     }
 
     /// Bilinear sample at `p` (one cell per unit).
