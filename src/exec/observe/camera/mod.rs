@@ -1,18 +1,19 @@
 //! The camera streams, rendered on the CPU: RGB, depth, semantic and instance segmentation from one
 //! rasterisation of the scene, and DVS events from the rendered luminance.
 //!
-//! - [`raster`] — the visibility buffer (nearest primitive and depth per sample).
+//! - [`raster`] — the visibility buffers (nearest primitive and depth per sample).
 //! - [`lanes`] — four-lane math for shading four pixels at once.
 //! - [`light`] — lighting from the weather.
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
 //! - [`dvs`] — the ESIM event simulator.
 //!
-//! A frame is drawn at `SS × SS` samples per pixel into the visibility buffer, with the same
+//! A frame is drawn at `SS × SS` samples per pixel, in bands of rows, with the same
 //! [`CameraPose`](crate::exec::observe::rig::CameraPose) (intrinsics and pose) that the annotations project
-//! with. Label streams are point samples of it (the pixel's first sample, at `(u + 0.25, v + 0.25)`; road
-//! paint's semantic label at the pixel centre when all samples see one primitive, where the colour is shaded);
-//! RGB shades a pixel once where its samples see one primitive and each sample where they differ (edge
-//! antialiasing), then adds rain streaks and maps to sRGB.
+//! with: every pixel's first sample, and all four where the first samples of the pixel and of its right,
+//! lower and diagonal neighbours differ ([`raster::BandVisibility`]). Label streams are point samples (the
+//! pixel's first sample, at `(u + 0.25, v + 0.25)`; road paint's semantic label at the pixel centre when all
+//! samples see one primitive, where the colour is shaded); RGB shades a pixel once where its samples see one
+//! primitive and each sample where they differ (edge antialiasing), then adds rain streaks and maps to sRGB.
 
 pub mod dvs;
 pub mod lanes;
@@ -31,7 +32,7 @@ use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
 use crate::mix::splitmix64;
 use lanes::{V3, floor_i32x4};
 use light::Lighting;
-use raster::{EMPTY, Raster, Setup, clip_near};
+use raster::{BandVisibility, EDGE, EMPTY, Raster, Setup, clip_near};
 use shade::{ActiveLights, Noise, ShadeContext};
 use wide::f32x4;
 
@@ -64,9 +65,6 @@ pub struct CameraImages {
     pub instance: Vec<u16>,
 }
 
-/// The marker of an edge pixel (its samples see different primitives) in a row's primitives.
-const EDGE: u32 = EMPTY - 1;
-
 /// Rows of the images resolved as one task.
 const BAND_ROWS: usize = 8;
 
@@ -83,17 +81,15 @@ struct Band<'a> {
 #[derive(Debug, Default)]
 struct BandBuffers(Mutex<Vec<BandScratch>>);
 
-/// What resolving a band needs besides the images: its visibility buffer and a row's scratch, kept from band to
-/// band (one set per worker at a time) so that a frame allocates nothing. Every row rewrites what it reads.
+/// What resolving a band needs besides the images: its visibility grid, its edge pixels and a row's scratch,
+/// kept from band to band (one set per worker at a time) so that a frame allocates nothing. Every band
+/// rewrites what it reads.
 #[derive(Debug)]
 struct BandScratch {
-    /// The band's visibility buffer.
-    vis: Raster,
-    /// Per pixel of a row: the primitive all its samples see (or `EDGE`) and their mean depth key.
-    row_prim: Vec<u32>,
-    row_key: Vec<f32>,
-    /// The samples of the row's edge pixels (four per pixel, in pixel order) and their shaded colours and
-    /// tags, by the sample's index in that list; their order of shading (primitive, index).
+    /// The band's visibility.
+    vis: BandVisibility,
+    /// The samples of the band's edge pixels (four per pixel, in (row, column) order) and their shaded colours
+    /// and tags, by the sample's index in that list; their order of shading (primitive, index).
     edges: Vec<Sample>,
     order: Vec<u64>,
     edge_colour: Vec<Vec3>,
@@ -106,13 +102,11 @@ impl BandScratch {
     /// Buffers for bands of a `w`-pixel-wide image.
     fn new(w: usize) -> BandScratch {
         BandScratch {
-            vis: Raster::new(w * SS, BAND_ROWS * SS),
-            row_prim: vec![EMPTY; w],
-            row_key: vec![0.0; w],
-            edges: Vec::with_capacity(w * SS * SS),
-            order: Vec::with_capacity(w * SS * SS),
-            edge_colour: vec![Vec3::ZERO; w * SS * SS],
-            edge_tag: vec![0; w * SS * SS],
+            vis: BandVisibility::new(w, BAND_ROWS),
+            edges: Vec::new(),
+            order: Vec::new(),
+            edge_colour: Vec::new(),
+            edge_tag: Vec::new(),
             rgb: [vec![0.0; w + 3], vec![0.0; w + 3], vec![0.0; w + 3]],
         }
     }
@@ -361,13 +355,17 @@ impl Renderer {
         for tri in &frame.mesh.tris {
             draw(tri);
         }
-        // Each triangle into the bands of rows it reaches, in drawing order.
+        // Each triangle into the bands of rows it reaches, in drawing order: a band's sample rows and the
+        // first of the band below (its grid's last row).
         let band_samples = BAND_ROWS * SS;
         for bin in &mut self.bins {
             bin.clear();
         }
+        let last_bin = self.bins.len() - 1;
         for (i, t) in self.tris.iter().enumerate() {
-            for bin in &mut self.bins[t.row0 as usize / band_samples..=t.row1 as usize / band_samples] {
+            let first = (t.row0 as usize).saturating_sub(band_samples).div_ceil(band_samples);
+            let last = (t.row1 as usize / band_samples).min(last_bin);
+            for bin in &mut self.bins[first..=last] {
                 bin.push(i as u32);
             }
         }
@@ -480,76 +478,90 @@ impl Renderer {
             cy: c.height_px as f32 * 0.5,
             inv_f: 1.0 / c.focal_px as f32,
         };
-        let sw = w * SS;
         let inv_ss = 1.0 / SS as f32;
         let mut taken = self.band_buffers.0.lock().map_or(None, |mut b| b.pop());
         let BandScratch {
             vis,
-            row_prim,
-            row_key,
             edges,
             order,
             edge_colour,
             edge_tag,
             rgb,
         } = taken.get_or_insert_with(|| BandScratch::new(w));
-        // The band's visibility buffer: its triangles drawn in order.
-        vis.clear(0.0);
-        let origin = y0 * SS;
-        for &i in &self.bins[y0 / BAND_ROWS] {
-            vis.draw_rows(&self.tris[i as usize], origin..=origin + h * SS - 1, origin);
+        vis.draw(&self.tris, &self.bins[y0 / BAND_ROWS], y0, h, c.height_px as usize);
+        let BandVisibility {
+            grid,
+            prim: band_prim,
+            key: band_key,
+            edge_x,
+            edge_key,
+            edge_prim,
+            edge_rows,
+        } = vis;
+        // Edge candidates whose four samples see one primitive after all are shaded as such, with the mean of
+        // their keys; the others' samples are listed and shaded, up to four of one primitive at a time (over
+        // the band, so that the lanes fill).
+        edges.clear();
+        for row in 0..h {
+            let y = y0 + row;
+            for e in edge_rows[row]..edge_rows[row + 1] {
+                let (x, p, k) = (edge_x[e] as usize, edge_prim[e], edge_key[e]);
+                if p[1] == p[0] && p[2] == p[0] && p[3] == p[0] {
+                    band_prim[row * w + x] = p[0];
+                    band_key[row * w + x] = (k[0] + k[1] + k[2] + k[3]) * 0.25;
+                    continue;
+                }
+                for (i, (prim, key)) in p.into_iter().zip(k).enumerate() {
+                    let (sx, sy) = ((i % SS) as f32, (i / SS) as f32);
+                    edges.push(Sample {
+                        prim,
+                        key,
+                        u: x as f32 + (sx + 0.5) * inv_ss,
+                        v: y as f32 + (sy + 0.5) * inv_ss,
+                    });
+                }
+            }
         }
+        order.clear();
+        order.extend(
+            edges
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (u64::from(s.prim) << 32) | i as u64),
+        );
+        order.sort_unstable();
+        edge_colour.resize(edges.len(), Vec3::ZERO);
+        edge_tag.resize(edges.len(), 0);
+        for group in order.chunk_by(|a, b| a >> 32 == b >> 32) {
+            for chunk in group.chunks(4) {
+                let at = |i: usize| &edges[(chunk[i.min(chunk.len() - 1)] & 0xffff_ffff) as usize];
+                let lane = |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(at(i))));
+                let (colour, tags) =
+                    self.shade4(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
+                for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
+                    edge_colour[(o & 0xffff_ffff) as usize] = c;
+                    edge_tag[(o & 0xffff_ffff) as usize] = t;
+                }
+            }
+        }
+        // The edge pixels' samples in `edge_colour`, in (row, column) order.
+        let mut e = 0;
         for row in 0..h {
             let y = y0 + row;
             let v_centre = f32x4::splat(y as f32 + 0.5);
             let labels = row * w..(row + 1) * w;
-            let top = row * SS * sw..(row * SS + 1) * sw;
-            let bottom = (row * SS + 1) * sw..(row * SS + 2) * sw;
-            let (prim_top, prim_bottom) = (&vis.prim[top.clone()], &vis.prim[bottom.clone()]);
-            let (key_top, key_bottom) = (&vis.key[top], &vis.key[bottom]);
+            let (grid_prim, grid_key) = (&grid.prim[labels.clone()], &grid.key[labels.clone()]);
             // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
-            depth_labels(key_top, &mut out.depth_m[labels.clone()]);
+            depth_labels(grid_key, &mut out.depth_m[labels.clone()]);
             let mut last = (EMPTY, 0u16);
-            for (i, p) in out.instance[labels.clone()].iter_mut().zip(prim_top.chunks_exact(SS)) {
-                if p[0] != last.0 {
-                    last = (
-                        p[0],
-                        if p[0] == EMPTY {
-                            0
-                        } else {
-                            frame.prim(scene, p[0]).instance
-                        },
-                    );
+            for (i, &p) in out.instance[labels.clone()].iter_mut().zip(grid_prim) {
+                if p != last.0 {
+                    last = (p, if p == EMPTY { 0 } else { frame.prim(scene, p).instance });
                 }
                 *i = last.1;
             }
-            edges.clear();
-            for (x, ((((prim_out, key_out), pt), pb), (kt, kb))) in row_prim
-                .iter_mut()
-                .zip(row_key.iter_mut())
-                .zip(prim_top.chunks_exact(SS))
-                .zip(prim_bottom.chunks_exact(SS))
-                .zip(key_top.chunks_exact(SS).zip(key_bottom.chunks_exact(SS)))
-                .enumerate()
-            {
-                let p0 = pt[0];
-                if pt[1] == p0 && pb[0] == p0 && pb[1] == p0 {
-                    *prim_out = p0;
-                    *key_out = (kt[0] + kt[1] + kb[0] + kb[1]) * 0.25;
-                } else {
-                    *prim_out = EDGE;
-                    let samples = [(pt[0], kt[0]), (pt[1], kt[1]), (pb[0], kb[0]), (pb[1], kb[1])];
-                    for (k, (prim, key)) in samples.into_iter().enumerate() {
-                        let (sx, sy) = ((k % SS) as f32, (k / SS) as f32);
-                        edges.push(Sample {
-                            prim,
-                            key,
-                            u: x as f32 + (sx + 0.5) * inv_ss,
-                            v: y as f32 + (sy + 0.5) * inv_ss,
-                        });
-                    }
-                }
-            }
+            let row_prim = &band_prim[labels.clone()];
+            let row_key = &band_key[labels.clone()];
             // Pixels whose samples see one primitive: shaded at their centres, up to four neighbours of one
             // primitive at a time.
             let semantic = &mut out.semantic[labels];
@@ -578,29 +590,7 @@ impl Renderer {
                 }
                 x = end;
             }
-            // Edge samples, up to four of one primitive at a time.
-            order.clear();
-            order.extend(
-                edges
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| (u64::from(s.prim) << 32) | i as u64),
-            );
-            order.sort_unstable();
-            for group in order.chunk_by(|a, b| a >> 32 == b >> 32) {
-                for chunk in group.chunks(4) {
-                    let at = |i: usize| &edges[(chunk[i.min(chunk.len() - 1)] & 0xffff_ffff) as usize];
-                    let lane = |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(at(i))));
-                    let (colour, tags) =
-                        self.shade4(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
-                    for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
-                        edge_colour[(o & 0xffff_ffff) as usize] = c;
-                        edge_tag[(o & 0xffff_ffff) as usize] = t;
-                    }
-                }
-            }
             // Edge pixels: the mean of their samples' colours, the first sample's tag.
-            let mut e = 0;
             for (x, _) in row_prim.iter().enumerate().filter(|(_, p)| **p == EDGE) {
                 let c = &edge_colour[e..e + 4];
                 let colour = (c[0] + c[1] + c[2] + c[3]) * 0.25;
@@ -685,12 +675,11 @@ impl Renderer {
     }
 }
 
-/// A row's depth labels from its top sample row's keys: each pixel's first sample, `1 / key` metres (the sky's
-/// key 0 gives the far plane). Four pixels at a time: an IEEE division per lane, the same values as one at a
-/// time.
-fn depth_labels(key_top: &[f32], depth_m: &mut [f32]) {
-    for (d, k) in depth_m.chunks_mut(4).zip(key_top.chunks(4 * SS)) {
-        let first = f32x4::new(std::array::from_fn(|i| k.get(i * SS).copied().unwrap_or(1.0)));
+/// A row's depth labels from its pixels' first samples' keys: `1 / key` metres (the sky's key 0 gives the far
+/// plane). Four pixels at a time: an IEEE division per lane, the same values as one at a time.
+fn depth_labels(keys: &[f32], depth_m: &mut [f32]) {
+    for (d, k) in depth_m.chunks_mut(4).zip(keys.chunks(4)) {
+        let first = f32x4::new(std::array::from_fn(|i| k.get(i).copied().unwrap_or(1.0)));
         let depth = (f32x4::ONE / first).min(f32x4::splat(SKY_DEPTH_M)).to_array();
         // A fixed-size copy where the chunk is whole (a slice copy of unknown length calls memcpy).
         match <&mut [f32; 4]>::try_from(&mut *d) {
@@ -753,7 +742,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(9);
         for w in 0..=13usize {
             // Keys of the sky (0), of near and of far surfaces.
-            let keys: Vec<f32> = (0..w * SS)
+            let keys: Vec<f32> = (0..w)
                 .map(|i| match i % 3 {
                     0 => 0.0,
                     1 => rng.random_range(0.001..20.0),
@@ -762,9 +751,7 @@ mod tests {
                 .collect();
             let mut got = vec![-1.0f32; w];
             depth_labels(&keys, &mut got);
-            let expected: Vec<u32> = (0..w)
-                .map(|x| (1.0 / keys[x * SS]).min(SKY_DEPTH_M).to_bits())
-                .collect();
+            let expected: Vec<u32> = (0..w).map(|x| (1.0 / keys[x]).min(SKY_DEPTH_M).to_bits()).collect();
             assert_eq!(got.iter().map(|d| d.to_bits()).collect::<Vec<_>>(), expected, "w {w}");
         }
     }
