@@ -489,29 +489,17 @@ impl Renderer {
             rgb,
         } = taken.get_or_insert_with(|| BandScratch::new(w));
         vis.draw(&self.tris, &self.bins[y0 / BAND_ROWS], y0, h, c.height_px as usize);
-        let BandVisibility {
-            grid,
-            prim: band_prim,
-            key: band_key,
-            edge_x,
-            edge_key,
-            edge_prim,
-            edge_rows,
-        } = vis;
-        // Edge candidates whose four samples see one primitive after all are shaded as such, with the mean of
-        // their keys; the others' samples are listed and shaded, up to four of one primitive at a time (over
-        // the band, so that the lanes fill).
+        // The edge pixels' samples, listed and shaded up to four of one primitive at a time (over the band, so
+        // that the lanes fill).
         edges.clear();
         for row in 0..h {
             let y = y0 + row;
-            for e in edge_rows[row]..edge_rows[row + 1] {
-                let (x, p, k) = (edge_x[e] as usize, edge_prim[e], edge_key[e]);
-                if p[1] == p[0] && p[2] == p[0] && p[3] == p[0] {
-                    band_prim[row * w + x] = p[0];
-                    band_key[row * w + x] = (k[0] + k[1] + k[2] + k[3]) * 0.25;
+            for e in vis.edge_rows[row]..vis.edge_rows[row + 1] {
+                let x = vis.edge_x[e] as usize;
+                if vis.prim[row * w + x] != EDGE {
                     continue;
                 }
-                for (i, (prim, key)) in p.into_iter().zip(k).enumerate() {
+                for (i, (prim, key)) in vis.edge_prim[e].into_iter().zip(vis.edge_key[e]).enumerate() {
                     let (sx, sy) = ((i % SS) as f32, (i / SS) as f32);
                     edges.push(Sample {
                         prim,
@@ -550,7 +538,7 @@ impl Renderer {
             let y = y0 + row;
             let v_centre = f32x4::splat(y as f32 + 0.5);
             let labels = row * w..(row + 1) * w;
-            let (grid_prim, grid_key) = (&grid.prim[labels.clone()], &grid.key[labels.clone()]);
+            let (grid_prim, grid_key) = (&vis.grid.prim[labels.clone()], &vis.grid.key[labels.clone()]);
             // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
             depth_labels(grid_key, &mut out.depth_m[labels.clone()]);
             let mut last = (EMPTY, 0u16);
@@ -560,8 +548,8 @@ impl Renderer {
                 }
                 *i = last.1;
             }
-            let row_prim = &band_prim[labels.clone()];
-            let row_key = &band_key[labels.clone()];
+            let row_prim = &vis.prim[labels.clone()];
+            let row_key = &vis.key[labels.clone()];
             // Pixels whose samples see one primitive: shaded at their centres, up to four neighbours of one
             // primitive at a time.
             let semantic = &mut out.semantic[labels];

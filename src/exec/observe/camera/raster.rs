@@ -135,14 +135,15 @@ pub const EDGE: u32 = EMPTY - 1;
 pub struct BandVisibility {
     /// The grid: the first sample of every pixel of the band's rows and of the row below.
     pub grid: Raster,
-    /// Per pixel of the band: the primitive all its samples see (or [`EDGE`]) and their mean depth key
-    /// (interpolated from the corners where the pixel is not a candidate).
+    /// Per pixel of the band: the primitive all its samples see (or [`EDGE`] where they differ) and their
+    /// mean depth key (interpolated from the corners where the pixel is not a candidate).
     pub prim: Vec<u32>,
     /// See [`BandVisibility::prim`].
     pub key: Vec<f32>,
-    /// The edge candidates in (row, column) order: their columns, their four samples' depth keys and
-    /// primitives (in the order (0, 0), (1, 0), (0, 1), (1, 1) within the pixel) and where each row's start
-    /// (one more entry than rows).
+    /// The edge candidates in (row, column) order (those whose samples turned out to agree included: their
+    /// [`BandVisibility::prim`] is not [`EDGE`]): their columns, their four samples' depth keys and primitives
+    /// (in the order (0, 0), (1, 0), (0, 1), (1, 1) within the pixel) and where each row's start (one more
+    /// entry than rows).
     pub edge_x: Vec<u32>,
     /// See [`BandVisibility::edge_x`].
     pub edge_key: Vec<[f32; 4]>,
@@ -269,6 +270,17 @@ impl BandVisibility {
                 }
             }
         }
+        // Candidates whose four samples see one primitive after all: that primitive, the mean of their keys.
+        for row in 0..h {
+            for e in edge_rows[row]..edge_rows[row + 1] {
+                let (p, k) = (edge_prim[e], edge_key[e]);
+                if p[1] == p[0] && p[2] == p[0] && p[3] == p[0] {
+                    let at = row * w + edge_x[e] as usize;
+                    band_prim[at] = p[0];
+                    band_key[at] = (k[0] + k[1] + k[2] + k[3]) * 0.25;
+                }
+            }
+        }
     }
 }
 
@@ -347,9 +359,7 @@ impl Setup {
             prim,
         })
     }
-}
 
-impl Setup {
     /// The samples of sample row `row` (centred at `row + 0.5`) that the triangle covers (`None`: none).
     #[inline]
     pub fn span(&self, row: usize) -> Option<Span> {
@@ -700,6 +710,15 @@ mod tests {
                         for k in 0..4 {
                             let got = (band.edge_prim[e][k], band.edge_key[e][k].to_bits());
                             assert_eq!(got, sample(x, y, k), "pixel {x},{y} sample {k}");
+                        }
+                        // Resolved: one primitive with the mean key where the samples agree, an edge where not.
+                        let p = band.edge_prim[e];
+                        if p.iter().all(|&q| q == p[0]) {
+                            let k = band.edge_key[e];
+                            assert_eq!(band.prim[row * w + x], p[0]);
+                            assert_eq!(band.key[row * w + x], (k[0] + k[1] + k[2] + k[3]) * 0.25);
+                        } else {
+                            assert_eq!(band.prim[row * w + x], EDGE, "pixel {x},{y}");
                         }
                     }
                     // Other pixels: one primitive, the full raster's first sample's.
