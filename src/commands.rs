@@ -22,6 +22,20 @@ pub mod exit {
     pub const INVALID: i32 = 2;
 }
 
+/// Why this binary cannot run on this CPU, if it cannot: x86-64 builds use AVX2 (`.cargo/config.toml`), and a
+/// CPU without it would stop at the first AVX2 instruction with `SIGILL` instead of a message.
+pub fn unsupported_cpu() -> Option<String> {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    if !std::arch::is_x86_feature_detected!("avx2") {
+        return Some(
+            "error: this build of pedsynth uses AVX2, which this CPU does not have\n  help: build it for every \
+             x86-64 CPU (the same outputs, slower): RUSTFLAGS=\"-C target-cpu=x86-64\" cargo build --release\n"
+                .to_string(),
+        );
+    }
+    None
+}
+
 /// Width diagnostics are rendered at.
 pub const DIAGNOSTIC_WIDTH: usize = 100;
 

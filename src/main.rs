@@ -308,6 +308,10 @@ enum TownCommand {
 }
 
 fn main() -> ExitCode {
+    if let Some(message) = commands::unsupported_cpu() {
+        eprint!("{message}");
+        return ExitCode::from(commands::exit::FAILURE as u8);
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(err) => {

@@ -1021,3 +1021,95 @@ fn cyclists_are_drawn_in_their_boxes_as_rider_and_bicycle() {
         "{on_body} of {keypoints} keypoints on the cyclist"
     );
 }
+
+/// A lane's shading does not depend on the other points in its vector: `LANES` points of one primitive shaded
+/// together give, lane by lane, the bits each gives shaded alone (in every lane), for every primitive of a
+/// quickstart clip's busiest frame (ground with road paint, walls with windows, bodies with their capsules'
+/// normals), by day with shadows and at night in rain with lamps, headlights and wet reflections. Runs of
+/// pixels and edge samples are grouped differently, so this is what keeps an image independent of grouping.
+#[test]
+fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
+    use pedsynth::exec::observe::camera::lanes::{F, LANES, V3};
+    use pedsynth::exec::observe::camera::shade::{self, ActiveLights, Noise, Points, ShadeContext};
+    use rand::{RngExt, SeedableRng};
+
+    for weather in ["clear_noon", "night_rainy"] {
+        let c = clip(&spec("quickstart.yaml"), &[&format!("dataset.weathers=[{weather}]")]);
+        let net = &c.towns[&c.script.town].network;
+        let stat = StaticScene::build(&c.script, &c.trace, net);
+        let frame_no = c.busy_frames(1)[0];
+        let mut frame = FrameScene::default();
+        frame.build(&stat, &c.script, &c.trace, scene::SceneTime::at(frame_no));
+        let light = Lighting::from_weather(&c.script.weather_params);
+        let noise = Noise::new(c.script.seed);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        // Every primitive's triangles, static and of the frame.
+        let mut tris: BTreeMap<u32, Vec<[Vec3; 3]>> = BTreeMap::new();
+        for t in stat.tris.iter().chain(&frame.mesh.tris) {
+            tris.entry(t.prim).or_default().push(t.v);
+        }
+        let (mut checked, mut painted) = (0, 0);
+        for (&id, prim_tris) in &tris {
+            let prim = frame.prim(&stat, id);
+            // Points on the primitive's triangles, seen from 1.6 m above a point 12 m away.
+            let pts: [Vec3; LANES] = std::array::from_fn(|_| {
+                let v = prim_tris[rng.random_range(0..prim_tris.len())];
+                let (a, b): (f32, f32) = (rng.random(), rng.random());
+                let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                v[0] + (v[1] - v[0]) * a + (v[2] - v[0]) * b
+            });
+            let cam = pts[0] + Vec3::new(-12.0, 3.0, 1.6);
+            let mut lamps: Vec<Vec3> = stat.lamps.iter().map(|l| l.pos).collect();
+            lamps.sort_by(|a, b| a.distance(pts[0]).total_cmp(&b.distance(pts[0])));
+            lamps.truncate(16);
+            let lights = ActiveLights {
+                lamps,
+                heads: vec![
+                    (cam - Vec3::Z * 0.7, Vec3::X),
+                    (pts[3] - Vec3::new(9.0, 0.0, 0.6), Vec3::X),
+                ],
+            };
+            let ctx = ShadeContext {
+                scene: &stat,
+                frame: &frame,
+                light: &light,
+                noise: &noise,
+                lights: &lights,
+            };
+            let shadow: [f32; LANES] = std::array::from_fn(|i| [0.0, 1.0, 0.25][i % 3]);
+            let points = |lane: Option<usize>| {
+                let at = |i: usize| lane.unwrap_or(i);
+                let p = V3::from_lanes(std::array::from_fn(|i| pts[at(i)]));
+                let ray = V3::from_lanes(std::array::from_fn(|i| pts[at(i)] - cam));
+                Points {
+                    p,
+                    ray,
+                    ray_len: ray.length_squared().sqrt(),
+                    shadow: F::new(std::array::from_fn(|i| shadow[at(i)])),
+                }
+            };
+            let shaded = |pts: &Points| {
+                let (colour, tags) = shade::surface(&ctx, prim, pts);
+                let fogged = shade::fog(&light, colour, pts.ray_len * 7.0);
+                (fogged.lanes(), tags)
+            };
+            let (together, together_tags) = shaded(&points(None));
+            for lane in 0..LANES {
+                let (alone, alone_tags) = shaded(&points(Some(lane)));
+                assert_eq!(
+                    together[lane].to_array().map(f32::to_bits),
+                    alone[0].to_array().map(f32::to_bits),
+                    "{weather}: prim {id} ({:?}) lane {lane}",
+                    prim.material
+                );
+                assert_eq!(together_tags[lane], alone_tags[0], "{weather}: prim {id} lane {lane}");
+                painted += usize::from(alone_tags[0] == tag::ROAD_LINE);
+            }
+            checked += 1;
+        }
+        assert!(
+            checked > 500 && painted > 0,
+            "{weather}: {checked} primitives, {painted} painted points"
+        );
+    }
+}

@@ -1,79 +1,91 @@
-//! Four-lane math for shading four pixels (or samples) at once: a vector of four points ([`V3`]), floors
-//! without libm, an exponential, and the noise table sampled in four places. Built on `wide::f32x4` (SSE2 on
-//! every x86-64 CPU); every operation is plain IEEE single precision without fused multiply-adds, so the
+//! Lane math for shading [`LANES`] pixels (or samples) at once: a vector of points ([`V3`]), floors without
+//! libm, an exponential. Built on `wide::f32x8` (two SSE2 registers on every x86-64 CPU, one AVX register
+//! where the build enables AVX, e.g. `-C target-cpu=x86-64-v3`); every operation is plain IEEE single precision without fused multiply-adds, so the
 //! same inputs give the same bits on every machine the binary runs on, and each lane equals the scalar
 //! formula it replaces (tests below).
 
 use glam::Vec3;
-use wide::{f32x4, i32x4};
+
+/// Lanes of one shading call: points (or samples) shaded at once.
+pub const LANES: usize = 8;
+/// A vector of [`LANES`] floats (`wide`: two SSE registers, or one AVX register where the build targets AVX).
+pub type F = wide::f32x8;
+/// A vector of [`LANES`] integers.
+pub type I = wide::i32x8;
+
+/// A lane vector from a function of the lane.
+#[inline(always)]
+pub fn lanes_from(f: impl FnMut(usize) -> f32) -> F {
+    F::new(std::array::from_fn(f))
+}
 
 /// Four points or vectors, one per lane.
 #[derive(Clone, Copy, Debug)]
 pub struct V3 {
-    /// x of the four lanes.
-    pub x: f32x4,
-    /// y of the four lanes.
-    pub y: f32x4,
-    /// z of the four lanes.
-    pub z: f32x4,
+    /// x of the lanes.
+    pub x: F,
+    /// y of the lanes.
+    pub y: F,
+    /// z of the lanes.
+    pub z: F,
 }
 
 impl V3 {
     /// Zero in every lane.
     pub const ZERO: V3 = V3 {
-        x: f32x4::ZERO,
-        y: f32x4::ZERO,
-        z: f32x4::ZERO,
+        x: F::ZERO,
+        y: F::ZERO,
+        z: F::ZERO,
     };
 
     /// The same vector in every lane.
     #[inline(always)]
     pub fn splat(v: Vec3) -> V3 {
         V3 {
-            x: f32x4::splat(v.x),
-            y: f32x4::splat(v.y),
-            z: f32x4::splat(v.z),
+            x: F::splat(v.x),
+            y: F::splat(v.y),
+            z: F::splat(v.z),
         }
     }
 
-    /// Four vectors, one per lane.
+    /// One vector per lane.
     #[inline(always)]
-    pub fn from_lanes(v: [Vec3; 4]) -> V3 {
+    pub fn from_lanes(v: [Vec3; LANES]) -> V3 {
         V3 {
-            x: f32x4::new(v.map(|p| p.x)),
-            y: f32x4::new(v.map(|p| p.y)),
-            z: f32x4::new(v.map(|p| p.z)),
+            x: F::new(v.map(|p| p.x)),
+            y: F::new(v.map(|p| p.y)),
+            z: F::new(v.map(|p| p.z)),
         }
     }
 
-    /// The four lanes.
+    /// The lanes.
     #[inline(always)]
-    pub fn lanes(&self) -> [Vec3; 4] {
+    pub fn lanes(&self) -> [Vec3; LANES] {
         let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
         std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
     }
 
     /// Dot product per lane, `x·x + y·y + z·z` left to right (as `Vec3::dot`).
     #[inline(always)]
-    pub fn dot(self, o: V3) -> f32x4 {
+    pub fn dot(self, o: V3) -> F {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// Dot product with one vector.
     #[inline(always)]
-    pub fn dot_v(self, o: Vec3) -> f32x4 {
+    pub fn dot_v(self, o: Vec3) -> F {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// Squared length per lane.
     #[inline(always)]
-    pub fn length_squared(self) -> f32x4 {
+    pub fn length_squared(self) -> F {
         self.dot(self)
     }
 
     /// Scales every lane by its own factor.
     #[inline(always)]
-    pub fn scale(self, s: f32x4) -> V3 {
+    pub fn scale(self, s: F) -> V3 {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -83,8 +95,8 @@ impl V3 {
 
     /// `a * (1 − s) + b * s` per lane (as `Vec3::lerp`).
     #[inline(always)]
-    pub fn lerp(a: Vec3, b: Vec3, s: f32x4) -> V3 {
-        let r = f32x4::ONE - s;
+    pub fn lerp(a: Vec3, b: Vec3, s: F) -> V3 {
+        let r = F::ONE - s;
         V3 {
             x: r * a.x + s * b.x,
             y: r * a.y + s * b.y,
@@ -94,7 +106,7 @@ impl V3 {
 
     /// Lane by lane: `mask` ? `a` : `b`.
     #[inline(always)]
-    pub fn select(mask: f32x4, a: V3, b: V3) -> V3 {
+    pub fn select(mask: F, a: V3, b: V3) -> V3 {
         V3 {
             x: mask.select(a.x, b.x),
             y: mask.select(a.y, b.y),
@@ -105,8 +117,8 @@ impl V3 {
     /// Unit vectors, or zero where the length is zero or not finite (as `Vec3::normalize_or_zero`).
     #[inline(always)]
     pub fn normalize_or_zero(self) -> V3 {
-        let rcp = f32x4::ONE / self.length_squared().sqrt();
-        let ok = rcp.is_finite() & rcp.simd_gt(f32x4::ZERO);
+        let rcp = F::ONE / self.length_squared().sqrt();
+        let ok = rcp.is_finite() & rcp.simd_gt(F::ZERO);
         let n = self.scale(rcp);
         V3::select(ok, n, V3::ZERO)
     }
@@ -152,27 +164,27 @@ impl std::ops::Mul for V3 {
 /// `x.floor()` per lane as an integer, for `|x| < 2^31` (NaN and larger values give `i32::MIN`): rounding
 /// to nearest, then one down where that went up.
 #[inline(always)]
-pub fn floor_i32x4(x: f32x4) -> i32x4 {
+pub fn floor_int(x: F) -> I {
     let r = x.fast_round_int();
-    let up: i32x4 = wide::bytemuck::cast(r.round_float().simd_gt(x));
+    let up: I = wide::bytemuck::cast(r.round_float().simd_gt(x));
     r + up
 }
 
 /// `e^x` per lane (Cephes' `expf` polynomial, relative error below 2·10⁻⁷), `x` clamped to [−87.3, 88.3].
 #[inline(always)]
-pub fn exp4(x: f32x4) -> f32x4 {
-    let x = x.max(f32x4::splat(-87.3)).min(f32x4::splat(88.3));
+pub fn exp_lanes(x: F) -> F {
+    let x = x.max(F::splat(-87.3)).min(F::splat(88.3));
     let n = (x * std::f32::consts::LOG2_E).fast_round_int();
     let nf = n.round_float();
     let r = x - nf * 0.693_359_4 - nf * -2.121_944_4e-4;
-    let mut y = f32x4::splat(1.987_569_1e-4);
+    let mut y = F::splat(1.987_569_1e-4);
     y = y * r + 1.398_199_9e-3;
     y = y * r + 8.333_452e-3;
     y = y * r + 4.166_579_6e-2;
     y = y * r + 0.166_666_65;
     y = y * r + 0.5;
     let y = y * r * r + r + 1.0;
-    let scale: f32x4 = wide::bytemuck::cast((n + 127) << 23);
+    let scale: F = wide::bytemuck::cast((n + 127) << 23);
     y * scale
 }
 
@@ -184,8 +196,8 @@ mod tests {
     proptest! {
         #[test]
         fn the_lane_floor_is_the_floor(a in -2.0e9f32..2.0e9, b in -1.0e4f32..1.0e4, c in -3.0f32..3.0) {
-            let v = [a, b, c, b.trunc() - 0.5];
-            let got = floor_i32x4(f32x4::new(v)).to_array();
+            let v = [a, b, c, b.trunc() - 0.5, -a, -b, -c, 0.5 - b.trunc()];
+            let got = floor_int(F::new(v)).to_array();
             for (g, x) in got.iter().zip(v) {
                 prop_assert_eq!(*g as f32, x.floor(), "{}", x);
             }
@@ -193,7 +205,7 @@ mod tests {
 
         #[test]
         fn the_lane_exp_is_within_a_few_ulps(x in -87.0f32..88.0) {
-            let got = exp4(f32x4::splat(x)).to_array()[0];
+            let got = exp_lanes(F::splat(x)).to_array()[0];
             let want = f64::from(x).exp();
             let rel = ((f64::from(got) - want) / want).abs();
             prop_assert!(rel < 4.0e-7, "exp({}) = {} against {} ({:e})", x, got, want, rel);
@@ -202,7 +214,7 @@ mod tests {
 
     #[test]
     fn exp_saturates_instead_of_overflowing() {
-        let got = exp4(f32x4::new([-1.0e4, -87.3, 0.0, 1.0e4])).to_array();
+        let got = exp_lanes(F::new([-1.0e4, -87.3, 0.0, 1.0e4, -1.0e4, -87.3, 0.0, 1.0e4])).to_array();
         assert!(got[0] >= 0.0 && got[0] < 1.0e-37);
         assert_eq!(got[2], 1.0);
         assert!(got[3].is_finite() && got[3] > 1.0e38);
@@ -215,16 +227,21 @@ mod tests {
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(3.0, 4.0, 12.0),
             Vec3::new(-1.0e-3, 2.0e-3, 0.0),
+            Vec3::new(f32::NAN, 1.0, 0.0),
+            Vec3::new(f32::INFINITY, 0.0, 0.0),
+            Vec3::new(0.1, 0.2, 0.3),
+            Vec3::new(-5.0, 7.0, -9.0),
         ];
         let b = Vec3::new(0.3, -0.7, 0.2);
         let v = V3::from_lanes(a);
         let n = v.normalize_or_zero().lanes();
         let d = v.dot_v(b).to_array();
-        let l = V3::lerp(b, a[2], f32x4::new([0.0, 0.25, 0.5, 1.0])).lanes();
-        for i in 0..4 {
-            assert_eq!(n[i], a[i].normalize_or_zero());
-            assert_eq!(d[i], a[i].dot(b));
-            assert_eq!(l[i], b.lerp(a[2], [0.0, 0.25, 0.5, 1.0][i]));
+        let s = [0.0, 0.25, 0.5, 1.0, 0.1, 0.7, 0.9, 0.33];
+        let l = V3::lerp(b, a[2], F::new(s)).lanes();
+        for i in 0..LANES {
+            assert_eq!(n[i], a[i].normalize_or_zero(), "{i}");
+            assert_eq!(d[i].to_bits(), a[i].dot(b).to_bits(), "{i}");
+            assert_eq!(l[i], b.lerp(a[2], s[i]));
         }
     }
 }

@@ -5,9 +5,8 @@
 
 use glam::Vec3;
 use std::ops::Add;
-use wide::f32x4;
 
-use super::lanes::{V3, floor_i32x4};
+use super::lanes::{F, I, V3, floor_int};
 use crate::dsl::types::WeatherParams;
 
 /// The lighting of a clip.
@@ -99,27 +98,25 @@ impl Lighting {
         }
     }
 
-    /// The sky's colour in four view directions (unit, world frame), the sun's disc included.
+    /// The sky's colour in the lanes' view directions (unit, world frame), the sun's disc included.
     #[inline(always)]
-    pub fn sky4(&self, dir: V3) -> V3 {
-        let up = dir.z.max(f32x4::ZERO);
+    pub fn sky(&self, dir: V3) -> V3 {
+        let up = dir.z.max(F::ZERO);
         let mut c = V3::lerp(self.horizon, self.zenith, horizon_to_zenith(up));
         let cos_sun = dir.dot_v(self.sun_dir);
-        let glowing = cos_sun.simd_gt(f32x4::splat(0.9));
+        let glowing = cos_sun.simd_gt(F::splat(0.9));
         if glowing.any() {
-            let g = ((cos_sun - 0.9) / 0.1).max(f32x4::ZERO);
+            let g = ((cos_sun - 0.9) / 0.1).max(F::ZERO);
             let g2 = g * g;
             let g4 = g2 * g2;
-            let disc = cos_sun
-                .simd_gt(f32x4::splat(0.9996))
-                .select(f32x4::splat(4.0), f32x4::ZERO);
-            let k = glowing.select(f32x4::splat(0.4) * g4 * g4 + disc, f32x4::ZERO);
+            let disc = cos_sun.simd_gt(F::splat(0.9996)).select(F::splat(4.0), F::ZERO);
+            let k = glowing.select(F::splat(0.4) * g4 * g4 + disc, F::ZERO);
             c = c.add(V3::splat(self.sun).scale(k));
         }
-        let below = dir.z.simd_lt(f32x4::ZERO);
+        let below = dir.z.simd_lt(F::ZERO);
         if below.any() {
-            let s = below.select((-dir.z * 4.0).min(f32x4::ONE), f32x4::ZERO);
-            c = c.scale(f32x4::ONE - s).add(V3::splat(self.ground_ambient).scale(s));
+            let s = below.select((-dir.z * 4.0).min(F::ONE), F::ZERO);
+            c = c.scale(F::ONE - s).add(V3::splat(self.ground_ambient).scale(s));
         }
         c
     }
@@ -136,23 +133,14 @@ static HORIZON_TO_ZENITH: std::sync::LazyLock<[f32; GRADIENT_STEPS + 2]> = std::
 
 /// `up^0.6` for `up` in [0, 1], from [`HORIZON_TO_ZENITH`].
 #[inline(always)]
-fn horizon_to_zenith(up: f32x4) -> f32x4 {
+fn horizon_to_zenith(up: F) -> F {
     let table = &*HORIZON_TO_ZENITH;
-    let s = up.min(f32x4::ONE).sqrt() * GRADIENT_STEPS as f32;
-    let i = floor_i32x4(s)
-        .max(wide::i32x4::ZERO)
-        .min(wide::i32x4::splat(GRADIENT_STEPS as i32));
+    let s = up.min(F::ONE).sqrt() * GRADIENT_STEPS as f32;
+    let i = floor_int(s).max(I::ZERO).min(I::splat(GRADIENT_STEPS as i32));
     let f = s - i.round_float();
     let ia = i.to_array();
-    let at = |j: usize| {
-        [
-            table[ia[0] as usize + j],
-            table[ia[1] as usize + j],
-            table[ia[2] as usize + j],
-            table[ia[3] as usize + j],
-        ]
-    };
-    let (a, b) = (f32x4::new(at(0)), f32x4::new(at(1)));
+    let at = |j: usize| F::new(ia.map(|i| table[i as usize + j]));
+    let (a, b) = (at(0), at(1));
     a + (b - a) * f
 }
 
@@ -174,7 +162,7 @@ mod tests {
     fn the_gradient_table_follows_the_power_law() {
         for k in 0..=2000 {
             let up = k as f32 / 2000.0;
-            let got = horizon_to_zenith(f32x4::splat(up)).to_array()[0];
+            let got = horizon_to_zenith(F::splat(up)).to_array()[0];
             assert!(
                 (got - up.powf(0.6)).abs() < 1.0e-3,
                 "{up}: {got} against {}",

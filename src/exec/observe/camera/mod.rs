@@ -2,7 +2,7 @@
 //! rasterisation of the scene, and DVS events from the rendered luminance.
 //!
 //! - [`raster`] — the visibility buffers (nearest primitive and depth per sample).
-//! - [`lanes`] — four-lane math for shading four pixels at once.
+//! - [`lanes`] — lane math for shading several pixels at once.
 //! - [`light`] — lighting from the weather.
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
 //! - [`dvs`] — the ESIM event simulator.
@@ -30,7 +30,7 @@ use std::sync::Mutex;
 use super::rig::{Camera, CameraPose};
 use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
 use crate::mix::splitmix64;
-use lanes::{V3, floor_i32x4};
+use lanes::{F, LANES, V3, floor_int, lanes_from};
 use light::Lighting;
 use raster::{BandVisibility, EDGE, EMPTY, Raster, Setup, clip_near};
 use shade::{ActiveLights, Noise, ShadeContext};
@@ -94,7 +94,8 @@ struct BandScratch {
     order: Vec<u64>,
     edge_colour: Vec<Vec3>,
     edge_tag: Vec<u8>,
-    /// The row's linear colours, one channel each (three lanes of slack for four-lane stores).
+    /// The row's linear colours, one channel each (`LANES − 1` of slack for whole-vector stores; the tone map
+    /// reads groups of four).
     rgb: [Vec<f32>; 3],
 }
 
@@ -107,7 +108,11 @@ impl BandScratch {
             order: Vec::new(),
             edge_colour: Vec::new(),
             edge_tag: Vec::new(),
-            rgb: [vec![0.0; w + 3], vec![0.0; w + 3], vec![0.0; w + 3]],
+            rgb: [
+                vec![0.0; w + LANES - 1],
+                vec![0.0; w + LANES - 1],
+                vec![0.0; w + LANES - 1],
+            ],
         }
     }
 }
@@ -145,22 +150,22 @@ impl SunView {
         self.project_f32(p).as_dvec3()
     }
 
-    /// The sun's visibility at four scene points of a surface (1 lit, 0 in shadow) from the shadow map's
+    /// The sun's visibility at the lanes' scene points of a surface (1 lit, 0 in shadow) from the shadow map's
     /// depth keys, 2×2 percentage-closer filtered: the points are lifted off the surface by 5 cm and
     /// compared with a bias of 8 cm; texel centres at integers, bilinear between.
     #[inline(always)]
-    fn sunlit4(&self, key: &[f32], p: V3, normal: Vec3) -> f32x4 {
+    fn sunlit(&self, key: &[f32], p: V3, normal: Vec3) -> F {
         let d = p + V3::splat(normal * 0.05) - V3::splat(self.centre);
         let half = SHADOW_PX as f32 * 0.5;
         let x = d.dot_v(self.u) * self.scale + half - 0.5;
         let y = d.dot_v(self.v) * self.scale + half - 0.5;
         let depth = (d.dot_v(self.dir) + 0.08).to_array();
-        let (x0, y0) = (floor_i32x4(x), floor_i32x4(y));
+        let (x0, y0) = (floor_int(x), floor_int(y));
         let (fx, fy) = (x - x0.round_float(), y - y0.round_float());
         let (xa, ya) = (x0.to_array(), y0.to_array());
         let last = (SHADOW_PX - 1) as i32;
-        let mut c = [[1.0f32; 4]; 4];
-        for i in 0..4 {
+        let mut c = [[1.0f32; LANES]; 4];
+        for i in 0..LANES {
             if xa[i] < 0 || ya[i] < 0 || xa[i] >= last || ya[i] >= last {
                 continue;
             }
@@ -175,7 +180,7 @@ impl SunView {
             c[2][i] = lit(q[SHADOW_PX]);
             c[3][i] = lit(q[SHADOW_PX + 1]);
         }
-        let [l00, l10, l01, l11] = c.map(f32x4::new);
+        let [l00, l10, l01, l11] = c.map(F::new);
         let a = l00 + (l10 - l00) * fx;
         let b = l01 + (l11 - l01) * fx;
         a + (b - a) * fy
@@ -489,7 +494,7 @@ impl Renderer {
             rgb,
         } = taken.get_or_insert_with(|| BandScratch::new(w));
         vis.draw(&self.tris, &self.bins[y0 / BAND_ROWS], y0, h, c.height_px as usize);
-        // The edge pixels' samples, listed and shaded up to four of one primitive at a time (over the band, so
+        // The edge pixels' samples, listed and shaded up to `LANES` of one primitive at a time (over the band, so
         // that the lanes fill).
         edges.clear();
         for row in 0..h {
@@ -521,11 +526,10 @@ impl Renderer {
         edge_colour.resize(edges.len(), Vec3::ZERO);
         edge_tag.resize(edges.len(), 0);
         for group in order.chunk_by(|a, b| a >> 32 == b >> 32) {
-            for chunk in group.chunks(4) {
+            for chunk in group.chunks(LANES) {
                 let at = |i: usize| &edges[(chunk[i.min(chunk.len() - 1)] & 0xffff_ffff) as usize];
-                let lane = |f: fn(&Sample) -> f32| f32x4::new(std::array::from_fn(|i| f(at(i))));
-                let (colour, tags) =
-                    self.shade4(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
+                let lane = |f: fn(&Sample) -> f32| lanes_from(|i| f(at(i)));
+                let (colour, tags) = self.shade(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
                 for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
                     edge_colour[(o & 0xffff_ffff) as usize] = c;
                     edge_tag[(o & 0xffff_ffff) as usize] = t;
@@ -536,7 +540,7 @@ impl Renderer {
         let mut e = 0;
         for row in 0..h {
             let y = y0 + row;
-            let v_centre = f32x4::splat(y as f32 + 0.5);
+            let v_centre = F::splat(y as f32 + 0.5);
             let labels = row * w..(row + 1) * w;
             let (grid_prim, grid_key) = (&vis.grid.prim[labels.clone()], &vis.grid.key[labels.clone()]);
             // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
@@ -550,7 +554,7 @@ impl Renderer {
             }
             let row_prim = &vis.prim[labels.clone()];
             let row_key = &vis.key[labels.clone()];
-            // Pixels whose samples see one primitive: shaded at their centres, up to four neighbours of one
+            // Pixels whose samples see one primitive: shaded at their centres, up to `LANES` neighbours of one
             // primitive at a time.
             let semantic = &mut out.semantic[labels];
             let mut x = 0;
@@ -561,19 +565,19 @@ impl Renderer {
                     continue;
                 }
                 let mut end = x + 1;
-                while end < w && end - x < 4 && row_prim[end] == prim {
+                while end < w && end - x < LANES && row_prim[end] == prim {
                     end += 1;
                 }
                 let n = end - x;
-                let key = f32x4::new(std::array::from_fn(|i| row_key[x + i.min(n - 1)]));
-                let u = f32x4::splat(x as f32 + 0.5) + f32x4::new([0.0, 1.0, 2.0, 3.0]);
-                let (colour, tags) = self.shade4(&ctx, &view, prim, key, u, v_centre);
-                // All four lanes are stored: those past `n` are overwritten by the pixels they fall on.
+                let key = lanes_from(|i| row_key[x + i.min(n - 1)]);
+                let u = F::splat(x as f32 + 0.5) + lanes_from(|i| i as f32);
+                let (colour, tags) = self.shade(&ctx, &view, prim, key, u, v_centre);
+                // All lanes are stored: those past `n` are overwritten by the pixels they fall on.
                 for (channel, lanes) in rgb.iter_mut().zip([colour.x, colour.y, colour.z]) {
-                    channel[x..x + 4].copy_from_slice(&lanes.to_array());
+                    channel[x..x + LANES].copy_from_slice(&lanes.to_array());
                 }
-                match semantic.get_mut(x..x + 4) {
-                    Some(four) => four.copy_from_slice(&tags),
+                match semantic.get_mut(x..x + LANES) {
+                    Some(all) => all.copy_from_slice(&tags),
                     None => semantic[x..end].copy_from_slice(&tags[..n]),
                 }
                 x = end;
@@ -595,20 +599,20 @@ impl Renderer {
         }
     }
 
-    /// The fogged colours and the semantic tags of four samples of one primitive (or of the sky) at pixel
+    /// The fogged colours and the semantic tags of `LANES` samples of one primitive (or of the sky) at pixel
     /// coordinates `(u, v)` with depth keys `key`.
     #[inline(always)]
-    fn shade4(&self, ctx: &ShadeContext, view: &View, prim: u32, key: f32x4, u: f32x4, v: f32x4) -> (V3, [u8; 4]) {
+    fn shade(&self, ctx: &ShadeContext, view: &View, prim: u32, key: F, u: F, v: F) -> (V3, [u8; LANES]) {
         let su = (u - view.cx) * view.inv_f;
         let sv = (v - view.cy) * view.inv_f;
         let ray = V3::splat(view.fwd) + V3::splat(view.right).scale(su) + V3::splat(view.down).scale(sv);
         if prim == EMPTY {
-            let dir = ray.scale(f32x4::ONE / ray.length_squared().sqrt());
-            let sky = self.light.sky4(dir);
-            return (shade::fog4(&self.light, sky, f32x4::splat(1.0e4)), [tag::SKY; 4]);
+            let dir = ray.scale(F::ONE / ray.length_squared().sqrt());
+            let sky = self.light.sky(dir);
+            return (shade::fog(&self.light, sky, F::splat(1.0e4)), [tag::SKY; LANES]);
         }
         let prim: &Prim = ctx.frame.prim(ctx.scene, prim);
-        let z = f32x4::ONE / key;
+        let z = F::ONE / key;
         let p = V3::splat(view.cam) + ray.scale(z);
         let ray_len = ray.length_squared().sqrt();
         // A flat surface turned away from the sun gets none of it whether in shadow or not (bodies shade
@@ -616,8 +620,8 @@ impl Renderer {
         let away =
             prim.normal.dot(self.light.sun_dir) <= 0.0 && !matches!(prim.material, Material::Body | Material::Head);
         let shadow = match &self.sun {
-            Some(sun) if !away => sun.sunlit4(&self.shadow.key, p, prim.normal),
-            _ => f32x4::ONE,
+            Some(sun) if !away => sun.sunlit(&self.shadow.key, p, prim.normal),
+            _ => F::ONE,
         };
         let pts = shade::Points {
             p,
@@ -625,8 +629,8 @@ impl Renderer {
             ray_len,
             shadow,
         };
-        let (colour, semantic) = shade::surface4(ctx, prim, &pts);
-        (shade::fog4(&self.light, colour, ray_len * z), semantic)
+        let (colour, semantic) = shade::surface(ctx, prim, &pts);
+        (shade::fog(&self.light, colour, ray_len * z), semantic)
     }
 
     /// Rain: thin, slanted, semi-transparent streaks at seeded places, brighter against dark backgrounds.

@@ -5,9 +5,8 @@
 
 use glam::{Vec2, Vec3};
 use std::ops::{Add, Mul, Sub};
-use wide::f32x4;
 
-use super::lanes::{V3, exp4, floor_i32x4};
+use super::lanes::{F, LANES, V3, exp_lanes, floor_int, lanes_from};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use crate::exec::observe::scene::{
     FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, road_paint_near, tag,
@@ -94,13 +93,14 @@ impl Noise {
         a + (b - a) * ty
     }
 
-    /// [`Noise::sample`] at four places `(qx, qy)`, lane by lane the same values.
+    /// [`Noise::sample`] at the lanes' places `(qx, qy)`, lane by lane the same values.
     #[inline(always)]
-    pub fn sample4(&self, qx: f32x4, qy: f32x4) -> f32x4 {
-        let (ix, iy) = (floor_i32x4(qx), floor_i32x4(qy));
+    pub fn sample_lanes(&self, qx: F, qy: F) -> F {
+        let (ix, iy) = (floor_int(qx), floor_int(qy));
         let (tx, ty) = (qx - ix.round_float(), qy - iy.round_float());
         let (xa, ya) = (ix.to_array(), iy.to_array());
-        let [v00, v10, v01, v11] = f32x4::transpose(std::array::from_fn(|i| f32x4::new(self.corners(xa[i], ya[i]))));
+        let c: [[f32; 4]; LANES] = std::array::from_fn(|i| self.corners(xa[i], ya[i]));
+        let [v00, v10, v01, v11] = [0, 1, 2, 3].map(|k| lanes_from(|i| c[i][k]));
         let a = v00 + (v10 - v00) * tx;
         let b = v01 + (v11 - v01) * tx;
         a + (b - a) * ty
@@ -137,7 +137,7 @@ pub struct ShadeContext<'a> {
     pub lights: &'a ActiveLights,
 }
 
-/// Four surface points of one primitive, as the camera sees them.
+/// Surface points of one primitive (one per lane), as the camera sees them.
 #[derive(Clone, Copy, Debug)]
 pub struct Points {
     /// The points, scene-relative.
@@ -145,40 +145,40 @@ pub struct Points {
     /// The camera's rays to them (not unit: `forward + right·x + down·y`).
     pub ray: V3,
     /// The rays' lengths.
-    pub ray_len: f32x4,
+    pub ray_len: F,
     /// The sun's visibility at each (0–1).
-    pub shadow: f32x4,
+    pub shadow: F,
 }
 
 /// A noise value per lane, scaled: `1 + amp × noise(q)`.
 #[inline(always)]
-fn grain(nz: &Noise, qx: f32x4, qy: f32x4, amp: f32) -> f32x4 {
-    f32x4::ONE + f32x4::splat(amp) * nz.sample4(qx, qy)
+fn grain(nz: &Noise, qx: F, qy: F, amp: f32) -> F {
+    F::ONE + F::splat(amp) * nz.sample_lanes(qx, qy)
 }
 
-/// The shaded colours of four points of one primitive, before fog, and their semantic tags (road paint
+/// The shaded colours of the lanes' points of one primitive, before fog, and their semantic tags (road paint
 /// turns road into road line): textures, then the light each point receives (sun with shadows, sky and
 /// ground ambient, street lamps, headlights) and reflections where the surface is glossy.
 #[inline(always)]
-pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) {
+pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES]) {
     let l = ctx.light;
     let nz = ctx.noise;
     let p = pts.p;
     let (x, y, z) = (p.x, p.y, p.z);
-    let one = f32x4::ONE;
+    let one = F::ONE;
     let mut normal = V3::splat(prim.normal);
     let mut albedo = V3::splat(prim.albedo);
     let mut emissive = V3::ZERO;
     // Mirror-like reflection share (wet ground, glass, paint).
-    let mut gloss = f32x4::ZERO;
+    let mut gloss = F::ZERO;
     let mut ground = false;
-    let mut semantic = [prim.tag; 4];
+    let mut semantic = [prim.tag; LANES];
     match prim.material {
         Material::Road => {
             ground = true;
-            let g = f32x4::ONE
-                + f32x4::splat(0.16) * nz.sample4(x * 1.3, y * 1.3)
-                + f32x4::splat(0.08) * nz.sample4(x * 6.1 + 37.0, y * 6.1 + 37.0);
+            let g = F::ONE
+                + F::splat(0.16) * nz.sample_lanes(x * 1.3, y * 1.3)
+                + F::splat(0.08) * nz.sample_lanes(x * 6.1 + 37.0, y * 6.1 + 37.0);
             albedo = albedo.scale(g);
             if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
                 && road_paint_near(
@@ -190,7 +190,7 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
             {
                 let (xs, ys) = (x.to_array(), y.to_array());
                 let mut painted = None;
-                for i in 0..4 {
+                for i in 0..LANES {
                     let xy = Vec2::new(xs[i], ys[i]);
                     if let Some((paint, paint_tag)) = road_paint(ctx.scene, piece, xy) {
                         let lanes = painted.get_or_insert_with(|| albedo.lanes());
@@ -209,13 +209,13 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
             ground = true;
             if prim.tag == tag::SIDEWALK {
                 let (gx, gy) = (x / 0.6, y / 0.6);
-                let (ix, iy) = (floor_i32x4(gx), floor_i32x4(gy));
+                let (ix, iy) = (floor_int(gx), floor_int(gy));
                 let (fx, fy) = (gx - ix.round_float(), gy - iy.round_float());
-                let joint = fx.simd_lt(f32x4::splat(0.05)) | fy.simd_lt(f32x4::splat(0.05));
+                let joint = fx.simd_lt(F::splat(0.05)) | fy.simd_lt(F::splat(0.05));
                 let (ixs, iys) = (ix.to_array(), iy.to_array());
-                let cell = f32x4::new(std::array::from_fn(|i| nz.cell(ixs[i], iys[i], 7)));
-                let tile = f32x4::splat(0.88) + f32x4::splat(0.2) * cell;
-                albedo = albedo.scale(joint.select(f32x4::splat(0.62), tile));
+                let cell = lanes_from(|i| nz.cell(ixs[i], iys[i], 7));
+                let tile = F::splat(0.88) + F::splat(0.2) * cell;
+                albedo = albedo.scale(joint.select(F::splat(0.62), tile));
             }
             albedo = albedo.scale(grain(nz, x * 3.7, y * 3.7, 0.08));
         }
@@ -225,10 +225,8 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
         }
         Material::Terrain => {
             ground = true;
-            let patch = nz.sample4(x * 0.21, y * 0.21);
-            let s = (f32x4::splat(0.5) + f32x4::splat(0.6) * patch)
-                .max(f32x4::ZERO)
-                .min(one);
+            let patch = nz.sample_lanes(x * 0.21, y * 0.21);
+            let s = (F::splat(0.5) + F::splat(0.6) * patch).max(F::ZERO).min(one);
             albedo = V3::lerp(prim.albedo, Vec3::new(0.11, 0.09, 0.05), s);
             albedo = albedo.scale(grain(nz, x * 2.9, y * 2.9, 0.2));
         }
@@ -236,27 +234,27 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
             let n = prim.normal;
             let a = (x * -n.y + y * n.x) / 2.8;
             let zz = z / 3.2;
-            let (cell_a, cell_z) = (floor_i32x4(a), floor_i32x4(zz));
+            let (cell_a, cell_z) = (floor_int(a), floor_int(zz));
             let (fa, fz) = (a - cell_a.round_float(), zz - cell_z.round_float());
-            let window = fa.simd_gt(f32x4::splat(0.22))
-                & fa.simd_lt(f32x4::splat(0.78))
-                & fz.simd_gt(f32x4::splat(0.3))
-                & fz.simd_lt(f32x4::splat(0.82))
-                & z.simd_gt(f32x4::splat(1.2));
+            let window = fa.simd_gt(F::splat(0.22))
+                & fa.simd_lt(F::splat(0.78))
+                & fz.simd_gt(F::splat(0.3))
+                & fz.simd_lt(F::splat(0.82))
+                & z.simd_gt(F::splat(1.2));
             let plain = albedo.scale(grain(nz, a * 4.0, z * 2.0, 0.07));
-            let floor_line = fz.simd_lt(f32x4::splat(0.04));
-            let wall = V3::select(floor_line, albedo.scale(f32x4::splat(0.7)), plain);
+            let floor_line = fz.simd_lt(F::splat(0.04));
+            let wall = V3::select(floor_line, albedo.scale(F::splat(0.7)), plain);
             albedo = V3::select(window, V3::splat(Vec3::new(0.03, 0.035, 0.045)), wall);
-            gloss = window.select(f32x4::splat(0.35), f32x4::ZERO);
+            gloss = window.select(F::splat(0.35), F::ZERO);
             if window.any() && l.night > 0.0 {
                 let (ca, cz, win) = (cell_a.to_array(), cell_z.to_array(), window.to_bitmask());
-                let lit = f32x4::new(std::array::from_fn(|i| {
+                let lit = lanes_from(|i| {
                     if win & (1 << i) != 0 && nz.cell(ca[i], cz[i], prim.aux) < 0.22 {
                         1.0
                     } else {
                         0.0
                     }
-                }));
+                });
                 emissive = V3::splat(Vec3::new(0.9, 0.7, 0.42) * (0.35 * l.night)).scale(lit);
             }
         }
@@ -264,20 +262,20 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
         Material::LampHead => emissive = V3::splat(Vec3::new(3.0, 2.5, 1.8) * l.night),
         Material::Trunk => albedo = albedo.scale(grain(nz, x * 9.0, z * 3.0, 0.2)),
         Material::Foliage => {
-            let f = f32x4::splat(0.8) + f32x4::splat(0.45) * nz.sample4(x * 2.2 + z, y * 2.2 - z);
+            let f = F::splat(0.8) + F::splat(0.45) * nz.sample_lanes(x * 2.2 + z, y * 2.2 - z);
             albedo = albedo.scale(f);
         }
-        Material::CarPaint => gloss = f32x4::splat(0.18),
-        Material::CarGlass => gloss = f32x4::splat(0.12),
+        Material::CarPaint => gloss = F::splat(0.18),
+        Material::CarGlass => gloss = F::splat(0.12),
         Material::HeadLamp => emissive = V3::splat(Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night)),
         Material::TailLamp => emissive = V3::splat(Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night)),
         Material::Beacon => emissive = V3::splat(prim.albedo * (1.5 + 2.0 * l.night)),
         Material::Body | Material::Head => {
             if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
-                normal = capsule_normal4(c, p);
+                normal = capsule_normals(c, p);
             }
             if prim.material == Material::Head {
-                let hair = normal.z.simd_gt(f32x4::splat(0.25)) | normal.dot_v(prim.normal).simd_lt(f32x4::splat(-0.3));
+                let hair = normal.z.simd_gt(F::splat(0.25)) | normal.dot_v(prim.normal).simd_lt(F::splat(-0.3));
                 albedo = V3::select(hair, V3::splat(prim.albedo2), albedo);
             }
             albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06));
@@ -285,12 +283,12 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
     }
     if ground && l.wet > 0.0 {
         // Darker when wet, and puddles (a low-frequency noise mask) that mirror the sky and the lights.
-        let mask = (nz.sample4(x * 0.35, y * 0.35) - 0.15) * 4.0;
-        let puddle = mask.max(f32x4::ZERO).min(one) * l.wet;
-        albedo = albedo.scale(f32x4::splat(1.0 - 0.4 * l.wet) - f32x4::splat(0.2) * puddle);
-        gloss = gloss.max(f32x4::splat(l.wet * 0.25) + f32x4::splat(0.6) * puddle);
+        let mask = (nz.sample_lanes(x * 0.35, y * 0.35) - 0.15) * 4.0;
+        let puddle = mask.max(F::ZERO).min(one) * l.wet;
+        albedo = albedo.scale(F::splat(1.0 - 0.4 * l.wet) - F::splat(0.2) * puddle);
+        gloss = gloss.max(F::splat(l.wet * 0.25) + F::splat(0.6) * puddle);
     }
-    let glossy = gloss.simd_gt(f32x4::ZERO).any();
+    let glossy = gloss.simd_gt(F::ZERO).any();
 
     // The unit vectors from the points to the camera, for reflections (glossy surfaces only).
     let view = if glossy {
@@ -300,31 +298,31 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
     };
 
     // Light received.
-    let ndl = normal.dot_v(l.sun_dir).max(f32x4::ZERO);
-    let up = f32x4::splat(0.5) + f32x4::splat(0.5) * normal.z;
+    let ndl = normal.dot_v(l.sun_dir).max(F::ZERO);
+    let up = F::splat(0.5) + F::splat(0.5) * normal.z;
     let mut light = V3::lerp(l.ground_ambient, l.sky_ambient, up).add(V3::splat(l.sun).scale(ndl * pts.shadow));
     let mut glints = V3::ZERO;
     if l.night > 0.0 {
         for &lamp in &ctx.lights.lamps {
             let d = V3::splat(lamp).sub(p);
             let d2 = d.length_squared();
-            let near = d2.simd_le(f32x4::splat(1600.0));
+            let near = d2.simd_le(F::splat(1600.0));
             if !near.any() {
                 continue;
             }
             let inv = one / d2.sqrt();
             let dir = d.scale(inv);
-            let fall = f32x4::splat(LAMP_INTENSITY * l.night) / (d2 + 1.0);
+            let fall = F::splat(LAMP_INTENSITY * l.night) / (d2 + 1.0);
             // The lamp shines downwards: light falls off away from below it.
-            let k = fall * normal.dot(dir).max(f32x4::ZERO) * dir.z.max(f32x4::ZERO);
-            light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, f32x4::ZERO)));
+            let k = fall * normal.dot(dir).max(F::ZERO) * dir.z.max(F::ZERO);
+            light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, F::ZERO)));
             if glossy {
                 let h = dir.add(view).normalize_or_zero();
-                let s = normal.dot(h).max(f32x4::ZERO);
+                let s = normal.dot(h).max(F::ZERO);
                 let s2 = s * s;
                 let s8 = s2 * s2 * s2 * s2;
                 let g = fall * 6.0 * gloss * s8 * s8 * s8 * s8;
-                glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, f32x4::ZERO)));
+                glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, F::ZERO)));
             }
         }
         for &(pos, axis) in &ctx.lights.heads {
@@ -332,77 +330,69 @@ pub fn surface4(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; 4]) 
             let d2 = d.length_squared();
             // A low beam: wide sideways, cut off just above the lamp's horizontal.
             let ahead = d.x * axis.x + d.y * axis.y;
-            let mut on =
-                d2.simd_ge(f32x4::splat(1e-4)) & d2.simd_le(f32x4::splat(3600.0)) & ahead.simd_gt(f32x4::splat(0.1));
+            let mut on = d2.simd_ge(F::splat(1e-4)) & d2.simd_le(F::splat(3600.0)) & ahead.simd_gt(F::splat(0.1));
             if !on.any() {
                 continue;
             }
             let side = ((d.x * axis.y - d.y * axis.x) / ahead / 0.7).abs();
             let up = d.z / ahead;
-            let cut = ((f32x4::splat(0.02) - up) / 0.04).max(f32x4::ZERO).min(one);
-            let beam = (one - side * side).max(f32x4::ZERO) * cut;
-            on &= beam.simd_gt(f32x4::ZERO);
+            let cut = ((F::splat(0.02) - up) / 0.04).max(F::ZERO).min(one);
+            let beam = (one - side * side).max(F::ZERO) * cut;
+            on &= beam.simd_gt(F::ZERO);
             if !on.any() {
                 continue;
             }
             let dir = d.scale(one / d2.sqrt());
-            let fall = f32x4::splat(HEADLAMP_INTENSITY * l.night) * beam / (d2 + 30.0);
-            let k = fall * (-normal.dot(dir)).max(f32x4::ZERO);
-            light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, f32x4::ZERO)));
+            let fall = F::splat(HEADLAMP_INTENSITY * l.night) * beam / (d2 + 30.0);
+            let k = fall * (-normal.dot(dir)).max(F::ZERO);
+            light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, F::ZERO)));
         }
     }
     let mut colour = albedo.mul(light).add(emissive).add(glints);
     if glossy {
-        let r = normal.scale(f32x4::splat(2.0) * view.dot(normal)).sub(view);
+        let r = normal.scale(F::splat(2.0) * view.dot(normal)).sub(view);
         let r = V3 { z: r.z.abs(), ..r };
-        let cos = normal.dot(view).max(f32x4::ZERO);
+        let cos = normal.dot(view).max(F::ZERO);
         let c5 = {
             let m = one - cos;
             let m2 = m * m;
             m2 * m2 * m
         };
-        let fresnel = f32x4::splat(0.04) + f32x4::splat(0.96) * c5;
-        colour = colour.add(
-            l.sky4(r)
-                .scale(gloss * (f32x4::splat(0.08) + f32x4::splat(0.92) * fresnel)),
-        );
+        let fresnel = F::splat(0.04) + F::splat(0.96) * c5;
+        colour = colour.add(l.sky(r).scale(gloss * (F::splat(0.08) + F::splat(0.92) * fresnel)));
     }
     (colour, semantic)
 }
 
-/// The least of four lanes.
+/// The least of the lanes.
 #[inline(always)]
-fn lane_min(v: f32x4) -> f32 {
-    let a = v.to_array();
-    a[0].min(a[1]).min(a[2].min(a[3]))
+fn lane_min(v: F) -> f32 {
+    v.to_array().into_iter().fold(f32::INFINITY, f32::min)
 }
 
-/// The greatest of four lanes.
+/// The greatest of the lanes.
 #[inline(always)]
-fn lane_max(v: f32x4) -> f32 {
-    let a = v.to_array();
-    a[0].max(a[1]).max(a[2].max(a[3]))
+fn lane_max(v: F) -> f32 {
+    v.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max)
 }
 
-/// The outward unit normals of a body capsule at four surface points (`+z` where a point is on the axis).
+/// The outward unit normals of a body capsule at the lanes' surface points (`+z` where a point is on the axis).
 #[inline(always)]
-fn capsule_normal4(c: &SceneCapsule, p: V3) -> V3 {
+fn capsule_normals(c: &SceneCapsule, p: V3) -> V3 {
     let d = c.b - c.a;
     let rel = p.sub(V3::splat(c.a));
-    let t = (rel.dot_v(d) / d.length_squared().max(1e-12))
-        .max(f32x4::ZERO)
-        .min(f32x4::ONE);
+    let t = (rel.dot_v(d) / d.length_squared().max(1e-12)).max(F::ZERO).min(F::ONE);
     let off = rel.sub(V3::splat(d).scale(t));
     let len2 = off.length_squared();
-    let ok = len2.simd_gt(f32x4::ZERO) & len2.is_finite();
-    V3::select(ok, off.scale(f32x4::ONE / len2.sqrt()), V3::splat(Vec3::Z))
+    let ok = len2.simd_gt(F::ZERO) & len2.is_finite();
+    V3::select(ok, off.scale(F::ONE / len2.sqrt()), V3::splat(Vec3::Z))
 }
 
-/// Applies fog over four distances.
+/// Applies fog over the lanes' distances.
 #[inline(always)]
-pub fn fog4(light: &Lighting, colour: V3, dist_m: f32x4) -> V3 {
-    let f = exp4(f32x4::splat(-light.fog_per_m) * dist_m);
-    colour.scale(f).add(V3::splat(light.fog).scale(f32x4::ONE - f))
+pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
+    let f = exp_lanes(F::splat(-light.fog_per_m) * dist_m);
+    colour.scale(f).add(V3::splat(light.fog).scale(F::ONE - f))
 }
 
 #[cfg(test)]
@@ -424,10 +414,10 @@ mod tests {
 
     proptest! {
         #[test]
-        fn four_noise_samples_equal_four_single_ones(x in proptest::array::uniform4(-3.0e3f32..3.0e3), y in proptest::array::uniform4(-3.0e3f32..3.0e3)) {
+        fn lane_noise_samples_equal_single_ones(x in proptest::array::uniform8(-3.0e3f32..3.0e3), y in proptest::array::uniform8(-3.0e3f32..3.0e3)) {
             let nz = Noise::new(17);
-            let got = nz.sample4(f32x4::new(x), f32x4::new(y)).to_array();
-            for i in 0..4 {
+            let got = nz.sample_lanes(F::new(x), F::new(y)).to_array();
+            for i in 0..LANES {
                 prop_assert_eq!(got[i], nz.sample(Vec2::new(x[i], y[i])));
             }
         }
