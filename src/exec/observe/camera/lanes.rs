@@ -1,8 +1,8 @@
 //! Lane math for shading [`LANES`] pixels (or samples) at once: a vector of points ([`V3`]), floors without
-//! libm, an exponential. Built on `wide::f32x8` (two SSE2 registers on every x86-64 CPU, one AVX register
-//! where the build enables AVX, e.g. `-C target-cpu=x86-64-v3`); every operation is plain IEEE single precision without fused multiply-adds, so the
-//! same inputs give the same bits on every machine the binary runs on, and each lane equals the scalar
-//! formula it replaces (tests below).
+//! libm, an exponential. Built on `wide::f32x8`: one AVX register in the x86-64 build (`.cargo/config.toml`
+//! enables AVX2), two SSE2 registers in a build for any x86-64 CPU. Every operation is plain IEEE single
+//! precision without fused multiply-adds, so the same inputs give the same bits on every machine and in both
+//! builds, and each lane equals the scalar formula it replaces (tests below).
 
 use glam::Vec3;
 
@@ -19,7 +19,7 @@ pub fn lanes_from(f: impl FnMut(usize) -> f32) -> F {
     F::new(std::array::from_fn(f))
 }
 
-/// Four points or vectors, one per lane.
+/// Points or vectors, one per lane.
 #[derive(Clone, Copy, Debug)]
 pub struct V3 {
     /// x of the lanes.
