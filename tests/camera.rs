@@ -1025,11 +1025,11 @@ fn cyclists_are_drawn_in_their_boxes_as_rider_and_bicycle() {
 /// A lane's shading does not depend on the other points in its vector: `LANES` points of one primitive shaded
 /// together give, lane by lane, the bits each gives shaded alone (in every lane), for every primitive of a
 /// quickstart clip's busiest frame (ground with road paint, walls with windows, bodies with their capsules'
-/// normals), by day with shadows and at night in rain with lamps, headlights and wet reflections. Runs of
+/// normals) and the sky, by day with shadows and at night in rain with lamps, headlights and wet reflections. Runs of
 /// pixels and edge samples are grouped differently, so this is what keeps an image independent of grouping.
 #[test]
 fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
-    use pedsynth::exec::observe::camera::lanes::{F, LANES, V3};
+    use pedsynth::exec::observe::camera::lanes::{LANES, V3, lanes_from};
     use pedsynth::exec::observe::camera::shade::{self, ActiveLights, Noise, Points, ShadeContext};
     use rand::{RngExt, SeedableRng};
 
@@ -1085,7 +1085,7 @@ fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
                     p,
                     ray,
                     ray_len: ray.length_squared().sqrt(),
-                    shadow: F::new(std::array::from_fn(|i| shadow[at(i)])),
+                    shadow: lanes_from(|i| shadow[at(i)]),
                 }
             };
             let shaded = |pts: &Points| {
@@ -1111,5 +1111,31 @@ fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
             checked > 500 && painted > 0,
             "{weather}: {checked} primitives, {painted} painted points"
         );
+        // The sky (its sun glow and the ground below the horizon are added only where a lane needs them):
+        // directions at the sun, near it, across the sky and below the horizon.
+        for _ in 0..200 {
+            let dirs: [Vec3; LANES] = std::array::from_fn(|i| match i % 4 {
+                0 => light.sun_dir,
+                1 => (light.sun_dir + Vec3::new(rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3), 0.0))
+                    .normalize(),
+                2 => Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random()).normalize(),
+                _ => Vec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    -rng.random::<f32>(),
+                )
+                .normalize(),
+            });
+            let together = light.sky(V3::from_lanes(dirs)).lanes();
+            for lane in 0..LANES {
+                let alone = light.sky(V3::from_lanes([dirs[lane]; LANES])).lanes();
+                assert_eq!(
+                    together[lane].to_array().map(f32::to_bits),
+                    alone[0].to_array().map(f32::to_bits),
+                    "{weather}: sky {:?}",
+                    dirs[lane]
+                );
+            }
+        }
     }
 }
