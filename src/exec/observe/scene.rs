@@ -979,7 +979,9 @@ impl StaticScene {
 
 /// Whether [`road_paint`] can find paint anywhere in the box `lo..=hi` (scene-relative): `false` where the
 /// box misses the piece's crosswalk and every marking's bounding box grown by the mark's half width, so that
-/// a run of points can skip the per-point test.
+/// a run of points can skip the per-point test. Inlined: shading calls it once per run of road pixels, and a
+/// call there spills every vector register of the shading around it.
+#[inline(always)]
 pub fn road_paint_near(scene: &StaticScene, piece: &PieceSurface, lo: Vec2, hi: Vec2) -> bool {
     let overlaps = |a: Vec2, b: Vec2| lo.x <= b.x && hi.x >= a.x && lo.y <= b.y && hi.y >= a.y;
     if let Some(cw) = piece.crosswalk {

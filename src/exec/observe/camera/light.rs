@@ -6,7 +6,7 @@
 use glam::Vec3;
 use std::ops::Add;
 
-use super::lanes::{F, I, V3, floor_int};
+use super::lanes::{F, I, V3, floor_int, lanes_from};
 use crate::dsl::types::WeatherParams;
 
 /// The lighting of a clip.
@@ -139,7 +139,9 @@ fn horizon_to_zenith(up: F) -> F {
     let i = floor_int(s).max(I::ZERO).min(I::splat(GRADIENT_STEPS as i32));
     let f = s - i.round_float();
     let ia = i.to_array();
-    let at = |j: usize| F::new(ia.map(|i| table[i as usize + j]));
+    // `lanes_from`, not `array::map`: the latter is sometimes left out of line, and a call spills every vector
+    // register of the shading around it.
+    let at = |j: usize| lanes_from(|k| table[ia[k] as usize + j]);
     let (a, b) = (at(0), at(1));
     a + (b - a) * f
 }

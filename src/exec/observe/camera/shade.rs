@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3};
 use std::ops::{Add, Mul, Sub};
 
-use super::lanes::{F, LANES, V3, exp_lanes, floor_int, lanes_from};
+use super::lanes::{F, LANES, V3, exp_lanes, floor_int, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use crate::exec::observe::scene::{
     FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, road_paint_near, tag,
@@ -100,7 +100,7 @@ impl Noise {
         let (tx, ty) = (qx - ix.round_float(), qy - iy.round_float());
         let (xa, ya) = (ix.to_array(), iy.to_array());
         let c: [[f32; 4]; LANES] = std::array::from_fn(|i| self.corners(xa[i], ya[i]));
-        let [v00, v10, v01, v11] = [0, 1, 2, 3].map(|k| lanes_from(|i| c[i][k]));
+        let [v00, v10, v01, v11] = transpose_cells(&c);
         let a = v00 + (v10 - v00) * tx;
         let b = v01 + (v11 - v01) * tx;
         a + (b - a) * ty
