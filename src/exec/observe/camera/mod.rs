@@ -582,8 +582,10 @@ impl Renderer {
                 }
                 x = end;
             }
-            // Edge pixels: the mean of their samples' colours, the first sample's tag.
-            for (x, _) in row_prim.iter().enumerate().filter(|(_, p)| **p == EDGE) {
+            // Edge pixels (candidates whose samples differ): the mean of their samples' colours, the first
+            // sample's tag.
+            let candidates = &vis.edge_x[vis.edge_rows[row]..vis.edge_rows[row + 1]];
+            for x in candidates.iter().map(|&x| x as usize).filter(|&x| row_prim[x] == EDGE) {
                 let c = &edge_colour[e..e + 4];
                 let colour = (c[0] + c[1] + c[2] + c[3]) * 0.25;
                 for (channel, v) in rgb.iter_mut().zip(colour.to_array()) {

@@ -151,6 +151,16 @@ pub struct BandVisibility {
     pub edge_prim: Vec<[u32; 4]>,
     /// See [`BandVisibility::edge_x`].
     pub edge_rows: Vec<usize>,
+    /// The candidates as bits, `w.div_ceil(64)` words per row (bit `b` of word `j`: column `64 j + b`), and
+    /// the index in [`BandVisibility::edge_x`] of each word's first candidate: a triangle's span finds its
+    /// candidates by words instead of searching the list.
+    edge_bits: Vec<u64>,
+    edge_rank: Vec<u32>,
+}
+
+/// Words of candidate bits per row of a `w`-pixel-wide band.
+const fn edge_words(w: usize) -> usize {
+    w.div_ceil(64)
 }
 
 impl BandVisibility {
@@ -164,6 +174,8 @@ impl BandVisibility {
             edge_key: Vec::new(),
             edge_prim: Vec::new(),
             edge_rows: Vec::with_capacity(rows + 1),
+            edge_bits: vec![0; edge_words(w) * rows],
+            edge_rank: vec![0; edge_words(w) * rows],
         }
     }
 
@@ -185,7 +197,10 @@ impl BandVisibility {
             edge_key,
             edge_prim,
             edge_rows,
+            edge_bits,
+            edge_rank,
         } = self;
+        let words = edge_words(w);
         // Pixels whose grid corners (their own first sample and those of the pixels right, below and
         // diagonally below) see one primitive are taken to be covered by it (only a feature narrower than a
         // pixel could hide between the corners), with the depth key of their centre interpolated from the
@@ -225,10 +240,26 @@ impl BandVisibility {
             if y0 + row + 1 == image_h {
                 prims.fill(EDGE);
             }
-            for (x, _) in prims.iter().enumerate().filter(|(_, p)| **p == EDGE) {
-                edge_x.push(x as u32);
-                edge_key.push([k0[x], 0.0, 0.0, 0.0]);
-                edge_prim.push([g0[x], EMPTY, EMPTY, EMPTY]);
+            // The candidates by words of 64 columns: their bits (a loop the compiler vectorises), then each set
+            // bit listed.
+            let (bits, rank) = (
+                &mut edge_bits[row * words..(row + 1) * words],
+                &mut edge_rank[row * words..(row + 1) * words],
+            );
+            for (j, chunk) in prims.chunks(64).enumerate() {
+                let mut m = 0u64;
+                for (b, &p) in chunk.iter().enumerate() {
+                    m |= u64::from(p == EDGE) << b;
+                }
+                bits[j] = m;
+                rank[j] = edge_x.len() as u32;
+                while m != 0 {
+                    let x = 64 * j + m.trailing_zeros() as usize;
+                    edge_x.push(x as u32);
+                    edge_key.push([k0[x], 0.0, 0.0, 0.0]);
+                    edge_prim.push([g0[x], EMPTY, EMPTY, EMPTY]);
+                    m &= m - 1;
+                }
             }
         }
         edge_rows.push(edge_x.len());
@@ -240,31 +271,45 @@ impl BandVisibility {
                 let rows = (t.row0 as usize).max(2 * y0)..=(t.row1 as usize).min(2 * (y0 + h) - 1);
                 for sample_row in rows {
                     let (sy, row) = (sample_row % 2, sample_row / 2 - y0);
-                    let (a, b) = (edge_rows[row], edge_rows[row + 1]);
-                    if a == b {
+                    if edge_rows[row] == edge_rows[row + 1] {
                         continue;
                     }
                     let Some(span) = t.span(sample_row) else {
                         continue;
                     };
-                    let first = a + edge_x[a..b].partition_point(|&x| 2 * x as usize + 1 < span.x0);
-                    for e in first..b {
-                        let x = edge_x[e] as usize;
-                        if 2 * x > span.x1 {
-                            break;
+                    // The candidates with a sample in the span: pixels `x0 / 2..=x1 / 2` (the first of them
+                    // through its right column only where `x0` is odd, as the column test below says).
+                    let (lo, hi) = (span.x0 / 2, (span.x1 / 2).min(w - 1));
+                    let (bits, rank) = (
+                        &edge_bits[row * words..(row + 1) * words],
+                        &edge_rank[row * words..(row + 1) * words],
+                    );
+                    for j in lo / 64..=hi / 64 {
+                        let mut m = bits[j];
+                        // Candidates left of the span still count for the index of the first one in it.
+                        let left = if j == lo / 64 { (1u64 << (lo % 64)) - 1 } else { 0 };
+                        let mut e = rank[j] as usize + (m & left).count_ones() as usize;
+                        m &= !left;
+                        if j == hi / 64 && hi % 64 < 63 {
+                            m &= (2u64 << (hi % 64)) - 1;
                         }
-                        // Sample (0, 0) is the grid's.
-                        for sx in (1 - sy)..2 {
-                            let column = 2 * x + sx;
-                            if column < span.x0 || column > span.x1 {
-                                continue;
+                        while m != 0 {
+                            let x = 64 * j + m.trailing_zeros() as usize;
+                            // Sample (0, 0) is the grid's.
+                            for sx in (1 - sy)..2 {
+                                let column = 2 * x + sx;
+                                if column < span.x0 || column > span.x1 {
+                                    continue;
+                                }
+                                let key = span.key(column);
+                                let k = sy * 2 + sx;
+                                if key > edge_key[e][k] {
+                                    edge_key[e][k] = key;
+                                    edge_prim[e][k] = t.prim;
+                                }
                             }
-                            let key = span.key(column);
-                            let k = sy * 2 + sx;
-                            if key > edge_key[e][k] {
-                                edge_key[e][k] = key;
-                                edge_prim[e][k] = t.prim;
-                            }
+                            e += 1;
+                            m &= m - 1;
                         }
                     }
                 }
