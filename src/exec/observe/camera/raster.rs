@@ -158,6 +158,25 @@ pub struct BandVisibility {
     edge_rank: Vec<u32>,
 }
 
+/// Whether any of the bits `lo..=hi` is set in `bits` (64 per word).
+#[inline(always)]
+fn any_bit(bits: &[u64], lo: usize, hi: usize) -> bool {
+    if lo > hi {
+        return false;
+    }
+    let (first, last) = (lo / 64, hi / 64);
+    let low = !((1u64 << (lo % 64)) - 1);
+    let high = if hi % 64 == 63 {
+        u64::MAX
+    } else {
+        (2u64 << (hi % 64)) - 1
+    };
+    if first == last {
+        return bits[first] & low & high != 0;
+    }
+    bits[first] & low != 0 || bits[first + 1..last].iter().any(|&m| m != 0) || bits[last] & high != 0
+}
+
 /// Words of candidate bits per row of a `w`-pixel-wide band.
 const fn edge_words(w: usize) -> usize {
     w.div_ceil(64)
@@ -269,9 +288,11 @@ impl BandVisibility {
             for &i in bin {
                 let t = &tris[i as usize];
                 let rows = (t.row0 as usize).max(2 * y0)..=(t.row1 as usize).min(2 * (y0 + h) - 1);
+                // The pixels the triangle's bounds reach: a row without candidates among them needs no span.
+                let (reach_lo, reach_hi) = t.pixel_reach(w);
                 for sample_row in rows {
                     let (sy, row) = (sample_row % 2, sample_row / 2 - y0);
-                    if edge_rows[row] == edge_rows[row + 1] {
+                    if !any_bit(&edge_bits[row * words..(row + 1) * words], reach_lo, reach_hi) {
                         continue;
                     }
                     let Some(span) = t.span(sample_row) else {
@@ -405,8 +426,18 @@ impl Setup {
         })
     }
 
+    /// The pixels (of `SS × SS` = 2 × 2 samples, at most `w`) that the triangle's horizontal bounds reach:
+    /// every span's samples belong to pixels `lo..=hi` (`lo > hi`: none).
+    #[inline(always)]
+    fn pixel_reach(&self, w: usize) -> (usize, usize) {
+        // Spans start at or after `ceil(min_x − 0.5)` and end at or before `floor(max_x − 0.5)`.
+        let lo = ceil_f64(self.min_x - 0.5).max(0.0) as usize / 2;
+        let hi = (floor_f64(self.max_x - 0.5).max(0.0) as usize / 2).min(w - 1);
+        (lo, hi)
+    }
+
     /// The samples of sample row `row` (centred at `row + 0.5`) that the triangle covers (`None`: none).
-    #[inline]
+    #[inline(always)]
     pub fn span(&self, row: usize) -> Option<Span> {
         let y = row as f64 + 0.5;
         let (mut lo, mut hi) = (self.min_x - 0.5, self.max_x - 0.5);
