@@ -1,0 +1,44 @@
+//! Renders the camera benchmark's frame (the busiest annotated frame of the first quickstart clip) N times on
+//! one core in one weather and prints the mean time per frame: a target for `perf record`, which the divan
+//! benchmark is not (it runs every weather). Run: `cargo build --release --example profile_frame &&
+//! perf record target/release/examples/profile_frame clear_noon 400 && perf report`.
+
+use pedsynth::exec::observe::camera::light::Lighting;
+use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
+use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
+
+#[path = "../benches/common/mod.rs"]
+mod common;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let weather = args.get(1).cloned().unwrap_or_else(|| "clear_noon".into());
+    let frames: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(200).max(1);
+    let s = common::busy_quickstart_clip(&[format!("dataset.weathers=[{weather}]")]);
+    let light = Lighting::from_weather(&s.script.weather_params);
+    let mut renderer = Renderer::new(&s.rig.camera, light, s.script.seed);
+    let mut frame = FrameScene::default();
+    let t = SceneTime::at(s.frame);
+    frame.build(&s.scene, &s.script, &s.trace, t);
+    let (pos, yaw) = ego_at(&s.trace, t);
+    let pose = s.rig.camera.at(pos, yaw);
+    let mut img = CameraImages::default();
+    let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(1).build() else {
+        eprintln!("no thread pool");
+        std::process::exit(1);
+    };
+    let start = std::time::Instant::now();
+    pool.install(|| {
+        for _ in 0..frames {
+            renderer.render(
+                &s.scene,
+                &frame,
+                &pose,
+                streak_seed(s.script.seed, s.frame, 0),
+                &mut img,
+            );
+        }
+    });
+    let per_frame_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;
+    println!("{weather}: {per_frame_ms:.3} ms per frame ({frames} frames, one core)");
+}
