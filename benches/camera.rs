@@ -7,7 +7,7 @@
 
 use pedsynth::exec::observe::camera::light::Lighting;
 use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
+use pedsynth::exec::observe::scene::{FrameScene, SceneTime};
 use pedsynth::exec::observe::{self};
 use pedsynth::exec::write::sensors::{rgb_png, semantic_png};
 
@@ -26,27 +26,10 @@ fn setup(weather: &str) -> Setup {
 #[divan::bench(args = ["clear_noon", "night_rainy"])]
 fn render_rgb_frame(bencher: divan::Bencher, weather: &str) {
     let s = setup(weather);
-    let light = Lighting::from_weather(&s.script.weather_params);
-    let mut renderer = Renderer::new(&s.rig.camera, light, s.script.seed);
-    let mut frame = FrameScene::default();
-    let t = SceneTime::at(s.frame);
-    frame.build(&s.scene, &s.script, &s.trace, t);
-    let (pos, yaw) = ego_at(&s.trace, t);
-    let pose = s.rig.camera.at(pos, yaw);
-    let mut img = CameraImages::default();
+    let mut r = s.busy_render();
     // One core: the renderer resolves bands of rows on the current rayon pool.
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
-    bencher.bench_local(|| {
-        pool.install(|| {
-            renderer.render(
-                &s.scene,
-                &frame,
-                &pose,
-                streak_seed(s.script.seed, s.frame, 0),
-                &mut img,
-            )
-        });
-    });
+    bencher.bench_local(|| pool.install(|| s.render_busy(&mut r)));
 }
 
 /// Every 16th frame of the clip (not only its busiest), rendered one after another on one core: the mean over a
@@ -59,11 +42,8 @@ fn render_rgb_clip_frames(bencher: divan::Bencher, weather: &str) {
     let frames: Vec<_> = (0..s.trace.frame_count)
         .step_by(16)
         .map(|f| {
-            let t = SceneTime::at(f);
-            let mut frame = FrameScene::default();
-            frame.build(&s.scene, &s.script, &s.trace, t);
-            let (pos, yaw) = ego_at(&s.trace, t);
-            (f, frame, s.rig.camera.at(pos, yaw))
+            let (frame, pose) = s.camera_frame(f);
+            (f, frame, pose)
         })
         .collect();
     let mut img = CameraImages::default();

@@ -3,10 +3,6 @@
 //! benchmark is not (it runs every weather). Run: `cargo build --release --example profile_frame &&
 //! perf record target/release/examples/profile_frame clear_noon 400 && perf report`.
 
-use pedsynth::exec::observe::camera::light::Lighting;
-use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
-
 #[path = "../benches/common/mod.rs"]
 mod common;
 
@@ -15,14 +11,7 @@ fn main() {
     let weather = args.get(1).cloned().unwrap_or_else(|| "clear_noon".into());
     let frames: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(200).max(1);
     let s = common::busy_quickstart_clip(&[format!("dataset.weathers=[{weather}]")]);
-    let light = Lighting::from_weather(&s.script.weather_params);
-    let mut renderer = Renderer::new(&s.rig.camera, light, s.script.seed);
-    let mut frame = FrameScene::default();
-    let t = SceneTime::at(s.frame);
-    frame.build(&s.scene, &s.script, &s.trace, t);
-    let (pos, yaw) = ego_at(&s.trace, t);
-    let pose = s.rig.camera.at(pos, yaw);
-    let mut img = CameraImages::default();
+    let mut r = s.busy_render();
     let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(1).build() else {
         eprintln!("no thread pool");
         std::process::exit(1);
@@ -30,13 +19,7 @@ fn main() {
     let start = std::time::Instant::now();
     pool.install(|| {
         for _ in 0..frames {
-            renderer.render(
-                &s.scene,
-                &frame,
-                &pose,
-                streak_seed(s.script.seed, s.frame, 0),
-                &mut img,
-            );
+            s.render_busy(&mut r);
         }
     });
     let per_frame_ms = start.elapsed().as_secs_f64() * 1e3 / frames as f64;

@@ -6,8 +6,11 @@ use std::path::Path;
 
 use pedsynth::dsl::LoadOptions;
 use pedsynth::dsl::types::Sensors;
+use pedsynth::exec::observe::camera::light::Lighting;
+use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
+use pedsynth::exec::observe::rig::CameraPose;
 use pedsynth::exec::observe::rig::Rig;
-use pedsynth::exec::observe::scene::StaticScene;
+use pedsynth::exec::observe::scene::{FrameScene, SceneTime, StaticScene, ego_at};
 use pedsynth::exec::observe::{self};
 use pedsynth::exec::simulate;
 use pedsynth::exec::trace::ClipTrace;
@@ -54,5 +57,44 @@ pub fn busy_quickstart_clip(overrides: &[String]) -> BusyClip {
         net,
         scene,
         frame,
+    }
+}
+
+impl BusyClip {
+    /// The scene of frame `frame` and the camera's pose in it.
+    pub fn camera_frame(&self, frame: u32) -> (FrameScene, CameraPose) {
+        let t = SceneTime::at(frame);
+        let mut scene = FrameScene::default();
+        scene.build(&self.scene, &self.script, &self.trace, t);
+        let (pos, yaw) = ego_at(&self.trace, t);
+        (scene, self.rig.camera.at(pos, yaw))
+    }
+}
+
+/// A renderer for the busiest frame of a clip, with that frame's scene, the camera pose and the images.
+pub struct BusyRender {
+    pub renderer: Renderer,
+    pub frame: FrameScene,
+    pub pose: CameraPose,
+    pub img: CameraImages,
+}
+
+impl BusyClip {
+    /// A renderer with the clip's lighting, set up for its busiest frame.
+    pub fn busy_render(&self) -> BusyRender {
+        let light = Lighting::from_weather(&self.script.weather_params);
+        let (frame, pose) = self.camera_frame(self.frame);
+        BusyRender {
+            renderer: Renderer::new(&self.rig.camera, light, self.script.seed),
+            frame,
+            pose,
+            img: CameraImages::default(),
+        }
+    }
+
+    /// Renders the busiest frame (on the current rayon pool).
+    pub fn render_busy(&self, r: &mut BusyRender) {
+        let seed = streak_seed(self.script.seed, self.frame, 0);
+        r.renderer.render(&self.scene, &r.frame, &r.pose, seed, &mut r.img);
     }
 }
