@@ -69,17 +69,7 @@ impl BusyClip {
         let (pos, yaw) = ego_at(&self.trace, t);
         (scene, self.rig.camera.at(pos, yaw))
     }
-}
 
-/// A renderer for the busiest frame of a clip, with that frame's scene, the camera pose and the images.
-pub struct BusyRender {
-    pub renderer: Renderer,
-    pub frame: FrameScene,
-    pub pose: CameraPose,
-    pub img: CameraImages,
-}
-
-impl BusyClip {
     /// A renderer with the clip's lighting, set up for its busiest frame.
     pub fn busy_render(&self) -> BusyRender {
         let light = Lighting::from_weather(&self.script.weather_params);
@@ -97,4 +87,12 @@ impl BusyClip {
         let seed = streak_seed(self.script.seed, self.frame, 0);
         r.renderer.render(&self.scene, &r.frame, &r.pose, seed, &mut r.img);
     }
+}
+
+/// A renderer for the busiest frame of a clip, with that frame's scene, the camera pose and the images.
+pub struct BusyRender {
+    pub renderer: Renderer,
+    pub frame: FrameScene,
+    pub pose: CameraPose,
+    pub img: CameraImages,
 }
