@@ -347,8 +347,15 @@ impl BandVisibility {
 /// plane of its depth key and its bounds. Setup is in `f64` (large coordinates after near-plane clipping).
 #[derive(Clone, Copy, Debug)]
 pub struct Setup {
-    /// Edge functions `(ex, ey, e0)`: `ex·x + ey·y + e0 ≥ 0` inside.
-    edges: [(f64, f64, f64); 3],
+    /// Per edge, the line `x = a·y + b` (sample units, the half-sample offset and the coverage tolerance
+    /// folded in) left of which (`lo`) or right of which (`hi`) a row's samples are outside: an edge bounds
+    /// the span on one side only, so its other line is `(0, ∓∞)`. Multiplications per row instead of the
+    /// divisions of the edge functions, and no branches.
+    lo: [(f64, f64); 3],
+    /// See [`Setup::lo`].
+    hi: [(f64, f64); 3],
+    /// A horizontal edge's function `(ey, e0)` (`ey·y + e0 ≥ −tol` inside; `(0, 0)` where there is none).
+    flat: (f64, f64),
     /// The depth key's plane: `k = kx·x + ky·y + k0`.
     kx: f64,
     ky: f64,
@@ -358,7 +365,7 @@ pub struct Setup {
     max_x: f64,
     /// Image width, samples.
     width: f64,
-    /// Coverage tolerance: a hair of overlap between neighbours rather than a crack.
+    /// Coverage tolerance: a hair of overlap between neighbours rather than a crack (edge-function units).
     tol: f64,
     /// First and last sample rows covered.
     pub row0: u32,
@@ -386,12 +393,27 @@ impl Setup {
             (ex, ey, e0)
         };
         let edges = [edge(a, b), edge(b, c), edge(c, a)];
+        let (w, h) = (width as f64, height as f64);
+        let tol = 1e-7 * (1.0 + w.max(h));
+        // `ex·x + ey·y + e0 ≥ −tol` ⇔ `x ≥ (−(ey·y + e0) − tol) / ex` where `ex > 0` (≤ where `ex < 0`); sample
+        // `i` is centred at `i + 0.5`.
+        let (mut lo, mut hi) = ([(0.0, f64::NEG_INFINITY); 3], [(0.0, f64::INFINITY); 3]);
+        let mut flat = (0.0, 0.0);
+        for (i, &(ex, ey, e0)) in edges.iter().enumerate() {
+            let line = (-ey / ex, (-e0 - tol) / ex - 0.5);
+            if ex > 0.0 {
+                lo[i] = line;
+            } else if ex < 0.0 {
+                hi[i] = line;
+            } else {
+                flat = (ey, e0);
+            }
+        }
         let inv = 1.0 / area;
         let kx = ((b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y)) * inv;
         let ky = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) * inv;
         let k0 = a.z - kx * a.x - ky * a.y;
 
-        let (w, h) = (width as f64, height as f64);
         let min_y = a.y.min(b.y).min(c.y).max(0.0);
         let max_y = a.y.max(b.y).max(c.y).min(h);
         let min_x = a.x.min(b.x).min(c.x).max(0.0);
@@ -405,14 +427,16 @@ impl Setup {
             return None;
         }
         Some(Setup {
-            edges,
+            lo,
+            hi,
+            flat,
             kx,
             ky,
             k0,
             min_x,
             max_x,
             width: w,
-            tol: 1e-7 * (1.0 + w.max(h)),
+            tol,
             row0: row0 as u32,
             row1: row1 as u32,
             prim,
@@ -433,18 +457,17 @@ impl Setup {
     #[inline(always)]
     pub fn span(&self, row: usize) -> Option<Span> {
         let y = row as f64 + 0.5;
-        let (mut lo, mut hi) = (self.min_x - 0.5, self.max_x - 0.5);
-        for &(ex, ey, e0) in &self.edges {
-            let rest = ey * y + e0;
-            if ex > 0.0 {
-                lo = lo.max((-rest - self.tol) / ex - 0.5);
-            } else if ex < 0.0 {
-                hi = hi.min((-rest - self.tol) / ex - 0.5);
-            } else if rest < -self.tol {
-                return None;
-            }
-        }
-        if lo > hi {
+        // Spelled out (`array::map` is not always inlined).
+        let at = |(a, b): (f64, f64)| a * y + b;
+        let lo = (self.min_x - 0.5)
+            .max(at(self.lo[0]))
+            .max(at(self.lo[1]))
+            .max(at(self.lo[2]));
+        let hi = (self.max_x - 0.5)
+            .min(at(self.hi[0]))
+            .min(at(self.hi[1]))
+            .min(at(self.hi[2]));
+        if lo > hi || self.flat.0 * y + self.flat.1 < -self.tol {
             return None;
         }
         let x0 = ceil_f64(lo).max(0.0) as usize;
