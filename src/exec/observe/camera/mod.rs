@@ -2,6 +2,7 @@
 //! rasterisation of the scene, and DVS events from the rendered luminance.
 //!
 //! - [`raster`] — the visibility buffers (nearest primitive and depth per sample).
+//! - [`group`] — grouping of edge samples by primitive for shading.
 //! - [`lanes`] — lane math for shading several pixels at once.
 //! - [`light`] — lighting from the weather.
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
@@ -16,6 +17,7 @@
 //! primitive and each sample where they differ (edge antialiasing), then adds rain streaks and maps to sRGB.
 
 pub mod dvs;
+pub mod group;
 pub mod lanes;
 pub mod light;
 pub mod raster;
@@ -30,6 +32,7 @@ use std::sync::Mutex;
 use super::rig::{Camera, CameraPose};
 use super::scene::{FrameScene, Material, Prim, StaticScene, tag};
 use crate::mix::splitmix64;
+use group::Grouper;
 use lanes::{F, LANES, V3, floor_int, lanes_from};
 use light::Lighting;
 use raster::{BandVisibility, EDGE, EMPTY, Raster, Setup, clip_near};
@@ -89,9 +92,9 @@ struct BandScratch {
     /// The band's visibility.
     vis: BandVisibility,
     /// The samples of the band's edge pixels (four per pixel, in (row, column) order) and their shaded colours
-    /// and tags, by the sample's index in that list; their order of shading (primitive, index).
+    /// and tags, by the sample's index in that list; their groups by primitive, shaded group by group.
     edges: Vec<Sample>,
-    order: Vec<u64>,
+    groups: Grouper,
     edge_colour: Vec<Vec3>,
     edge_tag: Vec<u8>,
     /// The row's linear colours, one channel each (`LANES − 1` of slack for whole-vector stores; the tone map
@@ -105,7 +108,7 @@ impl BandScratch {
         BandScratch {
             vis: BandVisibility::new(w, BAND_ROWS),
             edges: Vec::new(),
-            order: Vec::new(),
+            groups: Grouper::default(),
             edge_colour: Vec::new(),
             edge_tag: Vec::new(),
             rgb: [
@@ -488,7 +491,7 @@ impl Renderer {
         let BandScratch {
             vis,
             edges,
-            order,
+            groups,
             edge_colour,
             edge_tag,
             rgb,
@@ -515,24 +518,17 @@ impl Renderer {
                 }
             }
         }
-        order.clear();
-        order.extend(
-            edges
-                .iter()
-                .enumerate()
-                .map(|(i, s)| (u64::from(s.prim) << 32) | i as u64),
-        );
-        order.sort_unstable();
+        groups.group(edges.iter().map(|s| s.prim));
         edge_colour.resize(edges.len(), Vec3::ZERO);
         edge_tag.resize(edges.len(), 0);
-        for group in order.chunk_by(|a, b| a >> 32 == b >> 32) {
+        for group in groups.groups() {
             for chunk in group.chunks(LANES) {
-                let at = |i: usize| &edges[(chunk[i.min(chunk.len() - 1)] & 0xffff_ffff) as usize];
+                let at = |i: usize| &edges[chunk[i.min(chunk.len() - 1)] as usize];
                 let lane = |f: fn(&Sample) -> f32| lanes_from(|i| f(at(i)));
                 let (colour, tags) = self.shade(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
                 for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
-                    edge_colour[(o & 0xffff_ffff) as usize] = c;
-                    edge_tag[(o & 0xffff_ffff) as usize] = t;
+                    edge_colour[o as usize] = c;
+                    edge_tag[o as usize] = t;
                 }
             }
         }
