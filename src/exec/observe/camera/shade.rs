@@ -303,6 +303,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     let mut light = V3::lerp(l.ground_ambient, l.sky_ambient, up).add(V3::splat(l.sun).scale(ndl * pts.shadow));
     let mut glints = V3::ZERO;
     if l.night > 0.0 {
+        // Street lamps: `d` from the point to the lamp, `dir = d / |d|`. Written without normalising `d` (a
+        // square root and a division per lamp and lane saved, the costliest part of a night frame).
+        let lamp_intensity = F::splat(LAMP_INTENSITY * l.night);
         for &lamp in &ctx.lights.lamps {
             let d = V3::splat(lamp).sub(p);
             let d2 = d.length_squared();
@@ -310,18 +313,19 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             if !near.any() {
                 continue;
             }
-            let inv = one / d2.sqrt();
-            let dir = d.scale(inv);
-            let fall = F::splat(LAMP_INTENSITY * l.night) / (d2 + 1.0);
-            // The lamp shines downwards: light falls off away from below it.
-            let k = fall * normal.dot(dir).max(F::ZERO) * dir.z.max(F::ZERO);
+            // Diffuse, from a lamp that shines downwards (light falls off away from below it):
+            // `fall · (n·dir)⁺ · dir.z⁺` with `fall = I / (|d|² + 1)`, as `I · (n·d)⁺ · d.z⁺ / ((|d|² + 1) |d|²)`.
+            let fall_per_d2 = lamp_intensity / ((d2 + one) * d2.max(F::splat(1.0e-12)));
+            let k = fall_per_d2 * normal.dot(d).max(F::ZERO) * d.z.max(F::ZERO);
             light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, F::ZERO)));
             if glossy {
-                let h = dir.add(view).normalize_or_zero();
-                let s = normal.dot(h).max(F::ZERO);
-                let s2 = s * s;
+                // Blinn-Phong `(n·h)^32` with the half vector `h ∝ dir + view`, here `d + view · |d|`
+                // (the same direction), as `((n·h)⁺² / |h|²)^16`.
+                let h = d.add(view.scale(d2.sqrt()));
+                let nh = normal.dot(h).max(F::ZERO);
+                let s2 = nh * nh / h.length_squared().max(F::splat(1.0e-12));
                 let s8 = s2 * s2 * s2 * s2;
-                let g = fall * 6.0 * gloss * s8 * s8 * s8 * s8;
+                let g = fall_per_d2 * d2 * 6.0 * gloss * s8 * s8 * s8 * s8;
                 glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, F::ZERO)));
             }
         }
@@ -334,17 +338,19 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             if !on.any() {
                 continue;
             }
-            let side = ((d.x * axis.y - d.y * axis.x) / ahead / 0.7).abs();
-            let up = d.z / ahead;
-            let cut = ((F::splat(0.02) - up) / 0.04).max(F::ZERO).min(one);
+            // Lanes behind the lamp divide by zero or less; `on` masks them.
+            let per_ahead = one / ahead;
+            let side = ((d.x * axis.y - d.y * axis.x) * per_ahead * (1.0 / 0.7)).abs();
+            let up = d.z * per_ahead;
+            let cut = ((F::splat(0.02) - up) * 25.0).max(F::ZERO).min(one);
             let beam = (one - side * side).max(F::ZERO) * cut;
             on &= beam.simd_gt(F::ZERO);
             if !on.any() {
                 continue;
             }
-            let dir = d.scale(one / d2.sqrt());
-            let fall = F::splat(HEADLAMP_INTENSITY * l.night) * beam / (d2 + 30.0);
-            let k = fall * (-normal.dot(dir)).max(F::ZERO);
+            // `fall · (−n·dir)⁺` with `fall = I · beam / (|d|² + 30)` and `dir = d / |d|`, in one division.
+            let fall_per_d = F::splat(HEADLAMP_INTENSITY * l.night) * beam / ((d2 + 30.0) * d2.sqrt());
+            let k = fall_per_d * (-normal.dot(d)).max(F::ZERO);
             light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, F::ZERO)));
         }
     }
