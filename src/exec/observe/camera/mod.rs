@@ -228,6 +228,19 @@ pub struct Renderer {
     /// Scratch of [`nearest`]: (squared distance, index), reused from frame to frame.
     nearby: Vec<(f32, u32)>,
     lut: Box<[u8; LUT_LEN]>,
+    /// The frame's rain streaks, in drawing order, and per band of rows the ones that reach it (drawn while
+    /// the band is in cache: a whole-image pass misses the cache at every streak pixel).
+    streaks: Vec<Streak>,
+    streak_bins: Vec<Vec<u32>>,
+}
+
+/// A rain streak: a slanted, semi-transparent line from `(x0, y0)` down `steps` pixel rows.
+#[derive(Clone, Copy, Debug)]
+struct Streak {
+    x0: f32,
+    y0: f32,
+    steps: usize,
+    alpha: f32,
 }
 
 /// The (up to) `n` items nearest to `from` within `radius_m`, nearest first (ties by index), into `out`.
@@ -278,6 +291,8 @@ impl Renderer {
             lights: ActiveLights::default(),
             nearby: Vec::new(),
             lut: build_lut(),
+            streaks: Vec::new(),
+            streak_bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
         }
     }
 
@@ -307,10 +322,8 @@ impl Renderer {
         let cam_rel = (pose.centre - scene.origin).as_vec3();
         self.draw_shadows(scene, frame, cam_rel, pose.forward.as_vec3());
         self.choose_lights(scene, frame, cam_rel, pose);
+        self.place_streaks(streak_seed);
         self.resolve(scene, frame, pose, cam_rel, out);
-        if self.light.rain > 0.0 {
-            self.rain_streaks(streak_seed, out);
-        }
     }
 
     fn draw_visibility(&mut self, scene: &StaticScene, frame: &FrameScene, optical_from_scene: &DAffine3) {
@@ -592,6 +605,7 @@ impl Renderer {
             }
             tone_map(rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
+        self.draw_streaks(y0, out.rgb);
         if let (Ok(mut pool), Some(scratch)) = (self.band_buffers.0.lock(), taken) {
             pool.push(scratch);
         }
@@ -631,32 +645,72 @@ impl Renderer {
         (shade::fog(&self.light, colour, ray_len * z), semantic)
     }
 
-    /// Rain: thin, slanted, semi-transparent streaks at seeded places, brighter against dark backgrounds.
-    fn rain_streaks(&self, seed: u64, out: &mut CameraImages) {
-        let (w, h) = (out.width as f32, out.height as f32);
+    /// Rain: thin, slanted, semi-transparent streaks at seeded places (none without rain), listed per band of
+    /// rows they reach; [`Renderer::draw_streaks`] draws them.
+    fn place_streaks(&mut self, seed: u64) {
+        self.streaks.clear();
+        for bin in &mut self.streak_bins {
+            bin.clear();
+        }
+        if self.light.rain <= 0.0 {
+            return;
+        }
+        let (w, h) = (self.camera.width_px as f32, self.camera.height_px as f32);
         let mut rng = ChaCha8Rng::seed_from_u64(splitmix64(seed ^ 0x7a1f));
         let count = (self.light.rain * 1500.0 * (w * h) / (1280.0 * 720.0)) as usize;
-        let slant = 0.08 + 0.35 * self.light.wind;
-        let bright = 150.0 + 60.0 * (1.0 - self.light.night);
-        for _ in 0..count {
+        let last_bin = self.streak_bins.len() - 1;
+        for i in 0..count {
             let x0: f32 = rng.random_range(-50.0..w + 50.0);
             let y0: f32 = rng.random_range(-50.0..h);
             let len: f32 = rng.random_range(0.02..0.07) * h;
             let alpha: f32 = rng.random_range(0.12..0.3);
-            let steps = len as usize;
-            for k in 0..steps {
+            let streak = Streak {
+                x0,
+                y0,
+                steps: len as usize,
+                alpha,
+            };
+            self.streaks.push(streak);
+            // Rows `y0 + k` for `k < steps`, one row of margin each side (the bands' own test is exact).
+            let first = (y0 - 1.0).max(0.0) as usize / BAND_ROWS;
+            let last = ((y0 + streak.steps as f32 + 1.0).max(0.0) as usize / BAND_ROWS).min(last_bin);
+            for bin in &mut self.streak_bins[first.min(last_bin)..=last] {
+                bin.push(i as u32);
+            }
+        }
+    }
+
+    /// Draws the rain streaks over the rows `y0..y0 + rgb.len() / (3 w)` (`rgb`: those rows of the image), in
+    /// the streaks' order, brighter against dark backgrounds: each pixel sees the same blends in the same order
+    /// as a pass over the whole image.
+    fn draw_streaks(&self, y0: usize, rgb: &mut [u8]) {
+        let width = self.camera.width_px as usize;
+        let (w, h) = (width as f32, self.camera.height_px as f32);
+        let rows = y0..y0 + rgb.len() / (3 * width);
+        let slant = 0.08 + 0.35 * self.light.wind;
+        let bright = 150.0 + 60.0 * (1.0 - self.light.night);
+        for &i in &self.streak_bins[y0 / BAND_ROWS] {
+            let s = self.streaks[i as usize];
+            // The steps that can land in the band (a row of margin each side; the test below is exact).
+            let k0 = (rows.start as f32 - s.y0 - 1.0).max(0.0) as usize;
+            let k1 = ((rows.end as f32 - s.y0 + 1.0).max(0.0) as usize).min(s.steps);
+            for k in k0..k1 {
                 let t = k as f32;
-                let (x, y) = (x0 + t * slant, y0 + t);
+                let (x, y) = (s.x0 + t * slant, s.y0 + t);
                 if y < 0.0 || y >= h || x < 0.0 || x >= w - 1.0 {
+                    continue;
+                }
+                let row = y as usize;
+                if !rows.contains(&row) {
                     continue;
                 }
                 let xf = shade::floor_f32(x);
                 let (xi, fx) = (xf as usize, x - xf);
-                let row = y as usize * out.width;
+                let base = (row - rows.start) * width;
                 for (dx, cov) in [(0usize, 1.0 - fx), (1, fx)] {
-                    let o = (row + xi + dx) * 3;
-                    let a = alpha * cov;
-                    for ch in &mut out.rgb[o..o + 3] {
+                    let o = (base + xi + dx) * 3;
+                    let a = s.alpha * cov;
+                    for ch in &mut rgb[o..o + 3] {
                         *ch = (f32::from(*ch) * (1.0 - a) + bright * a) as u8;
                     }
                 }
