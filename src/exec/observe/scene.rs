@@ -1014,12 +1014,25 @@ pub fn road_paint(scene: &StaticScene, piece: &PieceSurface, p: Vec2) -> Option<
         let poly = &scene.crosswalks[cw as usize];
         if point_in_polygon(poly, p) {
             // Stripes 0.5 m wide every 1 m, parallel to the road.
-            let along = (piece.inner[1] - piece.inner[0]).normalize_or_zero();
-            let across = along.perp();
-            let k = p.dot(across);
-            return (k - k.floor() < 0.5).then_some((Vec3::splat(0.62), tag::ROAD_LINE));
+            let k = p.dot(crosswalk_across(piece));
+            return (k - k.floor() < 0.5).then_some((CROSSWALK_PAINT, tag::ROAD_LINE));
         }
     }
+    road_marking(piece, p)
+}
+
+/// The colour of a crosswalk's stripes (tagged [`tag::ROAD_LINE`]).
+pub const CROSSWALK_PAINT: Vec3 = Vec3::splat(0.62);
+
+/// The unit vector across a piece's road: a point `p` of its crosswalk is on a stripe where
+/// `k = p · across` has `k − ⌊k⌋ < 0.5`.
+#[inline]
+pub fn crosswalk_across(piece: &PieceSurface) -> Vec2 {
+    (piece.inner[1] - piece.inner[0]).normalize_or_zero().perp()
+}
+
+/// [`road_paint`] off the crosswalk: the lane marking at a road point, if any.
+pub fn road_marking(piece: &PieceSurface, p: Vec2) -> Option<(Vec3, u8)> {
     if piece.marks == [Mark::None, Mark::None] {
         return None;
     }

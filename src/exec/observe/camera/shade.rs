@@ -9,7 +9,8 @@ use std::ops::{Add, Mul, Sub};
 use super::lanes::{F, LANES, V3, exp_lanes, floor_int, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use crate::exec::observe::scene::{
-    FrameScene, Material, Prim, SceneCapsule, StaticScene, road_paint, road_paint_near, tag,
+    CROSSWALK_PAINT, FrameScene, Mark, Material, Prim, SceneCapsule, StaticScene, crosswalk_across, road_marking,
+    road_paint_near, tag,
 };
 use crate::mix::splitmix64;
 
@@ -188,20 +189,46 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                     Vec2::new(lane_max(x), lane_max(y)),
                 )
             {
-                let (xs, ys) = (x.to_array(), y.to_array());
-                let mut painted = None;
-                for i in 0..LANES {
-                    let xy = Vec2::new(xs[i], ys[i]);
-                    if let Some((paint, paint_tag)) = road_paint(ctx.scene, piece, xy) {
-                        let lanes = painted.get_or_insert_with(|| albedo.lanes());
-                        lanes[i] = paint * (0.92 + 0.08 * nz.sample(xy * 9.0));
-                        if prim.tag == tag::ROAD {
-                            semantic[i] = paint_tag;
+                // The same paint as `road_paint` lane by lane: the crosswalk (its polygon and stripes) for all
+                // lanes at once, then markings point by point for the lanes off it.
+                let mut off_crosswalk = u32::MAX;
+                if let Some(cw) = piece.crosswalk {
+                    let inside = inside_polygon_lanes(&ctx.scene.crosswalks[cw as usize], x, y);
+                    if inside.any() {
+                        off_crosswalk = !(inside.to_bitmask() as u32);
+                        let across = crosswalk_across(piece);
+                        let k = x * across.x + y * across.y;
+                        let stripe = inside & (k - k.floor()).simd_lt(F::splat(0.5));
+                        if stripe.any() {
+                            let f = F::splat(0.92) + F::splat(0.08) * nz.sample_lanes(x * 9.0, y * 9.0);
+                            albedo = V3::select(stripe, V3::splat(CROSSWALK_PAINT).scale(f), albedo);
+                            if prim.tag == tag::ROAD {
+                                let bits = stripe.to_bitmask() as u32;
+                                for (i, t) in semantic.iter_mut().enumerate() {
+                                    if bits & (1 << i) != 0 {
+                                        *t = tag::ROAD_LINE;
+                                    }
+                                }
+                            }
                         }
                     }
                 }
-                if let Some(lanes) = painted {
-                    albedo = V3::from_lanes(lanes);
+                if piece.marks != [Mark::None, Mark::None] {
+                    let (xs, ys) = (x.to_array(), y.to_array());
+                    let mut painted = None;
+                    for i in (0..LANES).filter(|&i| off_crosswalk & (1 << i) != 0) {
+                        let xy = Vec2::new(xs[i], ys[i]);
+                        if let Some((paint, paint_tag)) = road_marking(piece, xy) {
+                            let lanes = painted.get_or_insert_with(|| albedo.lanes());
+                            lanes[i] = paint * (0.92 + 0.08 * nz.sample(xy * 9.0));
+                            if prim.tag == tag::ROAD {
+                                semantic[i] = paint_tag;
+                            }
+                        }
+                    }
+                    if let Some(lanes) = painted {
+                        albedo = V3::from_lanes(lanes);
+                    }
                 }
             }
         }
@@ -370,6 +397,23 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     (colour, semantic)
 }
 
+/// [`point_in_polygon`](crate::exec::observe::scene::point_in_polygon) at the lanes' points `(x, y)`: the
+/// same even-odd crossings, lane by lane the same result.
+#[inline(always)]
+fn inside_polygon_lanes(poly: &[Vec2], x: F, y: F) -> F {
+    let mut inside = F::ZERO.simd_gt(F::ZERO);
+    let mut j = poly.len().wrapping_sub(1);
+    for (i, &a) in poly.iter().enumerate() {
+        let b = poly[j];
+        let straddles = y.simd_lt(F::splat(a.y)) ^ y.simd_lt(F::splat(b.y));
+        // Lanes that do not straddle the edge may divide by zero here; they are masked out.
+        let left = x.simd_lt(F::splat(b.x - a.x) * (y - a.y) / (b.y - a.y) + a.x);
+        inside ^= straddles & left;
+        j = i;
+    }
+    inside
+}
+
 /// The least of the lanes.
 #[inline(always)]
 fn lane_min(v: F) -> f32 {
@@ -425,6 +469,25 @@ mod tests {
             let got = nz.sample_lanes(F::new(x), F::new(y)).to_array();
             for i in 0..LANES {
                 prop_assert_eq!(got[i], nz.sample(Vec2::new(x[i], y[i])));
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn lane_polygon_tests_equal_single_ones(
+            poly in proptest::collection::vec((-20.0f32..20.0, -20.0f32..20.0), 3..7),
+            x in proptest::array::uniform8(-25.0f32..25.0),
+            y in proptest::array::uniform8(-25.0f32..25.0),
+        ) {
+            // Vertices on the points' rows too (horizontal edges, points level with a vertex).
+            let mut poly: Vec<Vec2> = poly.into_iter().map(|(a, b)| Vec2::new(a, b)).collect();
+            poly[0].y = y[0];
+            poly[1].y = poly[0].y;
+            let got = inside_polygon_lanes(&poly, F::new(x), F::new(y)).to_bitmask();
+            for i in 0..LANES {
+                let want = crate::exec::observe::scene::point_in_polygon(&poly, Vec2::new(x[i], y[i]));
+                prop_assert_eq!(got & (1 << i) != 0, want, "lane {}", i);
             }
         }
     }
