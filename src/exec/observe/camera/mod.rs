@@ -45,6 +45,10 @@ pub const SS: usize = 2;
 pub const NEAR_M: f32 = 0.05;
 /// Static clusters farther than this are not drawn (fog and the terrain plane take over), metres.
 const FAR_M: f32 = 450.0;
+/// The [`Lighting::night`] from which street lamps are lit (from a sun about 4.6° above the horizon down). At
+/// dawn's 5° (0.03) lamps at 3 % of their night intensity changed 0.2 % of a frame's pixels by 3–7 levels and
+/// the rest by at most 2 (PSNR 54.7 dB), and cost a fifth of the frame.
+const LAMPS_ON_NIGHT: f32 = 0.05;
 /// Depth written for sky pixels, metres (CARLA's far plane).
 pub const SKY_DEPTH_M: f32 = 1000.0;
 /// Shadow map: resolution and half-size of the square it covers, metres.
@@ -437,10 +441,13 @@ impl Renderer {
         if self.light.night <= 0.0 {
             return;
         }
-        nearest(&scene.lamps, |l| l.pos, cam, 90.0, 16, &mut self.nearby);
-        self.lights
-            .lamps
-            .extend(self.nearby.iter().map(|&(_, i)| scene.lamps[i as usize].pos));
+        // Street lamps switch on as the day fades (headlights are on whenever it is not full day).
+        if self.light.night >= LAMPS_ON_NIGHT {
+            nearest(&scene.lamps, |l| l.pos, cam, 90.0, 16, &mut self.nearby);
+            self.lights
+                .lamps
+                .extend(self.nearby.iter().map(|&(_, i)| scene.lamps[i as usize].pos));
+        }
         // The ego's own headlights (under the camera), then the nearest traffic's.
         let fwd = pose.forward.as_vec3();
         let axis = Vec3::new(fwd.x, fwd.y, 0.0).normalize_or_zero();
