@@ -5,11 +5,11 @@
 //! is ≥ 60 rendered frames per second on one core.
 //! Run: `cargo bench --bench camera`.
 
-use pedsynth::exec::observe::camera::light::Lighting;
-use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime};
-use pedsynth::exec::observe::{self};
-use pedsynth::exec::write::sensors::{rgb_png, semantic_png};
+use pedsynth::dataset::write::sensors::{rgb_png, semantic_png};
+use pedsynth::sensors;
+use pedsynth::sensors::camera::light::Lighting;
+use pedsynth::sensors::camera::{CameraImages, Renderer, streak_seed};
+use pedsynth::sensors::scene::{FrameScene, SceneTime};
 
 mod common;
 
@@ -69,13 +69,13 @@ fn build_frame_scene(bencher: divan::Bencher) {
 #[divan::bench]
 fn encode_rgb_png(bencher: divan::Bencher) {
     let s = setup("clear_noon");
-    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
+    let img = sensors::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
     bencher.bench_local(|| rgb_png(&img).expect("png").len());
 }
 
 #[divan::bench]
 fn encode_semantic_png(bencher: divan::Bencher) {
     let s = setup("clear_noon");
-    let img = observe::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
+    let img = sensors::render_frame(&s.script, &s.trace, &s.rig, &s.net, s.frame);
     bencher.bench_local(|| semantic_png(&img).expect("png").len());
 }

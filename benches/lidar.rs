@@ -13,10 +13,10 @@
 
 use divan::counter::ItemsCount;
 use glam::Affine3A;
-use pedsynth::dsl::types::Lidar;
-use pedsynth::exec::observe::lidar::{self, ScanScratch, Tracer};
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, ego_at};
-use pedsynth::exec::observe::{self};
+use pedsynth::sensors;
+use pedsynth::sensors::lidar::{self, ScanScratch, Tracer};
+use pedsynth::sensors::scene::{FrameScene, SceneTime, ego_at};
+use pedsynth::spec::types::Lidar;
 
 mod common;
 
@@ -40,7 +40,7 @@ fn setup(town: &str) -> Setup {
     let t = SceneTime::at(clip.frame);
     frame_scene.build(&clip.scene, &clip.script, &clip.trace, t);
     let (pos, yaw) = ego_at(&clip.trace, t);
-    let pose = observe::scene_from(&clip.scene, &clip.rig.world_from_lidar(pos, yaw));
+    let pose = sensors::scene_from(&clip.scene, &clip.rig.world_from_lidar(pos, yaw));
     let mut tracer = Tracer::new(&clip.scene);
     tracer.set_agents(&frame_scene, &pose);
     Setup {

@@ -3,21 +3,15 @@
 
 use std::path::Path;
 
-use pedsynth::commands::load_towns;
-use pedsynth::dsl::{self, LoadOptions};
-use pedsynth::planner;
+use pedsynth::dataset::inputs::load_towns;
+use pedsynth::plan;
+use pedsynth::spec::{self, LoadOptions};
 
 fn main() {
     divan::main();
 }
 
-fn spec(
-    town_override: &str,
-    clips: u32,
-) -> (
-    dsl::LoadedSpec,
-    std::collections::BTreeMap<String, planner::TownContext>,
-) {
+fn spec(town_override: &str, clips: u32) -> (spec::LoadedSpec, std::collections::BTreeMap<String, plan::TownContext>) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
     let options = LoadOptions {
         overrides: vec![
@@ -27,7 +21,7 @@ fn spec(
         ],
         allow_large: true,
     };
-    let loaded = dsl::load_file(&path, &options).expect("valid spec");
+    let loaded = spec::load_file(&path, &options).expect("valid spec");
     let towns = load_towns(&loaded).expect("towns load");
     (loaded, towns)
 }
@@ -38,7 +32,7 @@ fn plan_10k_clips(bencher: divan::Bencher, town: &str) {
     let (loaded, towns) = spec(&format!("dataset.towns=[{town}]"), 834);
     let hash = loaded.hash().expect("hash");
     bencher.bench(|| {
-        let plan = planner::plan(divan::black_box(&loaded.spec), &hash, "specs", &towns, None).expect("feasible");
+        let plan = plan::plan(divan::black_box(&loaded.spec), &hash, "specs", &towns, None).expect("feasible");
         assert_eq!(plan.clips.len(), 10_008);
         plan
     });

@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
-use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::simulate;
+use pedsynth::sim;
+use pedsynth::spec::LoadOptions;
 
 fn main() {
     divan::main();
@@ -18,8 +18,8 @@ fn plan(
     town: &str,
     clips: usize,
 ) -> (
-    std::collections::BTreeMap<String, pedsynth::planner::TownContext>,
-    pedsynth::planner::Plan,
+    std::collections::BTreeMap<String, pedsynth::plan::TownContext>,
+    pedsynth::plan::Plan,
 ) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/pedsynth_pp.yaml");
     let options = LoadOptions {
@@ -33,7 +33,7 @@ fn plan(
         ],
         allow_large: true,
     };
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).expect("feasible spec");
+    let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).expect("feasible spec");
     (towns, plan)
 }
 
@@ -47,7 +47,7 @@ fn simulate_13s_clip_10_peds_10_vehicles(bencher: divan::Bencher, town: &str) {
     let agents = (clip.pedestrians.len() + clip.vehicles.len() + 1) as u64;
     bencher
         .counter(divan::counter::ItemsCount::new(agents * u64::from(clip.frame_count)))
-        .bench(|| simulate::simulate(divan::black_box(clip), &plan.sim, net));
+        .bench(|| sim::simulate(divan::black_box(clip), &plan.sim, net));
 }
 
 #[divan::bench(args = TOWNS, sample_count = 10)]
@@ -61,7 +61,7 @@ fn simulate_8_clips_13s_10_peds_10_vehicles(bencher: divan::Bencher, town: &str)
         .sum();
     bencher.counter(divan::counter::ItemsCount::new(steps)).bench(|| {
         for clip in &plan.clips {
-            divan::black_box(simulate::simulate(divan::black_box(clip), &plan.sim, net));
+            divan::black_box(sim::simulate(divan::black_box(clip), &plan.sim, net));
         }
     });
 }

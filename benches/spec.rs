@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use pedsynth::dsl::{self, LoadOptions};
+use pedsynth::spec::{self, LoadOptions};
 
 fn main() {
     divan::main();
@@ -13,12 +13,12 @@ fn main() {
 fn validate_spec(bencher: divan::Bencher, name: &str) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("specs/{name}.yaml"));
     let options = LoadOptions::default();
-    bencher.bench(|| dsl::load_file(divan::black_box(&path), &options).expect("valid spec"));
+    bencher.bench(|| spec::load_file(divan::black_box(&path), &options).expect("valid spec"));
 }
 
 #[divan::bench]
 fn reject_alias_bomb(bencher: divan::Bencher) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad_specs/alias_bomb.yaml");
     let options = LoadOptions::default();
-    bencher.bench(|| dsl::load_file(divan::black_box(&path), &options).expect_err("rejected"));
+    bencher.bench(|| spec::load_file(divan::black_box(&path), &options).expect_err("rejected"));
 }

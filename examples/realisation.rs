@@ -15,10 +15,11 @@
 
 use std::path::Path;
 
-use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::observe::{self, rig::Rig};
-use pedsynth::exec::simulate;
-use pedsynth::planner::{CrosserSource, Role};
+use pedsynth::plan::{CrosserSource, Role};
+use pedsynth::sensors;
+use pedsynth::sim;
+use pedsynth::sim::rig::Rig;
+use pedsynth::spec::LoadOptions;
 use pedsynth::world::LaneType;
 use rayon::prelude::*;
 
@@ -43,7 +44,7 @@ fn main() {
         allow_large: false,
     };
     for spec in specs {
-        let (_, towns, plan) = match pedsynth::commands::plan_spec_file(Path::new(&spec), &options) {
+        let (_, towns, plan) = match pedsynth::dataset::inputs::plan_spec_file(Path::new(&spec), &options) {
             Ok(x) => x,
             Err(e) => {
                 eprintln!("{e}");
@@ -61,8 +62,8 @@ fn main() {
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
-                let trace = simulate::simulate(clip, &plan.sim, net);
-                let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
+                let trace = sim::simulate(clip, &plan.sim, net);
+                let ann = sensors::observe(clip, &trace, &plan.spec, &rig, net).annotations;
                 let mut c = [0usize; 13];
                 let mut why: Vec<String> = Vec::new();
                 for (i, p) in clip.pedestrians.iter().enumerate() {
@@ -109,7 +110,7 @@ fn main() {
                 }
                 // The executor's realisation (`exec::realise`): (planned labelled crossers, labelled, clips with a
                 // count, clips meeting it, re-simulations, squared miss).
-                let r = pedsynth::exec::realise::realise(clip, &plan.spec, &plan.sim, &rig, net);
+                let r = pedsynth::sensors::realise::realise(clip, &plan.spec, &plan.sim, &rig, net);
                 let wanted = clip.labelled_crossers.map_or(0, |w| w as usize);
                 let got = r.labelled_crossers() as usize;
                 if std::env::var_os("REALISATION_MISSES").is_some() && clip.labelled_crossers.is_some() && got != wanted
@@ -213,8 +214,8 @@ fn main() {
 /// One line on why allocated crosser `i` of `clip` was not labelled a crosser (`kind`), from its trace.
 fn why_unlabelled(
     kind: &str,
-    clip: &pedsynth::planner::ClipScript,
-    trace: &pedsynth::exec::trace::ClipTrace,
+    clip: &pedsynth::plan::ClipScript,
+    trace: &pedsynth::sim::trace::ClipTrace,
     i: usize,
 ) -> String {
     let p = &clip.pedestrians[i];
@@ -230,7 +231,7 @@ fn why_unlabelled(
         .crossing
         .as_ref()
         .and_then(|x| (0..frames.len()).find(|&f| x.near_curb.distance(frames[f].pos.truncate()) < 0.7));
-    let mut states: Vec<pedsynth::exec::trace::PedState> = frames[at.saturating_sub(10 * clip.fps as usize)..=at]
+    let mut states: Vec<pedsynth::sim::trace::PedState> = frames[at.saturating_sub(10 * clip.fps as usize)..=at]
         .iter()
         .map(|f| f.state)
         .collect();
@@ -286,7 +287,7 @@ fn why_unlabelled(
 
 /// Where `pos` lies from the ego in frame `f`, metres: `x` ahead along its heading (negative: behind it), `y`
 /// to its right.
-fn from_ego_m(trace: &pedsynth::exec::trace::ClipTrace, f: usize, pos: glam::DVec3) -> glam::DVec2 {
+fn from_ego_m(trace: &pedsynth::sim::trace::ClipTrace, f: usize, pos: glam::DVec3) -> glam::DVec2 {
     let e = &trace.ego[f];
     let (d, heading) = ((pos - e.pos).truncate(), glam::DVec2::from_angle(e.yaw_rad));
     glam::DVec2::new(d.dot(heading), d.perp_dot(heading))

@@ -7,10 +7,11 @@
 
 use std::path::{Path, PathBuf};
 
-use pedsynth::dsl::LoadOptions;
-use pedsynth::exec::observe::{self, rig::Rig};
-use pedsynth::exec::simulate;
-use pedsynth::exec::write::sensors::{rgb_png, semantic_png};
+use pedsynth::dataset::write::sensors::{rgb_png, semantic_png};
+use pedsynth::sensors;
+use pedsynth::sim;
+use pedsynth::sim::rig::Rig;
+use pedsynth::spec::LoadOptions;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -31,7 +32,7 @@ fn main() {
         overrides,
         allow_large: false,
     };
-    let (_, towns, plan) = match pedsynth::commands::plan_spec_file(Path::new(spec), &options) {
+    let (_, towns, plan) = match pedsynth::dataset::inputs::plan_spec_file(Path::new(spec), &options) {
         Ok(x) => x,
         Err(e) => {
             eprintln!("{e}");
@@ -46,8 +47,8 @@ fn main() {
         .filter(|c| only.as_ref().is_none_or(|id| *id == c.clip_id))
     {
         let net = &towns[&clip.town].network;
-        let trace = simulate::simulate(clip, &plan.sim, net);
-        let ann = observe::observe(clip, &trace, &plan.spec, &rig, net).annotations;
+        let trace = sim::simulate(clip, &plan.sim, net);
+        let ann = sensors::observe(clip, &trace, &plan.spec, &rig, net).annotations;
         let frame = fixed.unwrap_or_else(|| {
             let mut counts = vec![0u32; trace.frame_count as usize];
             for r in &ann.rows {
@@ -60,7 +61,7 @@ fn main() {
                 .map_or(0, |(f, _)| f as u32)
         });
         let start = std::time::Instant::now();
-        let img = observe::render_frame(clip, &trace, &rig, net, frame);
+        let img = sensors::render_frame(clip, &trace, &rig, net, frame);
         let took = start.elapsed();
         let (rgb, sem) = (rgb_png(&img).expect("png"), semantic_png(&img).expect("png"));
         let name = format!("{}-{frame:06}", clip.clip_id);
@@ -69,7 +70,7 @@ fn main() {
         let mean: f64 = img
             .rgb
             .chunks_exact(3)
-            .map(|p| f64::from(pedsynth::exec::observe::camera::luminance(p)))
+            .map(|p| f64::from(pedsynth::sensors::camera::luminance(p)))
             .sum::<f64>()
             / (img.width * img.height) as f64;
         println!(

@@ -10,19 +10,19 @@ const NOWHERE: &str = "pedsynth-fuzz-nowhere";
 
 /// The spec loader: YAML parsing (with its budget), the schema, every validation rule.
 pub fn spec(data: &[u8]) {
-    let options = crate::dsl::LoadOptions::default();
-    let _ = crate::dsl::load_bytes(data, "fuzz.yaml", Path::new(NOWHERE), &options);
+    let options = crate::spec::LoadOptions::default();
+    let _ = crate::spec::load_bytes(data, "fuzz.yaml", Path::new(NOWHERE), &options);
 }
 
 /// The plan reader: JSON, versions, the spec inside, town fingerprints, and the clips against their spec.
 pub fn plan(data: &[u8]) {
-    let _ = crate::commands::read_plan_bytes(data, &Path::new(NOWHERE).join("plan.json"));
+    let _ = crate::dataset::inputs::read_plan_bytes(data, &Path::new(NOWHERE).join("plan.json"));
 }
 
 /// The OpenDRIVE importer, then what the planner derives from a town (spawn points, fingerprint).
 pub fn xodr(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else { return };
     if let Ok(network) = crate::world::RoadNetwork::from_xodr_str(text, "fuzz.xodr") {
-        let _ = crate::planner::TownContext::new(network);
+        let _ = crate::plan::TownContext::new(network);
     }
 }

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use pedsynth::commands;
-use pedsynth::dsl::LoadOptions;
+use pedsynth::cli;
+use pedsynth::spec::LoadOptions;
 
 /// Synthetic pedestrian-crossing datasets for autonomous-driving research.
 #[derive(Parser)]
@@ -219,7 +219,7 @@ enum Command {
     Export {
         /// Format to write.
         #[arg(value_enum)]
-        format: pedsynth::exec::export::Format,
+        format: pedsynth::dataset::export::Format,
         /// Dataset directory (written by `pedsynth generate`, every clip done).
         dir: PathBuf,
         /// Output directory (re-running resumes: complete files are kept).
@@ -227,7 +227,7 @@ enum Command {
         out: PathBuf,
         /// How images get there from the dataset's sensors/.
         #[arg(long, value_enum, default_value = "hard")]
-        link: pedsynth::exec::export::LinkMode,
+        link: pedsynth::dataset::export::LinkMode,
         /// Copy images (same as `--link copy`).
         #[arg(long, conflicts_with = "link")]
         copy: bool,
@@ -270,7 +270,7 @@ fn parse_pair(text: &str) -> Result<(usize, usize), String> {
 }
 
 fn parse_shard(text: &str) -> Result<(usize, usize), String> {
-    pedsynth::commands::parse_shard(text)
+    cli::parse_shard(text)
 }
 
 /// How `generate` reports progress.
@@ -308,9 +308,9 @@ enum TownCommand {
 }
 
 fn main() -> ExitCode {
-    if let Some(message) = commands::unsupported_cpu() {
+    if let Some(message) = cli::unsupported_cpu() {
         eprint!("{message}");
-        return ExitCode::from(commands::exit::FAILURE as u8);
+        return ExitCode::from(pedsynth::error::exit::FAILURE as u8);
     }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -319,9 +319,9 @@ fn main() -> ExitCode {
             // still tells.
             err.print().ok();
             let code = if err.use_stderr() {
-                commands::exit::INVALID
+                pedsynth::error::exit::INVALID
             } else {
-                commands::exit::OK
+                pedsynth::error::exit::OK
             };
             return ExitCode::from(code as u8);
         }
@@ -338,17 +338,17 @@ fn main() -> ExitCode {
             specs,
             resolved,
             spec_args,
-        } => commands::validate(&specs, &load_options(spec_args), resolved, &mut out),
+        } => cli::validate(&specs, &load_options(spec_args), resolved, &mut out),
         Command::Plan {
             spec,
             json,
             emit,
             only,
             spec_args,
-        } => commands::plan(
+        } => cli::plan(
             &spec,
             &load_options(spec_args),
-            &commands::PlanArgs { json, emit, only },
+            &cli::PlanArgs { json, emit, only },
             &mut out,
         ),
         Command::Generate {
@@ -361,7 +361,7 @@ fn main() -> ExitCode {
             shard,
             spec_args,
         } => {
-            let args = commands::GenerateArgs {
+            let args = cli::GenerateArgs {
                 out: dir,
                 jobs,
                 only,
@@ -369,7 +369,7 @@ fn main() -> ExitCode {
                 progress_json: progress == ProgressFormat::Json,
                 shard,
             };
-            commands::generate(&input, &load_options(spec_args), &args, &mut out)
+            cli::generate(&input, &load_options(spec_args), &args, &mut out)
         }
         Command::Stats {
             dir,
@@ -380,13 +380,13 @@ fn main() -> ExitCode {
             overlap,
             min_track,
         } => {
-            let options = protocol.map(|Protocol::Pab| pedsynth::exec::read::protocol::PabOptions {
+            let options = protocol.map(|Protocol::Pab| pedsynth::dataset::read::protocol::PabOptions {
                 obs_length,
                 tte_frames: tte,
                 overlap,
                 min_track: min_track.unwrap_or(obs_length + tte.1),
             });
-            commands::stats(&dir, json, options.as_ref(), &mut out)
+            cli::stats(&dir, json, options.as_ref(), &mut out)
         }
         Command::Preview {
             dir,
@@ -394,7 +394,7 @@ fn main() -> ExitCode {
             stream,
             out: file,
         } => {
-            use pedsynth::exec::read::preview::{PreviewOptions, Stream};
+            use pedsynth::dataset::read::preview::{PreviewOptions, Stream};
             let (stream, name) = match stream {
                 PreviewStream::Rgb => (Stream::Rgb, "rgb"),
                 PreviewStream::Semantic => (Stream::Semantic, "semantic"),
@@ -404,7 +404,7 @@ fn main() -> ExitCode {
                 PreviewStream::Lidar => (Stream::Lidar, "lidar"),
             };
             let file = file.unwrap_or_else(|| PathBuf::from(format!("{clip}.{name}.png")));
-            commands::preview(
+            cli::preview(
                 &dir,
                 &PreviewOptions {
                     clip,
@@ -422,18 +422,18 @@ fn main() -> ExitCode {
             copy,
         } => {
             let link = if copy {
-                pedsynth::exec::export::LinkMode::Copy
+                pedsynth::dataset::export::LinkMode::Copy
             } else {
                 link
             };
-            commands::export(&dir, format, &to, link, &mut out, &mut err)
+            cli::export(&dir, format, &to, link, &mut out, &mut err)
         }
         Command::Merge {
             input,
             out: dir,
             shards,
             spec_args,
-        } => commands::merge(&input, &load_options(spec_args), &dir, &shards, &mut out),
+        } => cli::merge(&input, &load_options(spec_args), &dir, &shards, &mut out),
         Command::Slurm {
             input,
             out: dir,
@@ -447,7 +447,7 @@ fn main() -> ExitCode {
             spec_args,
         } => {
             let options = load_options(spec_args);
-            let slurm = pedsynth::exec::generate::cluster::SlurmOptions {
+            let slurm = pedsynth::cli::cluster::SlurmOptions {
                 input: input.display().to_string(),
                 overrides: options.overrides.clone(),
                 out: dir.display().to_string(),
@@ -458,7 +458,7 @@ fn main() -> ExitCode {
                 partition,
                 pedsynth,
             };
-            commands::slurm(&input, &options, &slurm, script.as_deref(), &mut out)
+            cli::slurm(&input, &options, &slurm, script.as_deref(), &mut out)
         }
         Command::K8s {
             input,
@@ -474,7 +474,7 @@ fn main() -> ExitCode {
             manifest,
             spec_args,
         } => {
-            let k8s = pedsynth::exec::generate::cluster::K8sOptions {
+            let k8s = pedsynth::cli::cluster::K8sOptions {
                 name,
                 completions,
                 parallelism,
@@ -485,20 +485,20 @@ fn main() -> ExitCode {
                 out: dir,
                 spec_on_volume,
             };
-            commands::k8s(&input, &load_options(spec_args), &k8s, manifest.as_deref(), &mut out)
+            cli::k8s(&input, &load_options(spec_args), &k8s, manifest.as_deref(), &mut out)
         }
-        Command::Verify { dir, tables_only } => commands::verify(&dir, tables_only, &mut out),
-        Command::Schema => commands::schema(&mut out),
+        Command::Verify { dir, tables_only } => cli::verify(&dir, tables_only, &mut out),
+        Command::Schema => cli::schema(&mut out),
         Command::Town {
             command: TownCommand::List,
-        } => commands::town_list(&mut out),
+        } => cli::town_list(&mut out),
         Command::Town {
             command: TownCommand::Show { town, png, json },
-        } => commands::town_show(&town, png.as_deref(), json, &mut out),
+        } => cli::town_show(&town, png.as_deref(), json, &mut out),
         Command::Town {
             command: TownCommand::Export { town, xodr },
-        } => commands::town_export(&town, &xodr, &mut out),
+        } => cli::town_export(&town, &xodr, &mut out),
     };
-    let code = commands::finish(result, &mut err);
+    let code = cli::finish(result, &mut err);
     ExitCode::from(code as u8)
 }

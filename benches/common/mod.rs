@@ -4,17 +4,17 @@
 
 use std::path::Path;
 
-use pedsynth::dsl::LoadOptions;
-use pedsynth::dsl::types::Sensors;
-use pedsynth::exec::observe::camera::light::Lighting;
-use pedsynth::exec::observe::camera::{CameraImages, Renderer, streak_seed};
-use pedsynth::exec::observe::rig::CameraPose;
-use pedsynth::exec::observe::rig::Rig;
-use pedsynth::exec::observe::scene::{FrameScene, SceneTime, StaticScene, ego_at};
-use pedsynth::exec::observe::{self};
-use pedsynth::exec::simulate;
-use pedsynth::exec::trace::ClipTrace;
-use pedsynth::planner::ClipScript;
+use pedsynth::plan::ClipScript;
+use pedsynth::sensors;
+use pedsynth::sensors::camera::light::Lighting;
+use pedsynth::sensors::camera::{CameraImages, Renderer, streak_seed};
+use pedsynth::sensors::scene::{FrameScene, SceneTime, StaticScene, ego_at};
+use pedsynth::sim;
+use pedsynth::sim::rig::CameraPose;
+use pedsynth::sim::rig::Rig;
+use pedsynth::sim::trace::ClipTrace;
+use pedsynth::spec::LoadOptions;
+use pedsynth::spec::types::Sensors;
 use pedsynth::world::RoadNetwork;
 
 /// A simulated clip and its busiest annotated frame.
@@ -35,12 +35,12 @@ pub fn busy_quickstart_clip(overrides: &[String]) -> BusyClip {
         overrides: overrides.to_vec(),
         allow_large: false,
     };
-    let (_, towns, plan) = pedsynth::commands::plan_spec_file(&path, &options).expect("quickstart plans");
+    let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).expect("quickstart plans");
     let script = plan.clips[0].clone();
     let net = towns[&script.town].network.clone();
-    let trace = simulate::simulate(&script, &plan.sim, &net);
+    let trace = sim::simulate(&script, &plan.sim, &net);
     let rig = Rig::from_spec(&plan.spec.sensors);
-    let ann = observe::observe(&script, &trace, &plan.spec, &rig, &net).annotations;
+    let ann = sensors::observe(&script, &trace, &plan.spec, &rig, &net).annotations;
     let mut counts = vec![0u32; trace.frame_count as usize];
     for r in &ann.rows {
         counts[r.frame as usize] += 1;

@@ -23,8 +23,7 @@
 //! biking and other lanes); `road_width_m` is its width. The model is 2-D for queries: elevation is kept per
 //! piece (`z_m`) but `lane_at` ignores it (CARLA's bridges overlap roads below them in plan view).
 
-mod builtin;
-pub mod cli;
+pub(crate) mod builtin;
 pub(crate) mod grid;
 mod index;
 mod obstacles;
@@ -39,7 +38,6 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-pub use cli::{town_export, town_list_text, town_show};
 pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSample, SpawnPoint};
 pub use signals::Signal;
 
@@ -185,6 +183,33 @@ pub enum WorldError {
         help("built-in towns: town01_like, town02_like, town03_like, town05_like; or give a path to an .xodr file")
     )]
     UnknownTown { name: String },
+}
+
+impl crate::error::Report for WorldError {
+    fn code(&self) -> &'static str {
+        use crate::error::code;
+        match self {
+            WorldError::XodrSyntax { .. } => code::XODR_SYNTAX,
+            WorldError::XodrInvalid { .. } => code::XODR_INVALID,
+            WorldError::XodrTooLarge { .. } => code::XODR_TOO_LARGE,
+            WorldError::Io { .. } => code::WORLD_IO,
+            WorldError::UnknownTown { .. } => code::UNKNOWN_TOWN,
+        }
+    }
+
+    fn summary(&self) -> String {
+        self.to_string()
+    }
+
+    fn render(&self) -> String {
+        crate::error::render_diagnostic(self)
+    }
+}
+
+impl From<WorldError> for crate::error::Error {
+    fn from(e: WorldError) -> Self {
+        crate::error::Error::report(e)
+    }
 }
 
 /// What a lane is for. Unknown OpenDRIVE types map to `Other`; `curb` maps to `Border`; the driving-like types
@@ -508,7 +533,7 @@ impl RoadNetwork {
     pub fn from_xodr_file(path: &Path) -> Result<RoadNetwork, WorldError> {
         let shown = path.display().to_string();
         // Capped while reading: a FIFO or a device reports no size, a growing file a wrong one.
-        let bytes = crate::fsutil::read_capped(path, opendrive::MAX_FILE_BYTES).map_err(|source| {
+        let bytes = crate::util::files::read_capped(path, opendrive::MAX_FILE_BYTES).map_err(|source| {
             if source.kind() == std::io::ErrorKind::FileTooLarge {
                 WorldError::XodrTooLarge {
                     path: shown.clone(),
@@ -652,6 +677,12 @@ fn bytecount_lines(b: &[u8]) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn builtin_town_names_match_the_spec_language() {
+        let names: Vec<&str> = crate::spec::types::BuiltinTown::ALL.iter().map(|t| t.name()).collect();
+        assert_eq!(names, BUILTIN_TOWN_NAMES);
+    }
 
     #[test]
     fn carla_frame_round_trip() {

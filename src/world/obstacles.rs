@@ -132,7 +132,7 @@ pub(crate) fn synthesize_buildings(net: &RoadNetwork) -> Vec<Obstacle> {
                 continue;
             }
             let depth = 12.0;
-            let h = crate::mix::splitmix64((li as u64) << 20 | start as u64);
+            let h = crate::util::mix::splitmix64((li as u64) << 20 | start as u64);
             let height = 8.0 + (h % 23) as f64;
             let o = Obstacle {
                 kind: ObstacleKind::Building,

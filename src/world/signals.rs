@@ -15,8 +15,7 @@
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-use super::opendrive::build::ref_at;
-use super::opendrive::parse::RawNetwork;
+use super::opendrive::parse::{RawNetwork, ref_at};
 use super::{LaneType, RoadNetwork, Route, point_in_polygon};
 
 /// A vehicle stops this far before the end of its approach road: the crosswalks at junction mouths span 0.5 to

@@ -8,7 +8,7 @@
 use glam::DVec2;
 
 use super::geometry::{Poly3At, eval_piecewise};
-use super::parse::{RawNetwork, RawRoad, RawSection};
+use super::parse::{RawNetwork, RawRoad, RawSection, ref_at};
 use super::{MAX_LANE_OFFSET_M, MAX_PIECES, MAX_WIDTH_M};
 use crate::world::{
     Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, ObstacleKind, Road, RoadNetwork, TownSource,
@@ -25,13 +25,6 @@ const DEFAULT_SPEED_MPS: f64 = 50.0 / 3.6;
 pub(crate) fn line_of(xml: &str, pos: u32) -> u32 {
     let end = (pos as usize).min(xml.len());
     1 + xml.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() as u32
-}
-
-/// Reference-line position and heading at `s`.
-pub(crate) fn ref_at(road: &RawRoad, s: f64) -> (DVec2, f64) {
-    let gi = road.geometries.partition_point(|g| g.s <= s + 1e-9).saturating_sub(1);
-    let g = &road.geometries[gi];
-    g.eval(s - g.s)
 }
 
 fn left_normal(h: f64) -> DVec2 {

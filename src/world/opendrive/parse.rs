@@ -5,6 +5,7 @@
 //! defaults. Strict where it matters: malformed XML, missing plan-view geometry, non-numeric, NaN/inf or
 //! absurd numbers are errors naming the file and the element's line. Never panics.
 
+use glam::DVec2;
 use roxmltree::{Document, Node, ParsingOptions};
 
 use super::geometry::{GeomKind, Geometry, Poly3At};
@@ -606,4 +607,11 @@ fn parse_object(cx: &Ctx, o: Node) -> Result<RawObject, WorldError> {
         outline,
         outline_in_road_coords: road_coords,
     })
+}
+
+/// Reference-line position and heading at `s`.
+pub(crate) fn ref_at(road: &RawRoad, s: f64) -> (DVec2, f64) {
+    let gi = road.geometries.partition_point(|g| g.s <= s + 1e-9).saturating_sub(1);
+    let g = &road.geometries[gi];
+    g.eval(s - g.s)
 }

@@ -18,11 +18,12 @@ use std::fmt::Write as _;
 
 use glam::DVec2;
 
-use super::build::{CrosswalkCorners, crosswalk_corners, ref_at};
+use super::build::{CrosswalkCorners, crosswalk_corners};
 use super::geometry::{GeomKind, Poly3At};
+use super::parse::ref_at;
 use super::parse::{RawLane, RawNetwork, RawRoad};
+use crate::util::xml::escape as xml_escape;
 use crate::world::{LaneType, Obstacle, RoadLink, RoadNetwork, WorldError, builtin};
-use crate::xml::escape as xml_escape;
 
 /// The OpenDRIVE revision written.
 pub const XODR_REV: (u32, u32) = (1, 7);

@@ -1,0 +1,714 @@
+//! Annotation of a simulated clip: the visibility gate, tight 2D boxes of the projected body, COCO-17
+//! keypoints with visibility flags, occlusion by vehicles, buildings, street lamps and other pedestrians, per-frame crossing
+//! labels with temporal smoothing, sequence labels, time-to-event and intention onset.
+//!
+//! Crossing label (the paper's definition): C = 1 in a frame when the pedestrian is in a crossing-type state
+//! *and* stands on a driving lane; C stays 1 for up to `crossing_label_smoothing_frames` frames after it
+//! leaves the driving lane while still in a crossing-type state (shoulders, parking strips, lane seams).
+//! Sequence label (JAAD/PIE): a crosser has C = 1 in at least one annotated frame. TTE counts the frames until
+//! the first C = 1 (0 at that frame, null after it and for pedestrians that never cross).
+//!
+//! Behaviour labels in PIE's and JAAD's terms: `look` (the head's gaze within `look_cone_deg` of the direction
+//! to the camera), `action` (walking from 0.3 m/s), the gesture and the reaction the trace records, and the
+//! gaze direction itself.
+
+use glam::{DVec2, DVec3};
+
+use super::body::{self, BodyPose, CHILD_OFFSET_M, Capsule};
+use super::cyclist;
+use super::scene;
+use crate::plan::ClipScript;
+use crate::sim::gate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px, min_box, too_small};
+use crate::sim::rig::{Camera, CameraPose};
+use crate::sim::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction, WalkSignal};
+use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
+use crate::spec::types::Annotations;
+use crate::world::{LaneType, RoadNetwork};
+
+/// Why a pedestrian-frame is not annotated (the first gate it fails).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rejections {
+    /// Farther than the gate's distance.
+    pub too_far: u64,
+    /// Behind the camera.
+    pub behind: u64,
+    /// Box smaller than the gate's minimum.
+    pub too_small: u64,
+    /// Box not inside the image.
+    pub outside_image: u64,
+    /// Occluded beyond the threshold.
+    pub occluded: u64,
+}
+
+/// One annotated pedestrian-frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnnotationRow {
+    /// Frame index.
+    pub frame: u32,
+    /// Pedestrian id.
+    pub pedestrian: u32,
+    /// Tight 2D box `[x_min, y_min, x_max, y_max]`, pixels.
+    pub bbox_px: [f32; 4],
+    /// Crossing label C.
+    pub crossing: bool,
+    /// Behaviour state.
+    pub state: PedState,
+    /// Ground distance from the ego vehicle, metres.
+    pub distance_m: f32,
+    /// Frames until the first C = 1 (None after it and for non-crossers).
+    pub tte_frames: Option<i32>,
+    /// Share of the body's sample points hidden by other objects.
+    pub occlusion: f32,
+    /// COCO-17 keypoints: `x, y, v` per joint (v: 0 outside the image, 1 occluded, 2 visible).
+    pub keypoints: [f32; 51],
+    /// The 17 joints in the world, `x, y, z` per joint, metres.
+    pub keypoints_3d: [f32; 51],
+    /// Ground position, metres.
+    pub pos_m: [f32; 3],
+    /// Body yaw, radians.
+    pub yaw_rad: f32,
+    /// Ground velocity, m/s.
+    pub velocity_mps: [f32; 2],
+    /// Lane type under the pedestrian.
+    pub lane_type: Option<LaneType>,
+    /// Centre of the 3D box, metres.
+    pub box3d_centre_m: [f32; 3],
+    /// Extents of the 3D box (length, width, height), metres.
+    pub box3d_size_m: [f32; 3],
+    /// Whether the pedestrian looks at the ego's camera ([`looks_at`]).
+    pub look: bool,
+    /// Whether it walks (ground speed at least [`WALKING_MPS`]) rather than stands.
+    pub walking: bool,
+    /// The gesture it makes to the ego's driver.
+    pub gesture: Option<Gesture>,
+    /// Its reaction to a vehicle.
+    pub reaction: Option<Reaction>,
+    /// Whether it stands on a crosswalk.
+    pub on_crosswalk: bool,
+    /// The pedestrian signal of its signalised crosswalk, where lights run.
+    pub walk_signal: Option<WalkSignal>,
+    /// Whether it is crossing (a crossing state) while its signal shows "don't walk".
+    pub against_signal: bool,
+    /// The head's forward direction in the world (unit vector).
+    pub gaze: [f32; 3],
+}
+
+/// A pedestrian moving at least this fast walks (PIE's and JAAD's `action`), m/s.
+pub const WALKING_MPS: f64 = 0.3;
+
+/// Whether a head at `eyes` looking along the unit vector `gaze` looks at `target`: the angle between `gaze`
+/// and the direction to `target` is at most `cone_deg`.
+pub fn looks_at(gaze: DVec3, eyes: DVec3, target: DVec3, cone_deg: f64) -> bool {
+    let to_target = (target - eyes).normalize_or_zero();
+    to_target != DVec3::ZERO && gaze.dot(to_target) >= cone_deg.to_radians().cos()
+}
+
+/// Per-pedestrian results over the whole clip.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PedestrianLabels {
+    /// Sequence label: C = 1 in at least one annotated frame.
+    pub crosser: bool,
+    /// First frame with C = 1 (in any frame, annotated or not).
+    pub first_crossing_frame: Option<u32>,
+    /// Frame of the decision to cross (intention onset).
+    pub intention_frame: Option<u32>,
+    /// Number of annotated frames.
+    pub annotated_frames: u32,
+}
+
+/// The annotations of one clip.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClipAnnotations {
+    /// Annotated pedestrian-frames, ordered by (frame, pedestrian).
+    pub rows: Vec<AnnotationRow>,
+    /// Per pedestrian, indexed by id.
+    pub pedestrians: Vec<PedestrianLabels>,
+    /// Counts of pedestrian-frames that failed the visibility gate, by reason.
+    pub rejections: Rejections,
+    /// Crossing label C of every pedestrian (by id) in every frame, annotated or not.
+    pub crossing: Vec<Vec<bool>>,
+    /// Every cyclist-frame in front of the camera whose box reaches at least a pixel into the image, ordered by
+    /// (frame, cyclist).
+    pub cyclists: Vec<CyclistRow>,
+}
+
+/// A cyclist seen by the camera in one frame: the box of rider and bicycle, the rider's keypoints.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CyclistRow {
+    /// Frame index.
+    pub frame: u32,
+    /// Cyclist id.
+    pub cyclist: u32,
+    /// 2D box of the rider and the bicycle, `[x_min, y_min, x_max, y_max]`, pixels, clipped to the image.
+    pub bbox_px: [f32; 4],
+    /// Whether the box was cut by the image's border.
+    pub truncated: bool,
+    /// Ground distance from the ego vehicle, metres.
+    pub distance_m: f32,
+    /// Share of the rider's sample points (17 joints, 5 body samples) hidden from the camera.
+    pub occlusion: f32,
+    /// Whether it passes the pedestrians' visibility gate (distance, minimum box size, inside the image when
+    /// required, occlusion).
+    pub annotated: bool,
+    /// The rider's COCO-17 keypoints `(u, v, flag)` (flag 2 visible, 1 occluded, 0 outside the image).
+    pub keypoints: [f32; 51],
+    /// The rider's joints in the world, `(x, y, z)` metres.
+    pub keypoints_3d: [f32; 51],
+}
+
+/// Occluder owner ids of cyclists' riders start here (pedestrians own their ids).
+const RIDER_OWNER_BASE: u32 = 1 << 31;
+/// Radius of the cylinder standing in for a cyclist when testing occlusion, metres.
+const RIDER_OCCLUDER_RADIUS_M: f64 = 0.3;
+
+/// Per-frame crossing labels of one pedestrian: raw (state ∧ driving lane), then smoothed.
+pub fn crossing_labels(frames: &[PedFrame], smoothing_frames: u32) -> Vec<bool> {
+    let mut out = Vec::with_capacity(frames.len());
+    let mut since_on_road: Option<u32> = None;
+    for f in frames {
+        let raw = f.state.is_crossing() && f.lane_type == Some(LaneType::Driving);
+        let label = if raw {
+            since_on_road = Some(0);
+            true
+        } else if f.state.is_crossing() {
+            let held = since_on_road.is_some_and(|n| n < smoothing_frames);
+            since_on_road = since_on_road.map(|n| n + 1);
+            held
+        } else {
+            since_on_road = None;
+            false
+        };
+        out.push(label);
+    }
+    out
+}
+
+/// An obstacle for occlusion rays in one frame.
+#[derive(Clone, Copy, Debug)]
+enum Occluder {
+    /// A vehicle: ground centre and `yaw.sin_cos()` (computed once per frame, not once per ray).
+    Vehicle { centre: DVec3, sin_cos: (f64, f64) },
+    /// A pedestrian body as an upright cylinder: ground point, radius, height, owner id.
+    Person {
+        ground: DVec3,
+        radius_m: f64,
+        height_m: f64,
+        owner: u32,
+    },
+    /// A street lamp's pole (the square, axis-aligned box the renderer draws): its centre and half extents.
+    Pole { centre: DVec3, half_m: DVec3 },
+}
+
+/// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
+fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
+    match *occ {
+        Occluder::Vehicle { centre, sin_cos } => crate::world::segment_hits_box(
+            from,
+            d,
+            t_max,
+            centre + DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5),
+            sin_cos,
+            DVec3::new(VEHICLE_LENGTH_M * 0.5, VEHICLE_WIDTH_M * 0.5, VEHICLE_HEIGHT_M * 0.5),
+        ),
+        Occluder::Person {
+            ground,
+            radius_m,
+            height_m,
+            ..
+        } => crate::world::segment_hits_cylinder(from, d, t_max, ground, radius_m, height_m),
+        Occluder::Pole { centre, half_m } => crate::world::segment_hits_box(from, d, t_max, centre, (0.0, 1.0), half_m),
+    }
+}
+
+/// The lamp poles of the clip's scene, as the renderer draws them ([`scene::clip_lamp_posts`]; the arm and the
+/// light are above any line of sight to a pedestrian).
+fn lamp_poles(trace: &ClipTrace, town: &RoadNetwork) -> Vec<Occluder> {
+    let half = f64::from(scene::LAMP_POLE_HALF_WIDTH_M);
+    let height_m = f64::from(scene::LAMP_HEIGHT_M + scene::LAMP_POLE_ABOVE_LIGHT_M);
+    scene::clip_lamp_posts(trace, town)
+        .into_iter()
+        .map(|post| Occluder::Pole {
+            centre: post.foot.extend(post.base_z_m + height_m * 0.5),
+            half_m: DVec3::new(half, half, height_m * 0.5),
+        })
+        .collect()
+}
+
+/// Whether the line of sight from the camera to `target` is blocked by one of `occluders` (already stripped of
+/// the target pedestrian's own body) or by a static obstacle.
+fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: DVec3) -> bool {
+    let d = target - camera;
+    let t_max = 1.0 - 0.05 / d.length().max(0.05);
+    occluders.iter().any(|occ| blocks(occ, camera, d, t_max))
+        || town.first_obstacle_hit(camera, camera + d * t_max).is_some()
+}
+
+/// Whether `occ` could block any line of sight from `camera` to a point within `reach_m` (in plan view) of
+/// `target`: such a line stays within `reach_m` of the segment `camera → target` in plan view, and an
+/// occluder lies within its bounding circle, so one farther than both radii from that segment blocks none.
+fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f64) -> bool {
+    let (centre, radius_m) = match *occ {
+        Occluder::Vehicle { centre, .. } => (centre.truncate(), VEHICLE_LENGTH_M.hypot(VEHICLE_WIDTH_M) * 0.5),
+        Occluder::Person { ground, radius_m, .. } => (ground.truncate(), radius_m),
+        Occluder::Pole { centre, half_m } => (centre.truncate(), half_m.truncate().length()),
+    };
+    let r = radius_m + reach_m + 1e-6;
+    crate::world::segment_projection(camera, target, centre).1 <= r * r
+}
+
+/// The image interval `[lo, hi]` covered by a sphere along one image axis, exactly (perspective included):
+/// `lateral` and `depth` are the centre's optical coordinates along that axis and along the optical axis,
+/// `r` its radius, `focal` and `principal` the intrinsics along the axis. The bounds are the planes through
+/// the camera centre tangent to the sphere; the sphere must lie entirely in front of the camera.
+fn sphere_interval(lateral: f64, depth: f64, r: f64, focal: f64, principal: f64) -> (f64, f64) {
+    // A plane `lateral = k·depth` is tangent when (lateral − k·depth)² = r²(1 + k²).
+    let a = depth * depth - r * r;
+    let disc = (lateral * lateral + a).max(0.0).sqrt();
+    let k_lo = (lateral * depth - r * disc) / a;
+    let k_hi = (lateral * depth + r * disc) / a;
+    (focal * k_lo + principal, focal * k_hi + principal)
+}
+
+/// The tight 2D box of a posed body: the exact extremes of the projected silhouette. A capsule is the convex
+/// hull of its two end spheres, and a projection of a convex hull (in front of the camera) is the convex hull
+/// of the projections, so the box is the union of the end spheres' exact image intervals.
+/// Returns None if any part of the body is within 5 cm of the camera plane or behind it.
+pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
+    project_capsules_box(&pose.capsules, cam)
+}
+
+/// [`project_box`] of any set of capsules (a cyclist: its rider and its bicycle).
+pub fn project_capsules_box<'a>(capsules: impl IntoIterator<Item = &'a Capsule>, cam: &CameraPose) -> Option<[f64; 4]> {
+    let c = &cam.camera;
+    let (cx, cy) = (f64::from(c.width_px) * 0.5, f64::from(c.height_px) * 0.5);
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for cap in capsules {
+        for centre in [cap.a, cap.b] {
+            let p = cam.optical_from_world.transform_point3(centre);
+            if p.z - cap.radius_m <= 0.05 {
+                return None;
+            }
+            let (u0, u1) = sphere_interval(p.x, p.z, cap.radius_m, c.focal_px, cx);
+            let (v0, v1) = sphere_interval(p.y, p.z, cap.radius_m, c.focal_px, cy);
+            lo = lo.min(DVec2::new(u0, v0));
+            hi = hi.max(DVec2::new(u1, v1));
+        }
+    }
+    Some([lo.x, lo.y, hi.x, hi.y])
+}
+
+/// Annotates a simulated clip.
+pub fn annotate(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    annotations: &Annotations,
+    camera: &Camera,
+    town: &RoadNetwork,
+) -> ClipAnnotations {
+    let gate = &annotations.visibility;
+    let n_peds = trace.pedestrians.len();
+    let heights: Vec<(f64, Option<f64>)> = script
+        .pedestrians
+        .iter()
+        .map(|p| (p.identity.height_m, p.child.map(|c| c.height_m)))
+        .chain(std::iter::repeat((1.75, None)))
+        .take(n_peds)
+        .collect();
+    let rider_heights: Vec<f64> = (0..trace.cyclists.len())
+        .map(|k| script.cyclists.get(k).map_or(1.75, |c| c.rider.height_m))
+        .collect();
+    let labels: Vec<Vec<bool>> = trace
+        .pedestrians
+        .iter()
+        .map(|f| crossing_labels(f, annotations.crossing_label_smoothing_frames))
+        .collect();
+    let first_crossing: Vec<Option<u32>> = labels
+        .iter()
+        .map(|l| l.iter().position(|c| *c).map(|f| f as u32))
+        .collect();
+    let mut out = ClipAnnotations {
+        rows: Vec::new(),
+        pedestrians: vec![PedestrianLabels::default(); n_peds],
+        rejections: Rejections::default(),
+        crossing: Vec::new(),
+        cyclists: Vec::new(),
+    };
+    for (i, p) in out.pedestrians.iter_mut().enumerate() {
+        p.first_crossing_frame = first_crossing[i];
+    }
+    for e in &trace.events {
+        if let Event::CrossingDecision { frame, pedestrian } = e
+            && let Some(p) = out.pedestrians.get_mut(pedestrian.index())
+            && p.intention_frame.is_none()
+        {
+            p.intention_frame = Some(*frame);
+        }
+    }
+
+    let poles = lamp_poles(trace, town);
+    let mut occluders: Vec<Occluder> = Vec::with_capacity(poles.len() + trace.vehicles.len() + 2 * n_peds);
+    let mut near: Vec<Occluder> = Vec::with_capacity(occluders.capacity());
+    let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
+    for frame in 0..trace.frame_count as usize {
+        let Some(ego) = trace.ego.get(frame) else { break };
+        let cam = camera.at(ego.pos, ego.yaw_rad);
+        occluders.clear();
+        occluders.extend_from_slice(&poles);
+        for v in &trace.vehicles {
+            if let Some(f) = v.get(frame) {
+                occluders.push(Occluder::Vehicle {
+                    centre: f.pos,
+                    sin_cos: f.yaw_rad.sin_cos(),
+                });
+            }
+        }
+        for (id, ped) in trace.pedestrians.iter().enumerate() {
+            let f = &ped[frame];
+            let (h, child) = heights[id];
+            occluders.push(Occluder::Person {
+                ground: f.pos,
+                radius_m: PED_OCCLUDER_RADIUS_PER_M * h,
+                height_m: h,
+                owner: id as u32,
+            });
+            if let Some(hc) = child {
+                let offset = glam::DMat3::from_rotation_z(f.yaw_rad) * CHILD_OFFSET_M;
+                occluders.push(Occluder::Person {
+                    ground: f.pos + offset,
+                    radius_m: PED_OCCLUDER_RADIUS_PER_M * hc,
+                    height_m: hc,
+                    owner: u32::MAX,
+                });
+            }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            if let Some(f) = frames.get(frame) {
+                occluders.push(Occluder::Person {
+                    ground: f.pos,
+                    radius_m: RIDER_OCCLUDER_RADIUS_M,
+                    height_m: rider_heights[ci],
+                    owner: RIDER_OWNER_BASE + ci as u32,
+                });
+            }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            let Some(f) = frames.get(frame) else { continue };
+            let distance = (f.pos - ego.pos).truncate().length();
+            if (f.pos - cam.centre).dot(cam.forward) <= 0.0 {
+                continue;
+            }
+            let rider = cyclist::rider_pose(f, rider_heights[ci]);
+            let bike = cyclist::bicycle(f, rider_heights[ci]);
+            let Some(bbox) = project_capsules_box(rider.capsules.iter().chain(&bike), &cam) else {
+                continue;
+            };
+            let clipped = [
+                bbox[0].clamp(0.0, width),
+                bbox[1].clamp(0.0, height),
+                bbox[2].clamp(0.0, width),
+                bbox[3].clamp(0.0, height),
+            ];
+            // In view: at least a pixel of the box inside the image.
+            if clipped[2] - clipped[0] < 1.0 || clipped[3] - clipped[1] < 1.0 {
+                continue;
+            }
+            let truncated = clipped != bbox;
+            let ground = f.pos.truncate();
+            near.clear();
+            near.extend(occluders.iter().filter(|occ| {
+                !matches!(occ, Occluder::Person { owner, .. } if *owner == RIDER_OWNER_BASE + ci as u32)
+                    && may_block(occ, cam.centre.truncate(), ground, 1.5)
+            }));
+            let samples = rider.occlusion_samples();
+            let mut keypoints = [0f32; 51];
+            let mut keypoints_3d = [0f32; 51];
+            let mut hidden = 0u32;
+            for (k, joint) in rider.joints.iter().enumerate() {
+                let p = cam.project(*joint);
+                let flag = if p.depth_m <= 0.05 || !cam.in_image(p.px) {
+                    0.0
+                } else if occluded(town, &near, cam.centre, *joint) {
+                    hidden += 1;
+                    1.0
+                } else {
+                    2.0
+                };
+                set_keypoint((&mut keypoints, &mut keypoints_3d), k, p.px, flag, *joint);
+            }
+            for sample in samples {
+                hidden += u32::from(occluded(town, &near, cam.centre, sample));
+            }
+            let occlusion = f64::from(hidden) / (rider.joints.len() + samples.len()) as f64;
+            let min = min_box(gate, distance);
+            let annotated = distance <= gate.max_distance_m
+                && !too_small(bbox[2] - bbox[0], bbox[3] - bbox[1], min)
+                && !(gate.require_inside_image && truncated)
+                && occlusion <= gate.max_occlusion;
+            out.cyclists.push(CyclistRow {
+                frame: frame as u32,
+                cyclist: ci as u32,
+                bbox_px: clipped.map(|x| x as f32),
+                truncated,
+                distance_m: distance as f32,
+                occlusion: occlusion as f32,
+                annotated,
+                keypoints,
+                keypoints_3d,
+            });
+        }
+        for (id, ped) in trace.pedestrians.iter().enumerate() {
+            let f = &ped[frame];
+            let distance = (f.pos - ego.pos).truncate().length();
+            if distance > gate.max_distance_m {
+                out.rejections.too_far += 1;
+                continue;
+            }
+            if gate.require_in_front && (f.pos - cam.centre).dot(cam.forward) <= 0.0 {
+                out.rejections.behind += 1;
+                continue;
+            }
+            let pose = body::pose(f, heights[id].0, DVec3::ZERO);
+            let Some(bbox) = project_box(&pose, &cam) else {
+                out.rejections.behind += 1;
+                continue;
+            };
+            let min = min_box(gate, distance);
+            let Some((w, hgt)) = gate_box_size_px(&cam, f.pos, f.yaw_rad, heights[id].0) else {
+                out.rejections.behind += 1;
+                continue;
+            };
+            if too_small(w, hgt, min) {
+                out.rejections.too_small += 1;
+                continue;
+            }
+            if gate.require_inside_image && (bbox[0] < 0.0 || bbox[1] < 0.0 || bbox[2] > width || bbox[3] > height) {
+                out.rejections.outside_image += 1;
+                continue;
+            }
+            // Keypoints and occlusion: the 17 joints plus torso and head samples.
+            let samples = pose.occlusion_samples();
+            let projected = pose.joints.map(|j| cam.project(j));
+            let inside = projected.map(|p| p.depth_m > 0.05 && cam.in_image(p.px));
+            let seen = inside.iter().map(|&i| u32::from(i)).sum::<u32>() + samples.len() as u32;
+            // Only the occluders near the lines of sight to this body take part in the ray tests.
+            let ground = f.pos.truncate();
+            let reach = pose
+                .joints
+                .iter()
+                .chain(&samples)
+                .map(|q| q.truncate().distance(ground))
+                .fold(0.0, f64::max);
+            near.clear();
+            near.extend(occluders.iter().filter(|occ| {
+                !matches!(occ, Occluder::Person { owner, .. } if *owner == id as u32)
+                    && may_block(occ, cam.centre.truncate(), ground, reach)
+            }));
+            // Stop casting rays once the body is hidden beyond the threshold (hidden only grows).
+            let too_hidden = |hidden: u32| f64::from(hidden) / f64::from(seen) > gate.max_occlusion;
+            let mut keypoints = [0f32; 51];
+            let mut keypoints_3d = [0f32; 51];
+            let mut hidden = 0u32;
+            for (k, joint) in pose.joints.iter().enumerate() {
+                if too_hidden(hidden) {
+                    break;
+                }
+                let p = projected[k];
+                let flag = if !inside[k] {
+                    0.0
+                } else if occluded(town, &near, cam.centre, *joint) {
+                    hidden += 1;
+                    1.0
+                } else {
+                    2.0
+                };
+                set_keypoint((&mut keypoints, &mut keypoints_3d), k, p.px, flag, *joint);
+            }
+            let mut rejected = too_hidden(hidden);
+            for sample in samples {
+                if rejected {
+                    break;
+                }
+                hidden += u32::from(occluded(town, &near, cam.centre, sample));
+                rejected = too_hidden(hidden);
+            }
+            if rejected {
+                out.rejections.occluded += 1;
+                continue;
+            }
+            let occlusion = f64::from(hidden) / f64::from(seen);
+            let crossing = labels[id][frame];
+            let tte = first_crossing[id].and_then(|fc| (frame as u32 <= fc).then(|| (fc - frame as u32) as i32));
+            let (box_centre, box_size) = pose.box3d();
+            out.pedestrians[id].annotated_frames += 1;
+            out.pedestrians[id].crosser |= crossing;
+            out.rows.push(AnnotationRow {
+                frame: frame as u32,
+                pedestrian: id as u32,
+                bbox_px: bbox.map(|x| x as f32),
+                crossing,
+                state: f.state,
+                distance_m: distance as f32,
+                tte_frames: tte,
+                occlusion: occlusion as f32,
+                keypoints,
+                keypoints_3d,
+                pos_m: [f.pos.x as f32, f.pos.y as f32, f.pos.z as f32],
+                yaw_rad: f.yaw_rad as f32,
+                velocity_mps: [f.velocity.x as f32, f.velocity.y as f32],
+                lane_type: f.lane_type,
+                box3d_centre_m: [box_centre.x as f32, box_centre.y as f32, box_centre.z as f32],
+                box3d_size_m: [box_size.x as f32, box_size.y as f32, box_size.z as f32],
+                look: looks_at(
+                    pose.gaze,
+                    (pose.joints[1] + pose.joints[2]) * 0.5,
+                    cam.centre,
+                    annotations.look_cone_deg,
+                ),
+                walking: f.velocity.length() >= WALKING_MPS,
+                gesture: f.gesture.map(|g| g.0),
+                reaction: f.reaction,
+                on_crosswalk: f.on_crosswalk,
+                walk_signal: f.walk_signal,
+                against_signal: f.walk_signal == Some(WalkSignal::DontWalk) && f.state.is_crossing(),
+                gaze: pose.gaze.to_array().map(|x| x as f32),
+            });
+        }
+    }
+    out.crossing = labels;
+    out
+}
+
+/// Writes joint `k` into a row's keypoint arrays: its pixel `px` with visibility `flag` (COCO's 0 / 1 / 2), and
+/// its world position.
+fn set_keypoint(
+    (keypoints, keypoints_3d): (&mut [f32; 51], &mut [f32; 51]),
+    k: usize,
+    px: DVec2,
+    flag: f32,
+    joint: DVec3,
+) {
+    keypoints[3 * k..3 * k + 3].copy_from_slice(&[px.x as f32, px.y as f32, flag]);
+    keypoints_3d[3 * k..3 * k + 3].copy_from_slice(&[joint.x as f32, joint.y as f32, joint.z as f32]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::types::BoxSize;
+
+    #[test]
+    fn looks_at_is_a_cone_around_the_gaze() {
+        let eyes = DVec3::new(0.0, 0.0, 1.6);
+        let x = DVec3::X;
+        assert!(looks_at(x, eyes, DVec3::new(10.0, 0.0, 1.6), 30.0));
+        // 29° and 31° to the left, and 29° above.
+        let at = |deg: f64| DVec3::new(10.0 * deg.to_radians().cos(), 10.0 * deg.to_radians().sin(), 1.6);
+        assert!(looks_at(x, eyes, at(29.0), 30.0));
+        assert!(!looks_at(x, eyes, at(31.0), 30.0));
+        let up = DVec3::new(10.0, 0.0, 1.6 + 10.0 * 29f64.to_radians().tan());
+        assert!(looks_at(x, eyes, up, 30.0));
+        assert!(!looks_at(x, eyes, DVec3::new(-10.0, 0.0, 1.6), 90.0), "behind the head");
+        assert!(!looks_at(x, eyes, eyes, 30.0), "no direction to oneself");
+    }
+
+    fn frame(state: PedState, lane: Option<LaneType>) -> PedFrame {
+        PedFrame {
+            pos: DVec3::ZERO,
+            yaw_rad: 0.0,
+            velocity: DVec2::ZERO,
+            state,
+            lane_type: lane,
+            head_yaw_rad: 0.0,
+            gait_phase: 0.0,
+            on_phone: false,
+            gesture: None,
+            reaction: None,
+            walk_signal: None,
+            on_crosswalk: false,
+        }
+    }
+
+    #[test]
+    fn crossing_label_needs_state_and_driving_lane_and_is_smoothed() {
+        use LaneType::*;
+        use PedState::*;
+        let frames = [
+            frame(CheckingTraffic, Some(Sidewalk)),
+            frame(CrossingRoad, Some(Sidewalk)),
+            frame(CrossingRoad, Some(Driving)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Shoulder)),
+            frame(CrossingRoad, Some(Driving)),
+            frame(FinishedCrossing, Some(Driving)),
+        ];
+        assert_eq!(
+            crossing_labels(&frames, 2),
+            vec![false, false, true, true, true, false, true, false]
+        );
+        assert_eq!(
+            crossing_labels(&frames, 0),
+            vec![false, false, true, false, false, false, true, false]
+        );
+    }
+
+    #[test]
+    fn the_size_gate_compares_width_with_width_and_height_with_height() {
+        let tall = BoxSize::new(15.0, 30.0);
+        let wide = BoxSize::new(30.0, 15.0);
+        assert!(!too_small(20.0, 40.0, tall));
+        assert!(too_small(20.0, 40.0, wide), "20 px wide is narrower than 30");
+        assert!(too_small(40.0, 20.0, tall), "20 px high is lower than 30");
+        assert!(!too_small(40.0, 20.0, wide));
+    }
+
+    #[test]
+    fn sphere_bounds_are_exact_under_perspective() {
+        // Spheres near the axis, off-axis (wide angle) and close: the interval contains every projected
+        // surface point and is attained by one.
+        let (f, c) = (640.0, 640.0);
+        for (x, z, r) in [(0.0, 10.0, 0.2), (9.0, 10.0, 0.15), (-3.0, 2.0, 0.3), (1.5, 0.5, 0.2)] {
+            let (lo, hi) = sphere_interval(x, z, r, f, c);
+            let (mut dlo, mut dhi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for k in 0..100_000 {
+                let t = std::f64::consts::TAU * f64::from(k) / 100_000.0;
+                let (px, pz) = (x + r * t.cos(), z + r * t.sin());
+                let u = f * px / pz + c;
+                dlo = dlo.min(u);
+                dhi = dhi.max(u);
+            }
+            assert!(
+                (lo - dlo).abs() < 1e-3 && (hi - dhi).abs() < 1e-3,
+                "{x} {z} {r}: {lo} {hi} vs {dlo} {dhi}"
+            );
+        }
+    }
+
+    #[test]
+    fn occluders_block_only_what_they_cover() {
+        let car = Occluder::Vehicle {
+            centre: DVec3::new(10.0, 0.0, 0.0),
+            sin_cos: 0.3_f64.sin_cos(),
+        };
+        let from = DVec3::new(0.0, 0.0, 1.0);
+        assert!(blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 1.0));
+        assert!(
+            !blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 0.3),
+            "target in front of the car"
+        );
+        assert!(
+            !blocks(&car, from, DVec3::new(20.0, 0.0, 3.0), 1.0),
+            "the ray passes over the roof"
+        );
+        let person = Occluder::Person {
+            ground: DVec3::new(5.0, 0.0, 0.0),
+            radius_m: 0.25,
+            height_m: 1.7,
+            owner: 1,
+        };
+        assert!(blocks(&person, from, DVec3::new(10.0, 0.0, 0.0), 1.0));
+        assert!(!blocks(&person, from, DVec3::new(10.0, 1.0, 0.0), 1.0));
+        assert!(!blocks(&person, from, DVec3::new(10.0, 0.0, 4.0), 1.0), "over the head");
+    }
+}

@@ -1,0 +1,233 @@
+//! Observation of a simulated clip: pure functions of (script, trace, frame), no IO.
+//!
+//! - [`body`] — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
+//! - [`cyclist`] — a cyclist's rider (riding pose, same joints) and bicycle.
+//! - [`annotate`] — visibility gate, boxes, keypoints, occlusion and crossing labels.
+//! - [`scene`] — the renderable geometry of a frame (one source for cameras and LiDAR).
+//! - [`camera`] — RGB, depth, semantic, instance and DVS, rendered on the CPU.
+//! - [`lidar`] — CARLA's ray-cast (and semantic) LiDAR, traced against the same scene.
+//!
+//! Sensor streams are too large to hold for a whole clip, so [`render_cameras`] and [`scan_lidar`] hand each
+//! frame to a sink (the writer) as soon as it is produced; the sink does the IO, this module none.
+
+pub mod annotate;
+pub mod body;
+pub mod camera;
+pub mod cyclist;
+pub mod lidar;
+pub mod realise;
+pub mod scene;
+
+use glam::{DAffine3, DVec3};
+
+use crate::plan::ClipScript;
+use crate::sim::rig::Rig;
+use crate::sim::trace::ClipTrace;
+use crate::spec::Spec;
+use crate::spec::types::{Lidar, Sensors};
+use crate::world::RoadNetwork;
+use annotate::ClipAnnotations;
+
+/// Everything observed of one clip.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Observations {
+    /// The annotation of every pedestrian-frame (and the rejections of the visibility gate).
+    pub annotations: ClipAnnotations,
+}
+
+/// Observes a simulated clip with the rig.
+pub fn observe(script: &ClipScript, trace: &ClipTrace, spec: &Spec, rig: &Rig, town: &RoadNetwork) -> Observations {
+    Observations {
+        annotations: annotate::annotate(script, trace, &spec.annotations, &rig.camera, town),
+    }
+}
+
+/// One rendered frame of the camera streams, as handed to the sink.
+#[derive(Debug)]
+pub struct SensorFrame<'a> {
+    /// Frame index.
+    pub frame: u32,
+    /// Simulated time of the frame, nanoseconds.
+    pub timestamp_ns: i64,
+    /// The frame's images.
+    pub images: &'a camera::CameraImages,
+    /// DVS events in (previous frame, this frame], sorted by time (empty without DVS).
+    pub events: &'a [camera::dvs::Event],
+}
+
+/// The simulated time of frame `frame` plus `k / substeps` of a frame, nanoseconds.
+pub fn frame_time_ns(frame: u32, fps: u32, k: u32, substeps: u32) -> i64 {
+    let ns = i128::from(frame) * 1_000_000_000 * i128::from(substeps) + i128::from(k) * 1_000_000_000;
+    (ns / (i128::from(fps.max(1)) * i128::from(substeps.max(1)))) as i64
+}
+
+/// Renders the camera streams of a clip frame by frame and hands each frame to `sink` (in frame order).
+/// Every image is a pure function of (script, trace, frame); `stat` is the clip's static scene
+/// ([`scene::StaticScene::build`]).
+pub fn render_cameras<E>(
+    stat: &scene::StaticScene,
+    script: &ClipScript,
+    trace: &ClipTrace,
+    sensors: &Sensors,
+    rig: &Rig,
+    mut sink: impl FnMut(SensorFrame) -> Result<(), E>,
+) -> Result<(), E> {
+    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut frame_scene = scene::FrameScene::default();
+    let mut images = camera::CameraImages::default();
+    let (w, h) = (rig.camera.width_px as usize, rig.camera.height_px as usize);
+    let mut esim = sensors.dvs.enabled.then(|| camera::dvs::Esim::new(&sensors.dvs, w, h));
+    let substeps = sensors.dvs.substeps.max(1);
+    let mut events = Vec::new();
+    let frames = trace.frame_count.min(trace.ego.len() as u32);
+    let mut render = |t: scene::SceneTime, k: u32, images: &mut camera::CameraImages| {
+        frame_scene.build(stat, script, trace, t);
+        let (pos, yaw) = scene::ego_at(trace, t);
+        let pose = rig.camera.at(pos, yaw);
+        renderer.render(
+            stat,
+            &frame_scene,
+            &pose,
+            camera::streak_seed(script.seed, t.frame, k),
+            images,
+        );
+    };
+    for frame in 0..frames {
+        events.clear();
+        if let Some(esim) = esim.as_mut()
+            && frame > 0
+        {
+            for k in 1..substeps {
+                let t = scene::SceneTime {
+                    frame: frame - 1,
+                    alpha: f64::from(k) / f64::from(substeps),
+                };
+                render(t, k, &mut images);
+                let now = frame_time_ns(frame - 1, script.fps, k, substeps);
+                esim.step(
+                    &images.rgb,
+                    now,
+                    camera::streak_seed(script.seed ^ 0xd75, frame - 1, k),
+                    &mut events,
+                );
+            }
+        }
+        render(scene::SceneTime::at(frame), 0, &mut images);
+        let now = frame_time_ns(frame, script.fps, 0, 1);
+        if let Some(esim) = esim.as_mut() {
+            esim.step(
+                &images.rgb,
+                now,
+                camera::streak_seed(script.seed ^ 0xd75, frame, 0),
+                &mut events,
+            );
+        }
+        sink(SensorFrame {
+            frame,
+            timestamp_ns: now,
+            images: &images,
+            events: &events,
+        })?;
+    }
+    Ok(())
+}
+
+/// One LiDAR tick, as handed to the sink.
+#[derive(Debug)]
+pub struct LidarFrame<'a> {
+    /// Frame index (one tick per frame).
+    pub frame: u32,
+    /// Simulated time of the frame, nanoseconds.
+    pub timestamp_ns: i64,
+    /// The kept returns, in CARLA's sensor frame (x forward, y right, z up).
+    pub points: &'a [lidar::LidarPoint],
+    /// What the tick did (rays, drop-off).
+    pub stats: lidar::TickStats,
+}
+
+/// The scene-relative `f32` pose of a world pose (the scene's coordinates are relative to its origin).
+pub fn scene_from(stat: &scene::StaticScene, world_from_sensor: &DAffine3) -> glam::Affine3A {
+    let mut rel = *world_from_sensor;
+    rel.translation -= stat.origin;
+    glam::Affine3A::from_mat3_translation(rel.matrix3.as_mat3(), rel.translation.as_vec3())
+}
+
+/// Scans a clip with the LiDAR tick by tick (one tick per frame) and hands each tick to `sink` (in frame
+/// order). Every point is a pure function of (script, trace, frame).
+pub fn scan_lidar<E>(
+    stat: &scene::StaticScene,
+    script: &ClipScript,
+    trace: &ClipTrace,
+    spec: &Lidar,
+    rig: &Rig,
+    mut sink: impl FnMut(LidarFrame) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut tracer = lidar::Tracer::new(stat);
+    let mut frame_scene = scene::FrameScene::default();
+    let mut scratch = lidar::ScanScratch::default();
+    let mut points = Vec::new();
+    let frames = trace.frame_count.min(trace.ego.len() as u32);
+    for frame in 0..frames {
+        let t = scene::SceneTime::at(frame);
+        frame_scene.build(stat, script, trace, t);
+        let (pos, yaw) = scene::ego_at(trace, t);
+        let pose = scene_from(stat, &rig.world_from_lidar(pos, yaw));
+        tracer.set_agents(&frame_scene, &pose);
+        points.clear();
+        let stats = lidar::scan(
+            spec,
+            script.fps,
+            frame,
+            script.seed,
+            &pose,
+            &tracer,
+            |id| frame_scene.prim(stat, id),
+            &mut scratch,
+            &mut points,
+        );
+        sink(LidarFrame {
+            frame,
+            timestamp_ns: frame_time_ns(frame, script.fps, 0, 1),
+            points: &points,
+            stats,
+        })?;
+    }
+    Ok(())
+}
+
+/// The world pose of each sensor at a frame: the camera (whose image the annotations are in) and the LiDAR,
+/// each as `world_from_sensor` with sensor axes x forward, y left, z up.
+pub fn sensor_poses(trace: &ClipTrace, rig: &Rig, frame: u32) -> [(&'static str, DAffine3); 2] {
+    let (pos, yaw): (DVec3, f64) = scene::ego_at(trace, scene::SceneTime::at(frame));
+    [
+        ("camera", rig.camera.world_from_sensor(pos, yaw)),
+        ("lidar", rig.world_from_lidar(pos, yaw)),
+    ]
+}
+
+/// Renders one frame of a clip (no DVS): for previews, tests and benchmarks.
+pub fn render_frame(
+    script: &ClipScript,
+    trace: &ClipTrace,
+    rig: &Rig,
+    town: &RoadNetwork,
+    frame: u32,
+) -> camera::CameraImages {
+    let stat = scene::StaticScene::build(script, trace, town);
+    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut frame_scene = scene::FrameScene::default();
+    let mut images = camera::CameraImages::default();
+    let t = scene::SceneTime::at(frame);
+    frame_scene.build(&stat, script, trace, t);
+    let (pos, yaw) = scene::ego_at(trace, t);
+    renderer.render(
+        &stat,
+        &frame_scene,
+        &rig.camera.at(pos, yaw),
+        camera::streak_seed(script.seed, frame, 0),
+        &mut images,
+    );
+    images
+}

@@ -1,0 +1,196 @@
+//! The ego's sensor rig: the pinhole camera (mount, intrinsics, projection) and the LiDAR's mount, from the
+//! spec.
+//!
+//! Frames: *world* (right-handed, x east, y north, z up), *vehicle* (x forward, y left, z up; origin on the
+//! ground under the vehicle's centre), *sensor* (the vehicle frame moved and turned by the mount) and
+//! *optical* (x right, y down, z forward, the usual image convention). Pixel (0, 0) is the top-left corner of
+//! the top-left pixel; `u` grows to the right, `v` downwards.
+
+use glam::{DAffine3, DMat3, DVec2, DVec3};
+
+use crate::spec::types::{Mount, Rgb, Sensors};
+
+/// The sensors on the ego vehicle, placed and configured from the spec.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rig {
+    /// The RGB camera (the annotations' camera: boxes and keypoints are in its image).
+    pub camera: Camera,
+    /// Pose of the LiDAR in the vehicle frame (x forward, y left, z up).
+    pub lidar_vehicle_from_sensor: DAffine3,
+}
+
+impl Rig {
+    /// The rig of a spec's sensors.
+    pub fn from_spec(sensors: &Sensors) -> Rig {
+        Rig {
+            camera: Camera::from_spec(&sensors.rgb),
+            lidar_vehicle_from_sensor: vehicle_from_mount(&sensors.lidar.mount),
+        }
+    }
+
+    /// The LiDAR's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
+    pub fn world_from_lidar(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.lidar_vehicle_from_sensor
+    }
+}
+
+/// Intrinsics and mount of a pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Image width, pixels.
+    pub width_px: u32,
+    /// Image height, pixels.
+    pub height_px: u32,
+    /// Focal length, pixels (square pixels).
+    pub focal_px: f64,
+    /// Pose of the sensor in the vehicle frame.
+    pub vehicle_from_sensor: DAffine3,
+}
+
+/// The rotation taking sensor axes (x forward, y left, z up) to optical axes (x right, y down, z forward).
+const OPTICAL_FROM_SENSOR: DMat3 = DMat3::from_cols(
+    DVec3::new(0.0, 0.0, 1.0),  // sensor x (forward) → optical z
+    DVec3::new(-1.0, 0.0, 0.0), // sensor y (left) → optical −x
+    DVec3::new(0.0, -1.0, 0.0), // sensor z (up) → optical −y
+);
+
+/// The pose of a mount in the vehicle frame. Pitch is about the vehicle's y axis with negative values looking
+/// down (CARLA's convention), yaw about z (positive turns left), roll about x.
+pub fn vehicle_from_mount(mount: &Mount) -> DAffine3 {
+    let yaw = DMat3::from_rotation_z(mount.yaw_deg.to_radians());
+    let pitch = DMat3::from_rotation_y(-mount.pitch_deg.to_radians());
+    let roll = DMat3::from_rotation_x(mount.roll_deg.to_radians());
+    DAffine3::from_mat3_translation(
+        yaw * pitch * roll,
+        DVec3::new(mount.forward_m, mount.left_m, mount.up_m),
+    )
+}
+
+/// The pose of a vehicle in the world: on the ground at `pos` (z is the ground height), heading `yaw_rad`.
+pub fn world_from_vehicle(pos: DVec3, yaw_rad: f64) -> DAffine3 {
+    DAffine3::from_mat3_translation(DMat3::from_rotation_z(yaw_rad), pos)
+}
+
+/// A camera placed in the world for one frame: everything needed to project points.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraPose {
+    /// Intrinsics.
+    pub camera: Camera,
+    /// World → optical frame.
+    pub optical_from_world: DAffine3,
+    /// Camera centre in the world.
+    pub centre: DVec3,
+    /// Unit forward axis in the world.
+    pub forward: DVec3,
+    /// Unit right axis in the world (image +u).
+    pub right: DVec3,
+    /// Unit down axis in the world (image +v).
+    pub down: DVec3,
+}
+
+/// A projected point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projection {
+    /// Pixel coordinates.
+    pub px: DVec2,
+    /// Depth along the optical axis, metres (≤ 0 behind the camera).
+    pub depth_m: f64,
+}
+
+impl Camera {
+    /// The RGB camera of a spec.
+    pub fn from_spec(rgb: &Rgb) -> Self {
+        let focal_px = f64::from(rgb.width_px) / (2.0 * (rgb.fov_deg.to_radians() / 2.0).tan());
+        Camera {
+            width_px: rgb.width_px,
+            height_px: rgb.height_px,
+            focal_px,
+            vehicle_from_sensor: vehicle_from_mount(&rgb.mount),
+        }
+    }
+
+    /// The camera's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
+    pub fn world_from_sensor(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.vehicle_from_sensor
+    }
+
+    /// The camera on a vehicle at `pos` heading `yaw_rad`.
+    pub fn at(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> CameraPose {
+        let world_from_sensor = self.world_from_sensor(vehicle_pos, vehicle_yaw_rad);
+        let sensor_from_world = world_from_sensor.inverse();
+        let optical_from_world = DAffine3::from_mat3(OPTICAL_FROM_SENSOR) * sensor_from_world;
+        let rot = world_from_sensor.matrix3;
+        CameraPose {
+            camera: *self,
+            optical_from_world,
+            centre: world_from_sensor.translation,
+            forward: rot.x_axis,
+            right: -rot.y_axis,
+            down: -rot.z_axis,
+        }
+    }
+}
+
+impl CameraPose {
+    /// Projects a world point.
+    pub fn project(&self, world: DVec3) -> Projection {
+        let p = self.optical_from_world.transform_point3(world);
+        let c = &self.camera;
+        let depth = p.z;
+        let inv = if depth.abs() > 1e-9 { 1.0 / depth } else { 1e9 };
+        Projection {
+            px: DVec2::new(
+                c.focal_px * p.x * inv + f64::from(c.width_px) * 0.5,
+                c.focal_px * p.y * inv + f64::from(c.height_px) * 0.5,
+            ),
+            depth_m: depth,
+        }
+    }
+
+    /// Whether a pixel lies inside the image.
+    pub fn in_image(&self, px: DVec2) -> bool {
+        px.x >= 0.0
+            && px.y >= 0.0
+            && px.x <= f64::from(self.camera.width_px)
+            && px.y <= f64::from(self.camera.height_px)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spec::types::Rgb;
+
+    #[test]
+    fn intrinsics_and_axes_follow_the_spec() {
+        let cam = Camera::from_spec(&Rgb::default());
+        assert!((cam.focal_px - 640.0).abs() < 1e-9, "f = W / (2 tan(45°)) = 640");
+        let pose = cam.at(DVec3::ZERO, 0.0);
+        assert!((pose.centre - DVec3::new(0.8, 0.3, 1.4)).length() < 1e-12);
+        // Pitch −8° looks down: the forward axis has a negative z component.
+        assert!((pose.forward.z - (-8f64.to_radians()).sin()).abs() < 1e-12);
+        // A point straight ahead along the optical axis lands on the principal point.
+        let ahead = pose.centre + pose.forward * 20.0;
+        let p = pose.project(ahead);
+        assert!((p.px - DVec2::new(640.0, 360.0)).length() < 1e-9 && (p.depth_m - 20.0).abs() < 1e-9);
+        // Left of the camera is left in the image; above is up.
+        assert!(pose.project(ahead + DVec3::Y).px.x < 640.0);
+        assert!(pose.project(ahead + DVec3::Z).px.y < 360.0);
+        // Behind the camera: negative depth.
+        assert!(pose.project(pose.centre - pose.forward).depth_m < 0.0);
+    }
+
+    #[test]
+    fn the_camera_turns_with_the_vehicle() {
+        let cam = Camera::from_spec(&Rgb::default());
+        let pose = cam.at(DVec3::new(10.0, 5.0, 0.0), std::f64::consts::FRAC_PI_2);
+        assert!(
+            (pose.forward.truncate().normalize() - DVec2::Y).length() < 1e-9,
+            "heading north looks north"
+        );
+        assert!(
+            (pose.right - DVec3::X).length() < 1e-9 || pose.right.x > 0.99,
+            "north-facing: right is east"
+        );
+    }
+}

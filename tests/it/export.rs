@@ -1,0 +1,311 @@
+//! `pedsynth export` (issue 17), the parts Python does not check (tests/interop_pie.py and
+//! tests/interop_jaad.py run PIE's, JAAD's and PedestrianActionBenchmark's own loaders on the exports, in CI):
+//!
+//! - the same dataset exports to byte-identical files, and a re-run over an export keeps it as it is;
+//! - a dataset without cameras exports its annotations and says that images are absent;
+//! - an unfinished dataset, a table changed after `generate` and a directory that is no dataset are refused
+//!   with exit code 2 and a message naming the problem, never a panic;
+//! - the poses' joints: OpenPose-18 order, neck at mid-shoulder, normalised within the box, hidden joints 0;
+//! - the seed's CSV layout has one row per annotated pedestrian-frame, none duplicated (the seed wrote each
+//!   twice).
+
+use crate::common;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use pedsynth::dataset::export::dataset::AnnotatedFrame;
+use pedsynth::dataset::export::pab::pose36;
+
+fn spec(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("specs").join(name)
+}
+
+fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+        .args(args)
+        .output()
+        .expect("runs");
+    (
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
+
+fn export(format: &str, dataset: &Path, out: &Path) -> (Option<i32>, String, String) {
+    pedsynth(&[
+        "export".as_ref(),
+        format.as_ref(),
+        dataset.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
+}
+
+#[test]
+fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
+    let tmp = common::Scratch::new("export");
+    let ds = tmp.path().join("ds");
+    // With cyclists: they go into the OpenSCENARIO files as bicycles and into PIE as vehicles of type bicycle.
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.push("traffic.cyclists.per_clip=[2, 2]");
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &overrides, &ds, None);
+    assert_eq!(code, 0, "{stderr}");
+
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    for out in [&a, &b] {
+        for (format, layout) in [
+            ("pie", "pie"),
+            ("pab-poses", "pie"),
+            ("jaad", "jaad"),
+            ("pab-poses-jaad", "jaad"),
+            ("seed-csv", "seed"),
+            ("openscenario", "xosc"),
+        ] {
+            let (code, stdout, stderr) = export(format, &ds, &out.join(layout));
+            assert_eq!(code, Some(0), "{stderr}");
+            if ["pie", "jaad", "seed-csv"].contains(&format) {
+                assert!(
+                    stdout.contains("images absent: the dataset has no RGB stream"),
+                    "{stdout}"
+                );
+            }
+        }
+    }
+    let files = common::all_files(&a);
+    for file in [
+        "pie/annotations/set01/video_0001_annt.xml",
+        "pie/poses/pose_set03.pkl",
+        "pie/pedsynth_export.json",
+        "jaad/annotations/video_0001.xml",
+        "jaad/poses/pose_set01.pkl",
+        "jaad/split_ids/default/val.txt",
+        "xosc/towns/town01_like.xodr",
+        "xosc/town01_like-clear_noon-0000.xosc",
+    ] {
+        assert!(files.contains_key(file), "{file}: {:?}", files.keys());
+    }
+    assert!(files == common::all_files(&b), "two exports of one dataset differ");
+    // The seed's CSV: one row per annotated pedestrian-frame, none twice, every row as wide as the header.
+    let view = pedsynth::dataset::export::dataset::Dataset::open(&ds).expect("opens");
+    let annotated: usize = view
+        .clips
+        .iter()
+        .map(|info| view.load(info).expect("loads"))
+        .flat_map(|c| c.pedestrians.into_values())
+        .map(|p| p.frames.len())
+        .sum();
+    let labels = String::from_utf8(files["seed/labels.csv"].clone()).expect("utf-8");
+    let mut lines = labels.lines();
+    let width = lines.next().expect("header").split(',').count();
+    assert_eq!(width, 12 + 3 * 17);
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), annotated, "one row per annotated pedestrian-frame");
+    let keys: std::collections::BTreeSet<Vec<&str>> = rows.iter().map(|r| r.split(',').take(3).collect()).collect();
+    assert_eq!(
+        keys.len(),
+        rows.len(),
+        "no duplicate (video_id, frame_id, pedestrian_id)"
+    );
+    assert!(rows.iter().all(|r| r.split(',').count() == width));
+    // OpenSCENARIO: every entity's polyline, evaluated at every frame, is where the tables put it.
+    for info in &view.clips {
+        let clip = view.load(info).expect("loads");
+        let xosc = String::from_utf8(files[&format!("xosc/{}.xosc", clip.clip_id)].clone()).expect("utf-8");
+        check_replay(&clip, &xosc);
+    }
+    // Re-running over an export keeps it byte for byte.
+    let (code, _, stderr) = export("pie", &ds, &a.join("pie"));
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(files == common::all_files(&a));
+
+    // A table changed after generate.
+    let table = ds.join("tables/annotations/town01_like-clear_noon-0000.parquet");
+    let original = std::fs::read(&table).expect("read");
+    let mut changed = original.clone();
+    let mid = changed.len() / 2;
+    changed[mid] ^= 1;
+    std::fs::write(&table, &changed).expect("write");
+    let (code, _, stderr) = export("pie", &ds, &tmp.path().join("c"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("blake3 differs from the manifest"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    std::fs::write(&table, &original).expect("restore");
+
+    // A clip not generated yet.
+    let manifest = ds.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest).expect("manifest");
+    std::fs::write(
+        &manifest,
+        text.replacen("\"status\": \"done\"", "\"status\": \"pending\"", 1),
+    )
+    .expect("write");
+    let (code, _, stderr) = export("pab-poses", &ds, &tmp.path().join("d"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("not generated yet"), "{stderr}");
+
+    // Not a dataset.
+    let (code, _, stderr) = export("pie", tmp.path(), &tmp.path().join("e"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("is") && stderr.contains("a pedsynth dataset"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn poses_are_openpose18_normalised_in_the_box_with_hidden_joints_zero() {
+    // COCO-17: joint k at (100 + 10 k, 200 + 5 k), visible (2), except the left wrist (9) hidden (1).
+    let mut keypoints = Vec::new();
+    for k in 0..17 {
+        keypoints.extend([
+            100.0 + 10.0 * k as f32,
+            200.0 + 5.0 * k as f32,
+            if k == 9 { 1.0 } else { 2.0 },
+        ]);
+    }
+    let frame = AnnotatedFrame {
+        frame: 0,
+        bbox_px: [100.0, 200.0, 300.0, 300.0],
+        crossing: false,
+        state: String::new(),
+        look: false,
+        action: "standing".into(),
+        gesture: "none".into(),
+        reaction: "none".into(),
+        occlusion: 0.0,
+        speed_mps: 0.0,
+        x_m: 0.0,
+        y_m: 0.0,
+        yaw_rad: 0.0,
+        distance_to_ego_m: 0.0,
+        box3d_m: [0.0; 6],
+        keypoints,
+    };
+    let p = pose36(&frame);
+    assert_eq!(p.len(), 36);
+    let at = |k: usize| ((10.0 * k as f64) / 200.0, (5.0 * k as f64) / 100.0);
+    assert_eq!((p[0], p[1]), at(0), "nose");
+    let (l, r) = (at(5), at(6));
+    assert!(
+        (p[2] - (l.0 + r.0) / 2.0).abs() < 1e-9 && (p[3] - (l.1 + r.1) / 2.0).abs() < 1e-9,
+        "neck"
+    );
+    assert_eq!((p[4], p[5]), at(6), "right shoulder third");
+    assert_eq!((p[14], p[15]), (0.0, 0.0), "the hidden left wrist is 0");
+    assert_eq!((p[28], p[29]), at(1), "left eye 15th");
+    assert_eq!((p[34], p[35]), at(4), "right ear last");
+}
+
+/// Parses an exported .xosc and checks that each entity's polyline, linearly interpolated in time, passes
+/// within the exporter's tolerance (2 cm, 0.02 rad, plus the file's rounding) of every frame of the tables:
+/// the ego from `frames`, vehicles from `vehicles`, cyclists (bicycles) from `cyclists`, pedestrians from
+/// `tracks`; and that the scenario declares
+/// exactly these entities, points at the exported town and carries the clip's weather.
+fn check_replay(clip: &pedsynth::dataset::export::dataset::Clip, xosc: &str) {
+    use pedsynth::dataset::export::openscenario::{TOLERANCE_M, TOLERANCE_RAD};
+    let doc = roxmltree::Document::parse(xosc).expect("well-formed");
+    let logic = doc.descendants().find(|n| n.has_tag_name("LogicFile")).unwrap();
+    assert_eq!(
+        logic.attribute("filepath"),
+        Some(format!("towns/{}.xodr", clip.town).as_str())
+    );
+    let num = |n: roxmltree::Node, a: &str| n.attribute(a).unwrap().parse::<f64>().unwrap();
+    let mut polylines: BTreeMap<String, Vec<[f64; 5]>> = BTreeMap::new();
+    for t in doc.descendants().filter(|n| n.has_tag_name("Trajectory")) {
+        let vertices = t
+            .descendants()
+            .filter(|n| n.has_tag_name("Vertex"))
+            .map(|v| {
+                let w = v.descendants().find(|n| n.has_tag_name("WorldPosition")).unwrap();
+                [num(v, "time"), num(w, "x"), num(w, "y"), num(w, "z"), num(w, "h")]
+            })
+            .collect();
+        polylines.insert(t.attribute("name").unwrap().to_owned(), vertices);
+    }
+    let declared: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("ScenarioObject"))
+        .map(|n| n.attribute("name").unwrap())
+        .collect();
+    let vehicles: std::collections::BTreeSet<u32> = clip.vehicles.iter().map(|v| v.vehicle).collect();
+    let cyclists: std::collections::BTreeSet<u32> = clip.cyclists.iter().map(|c| c.cyclist).collect();
+    assert!(
+        !cyclists.is_empty(),
+        "{}: the test's dataset has cyclists",
+        clip.clip_id
+    );
+    assert_eq!(declared.len(), 1 + vehicles.len() + cyclists.len() + clip.tracks.len());
+    let bicycles = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("Vehicle") && n.attribute("vehicleCategory") == Some("bicycle"))
+        .count();
+    assert_eq!(bicycles, cyclists.len());
+    assert_eq!(polylines.len(), declared.len());
+    assert_eq!(
+        clip.tracks.len(),
+        clip.pedestrians.len(),
+        "tracks cover every pedestrian"
+    );
+    let at = |name: &str, t: f64| -> [f64; 4] {
+        let p = &polylines[name];
+        let k = p.partition_point(|v| v[0] <= t + 1e-9).clamp(1, p.len() - 1);
+        let (a, b) = (p[k - 1], p[k]);
+        let w = if b[0] > a[0] {
+            ((t - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        std::array::from_fn(|i| a[i + 1] + (b[i + 1] - a[i + 1]) * w)
+    };
+    let fps = f64::from(clip.fps);
+    let mut checked = 0;
+    let mut check = |name: &str, frame: u32, want: [f64; 4]| {
+        let got = at(name, f64::from(frame) / fps);
+        let d = ((got[0] - want[0]).powi(2) + (got[1] - want[1]).powi(2) + (got[2] - want[2]).powi(2)).sqrt();
+        let dh = (got[3] - want[3] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        assert!(
+            d <= TOLERANCE_M + 0.002 && dh.abs() <= TOLERANCE_RAD + 0.001,
+            "{} {name} frame {frame}: polyline {got:?}, table {want:?}",
+            clip.clip_id
+        );
+        checked += 1;
+    };
+    for (f, e) in clip.ego.iter().enumerate() {
+        check("ego", f as u32, [e.x_m, e.y_m, e.z_m, e.yaw_rad]);
+    }
+    for v in &clip.vehicles {
+        check(
+            &format!("vehicle_{}", v.vehicle),
+            v.frame,
+            [v.x_m, v.y_m, v.z_m, v.yaw_rad],
+        );
+    }
+    for c in &clip.cyclists {
+        check(
+            &format!("cyclist_{}", c.cyclist),
+            c.frame,
+            [c.x_m, c.y_m, c.z_m, c.yaw_rad],
+        );
+    }
+    for (id, track) in &clip.tracks {
+        assert_eq!(
+            track.len(),
+            clip.frame_count as usize,
+            "pedestrian {id}: a row per frame"
+        );
+        for f in track {
+            check(&format!("pedestrian_{id}"), f.frame, [f.x_m, f.y_m, f.z_m, f.yaw_rad]);
+        }
+    }
+    assert!(checked > clip.frame_count as usize * 3);
+    let vertices: usize = polylines.values().map(Vec::len).sum();
+    assert!(
+        vertices * 4 < checked,
+        "polylines are simplified ({vertices} vertices for {checked} poses)"
+    );
+    let sun = doc.descendants().find(|n| n.has_tag_name("Sun")).unwrap();
+    assert!((num(sun, "elevation") - clip.sun_altitude_deg.to_radians()).abs() < 1e-3);
+}
