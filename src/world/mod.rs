@@ -30,6 +30,7 @@ mod obstacles;
 pub mod opendrive;
 mod render;
 mod routes;
+mod sidewalks;
 pub mod signals;
 
 use std::ops::Range;
@@ -38,7 +39,8 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-pub use routes::{Crossing, Route, RoutePoint, Side, SidewalkGraph, SidewalkSample, SpawnPoint};
+pub use routes::{Route, RoutePoint, SpawnPoint};
+pub use sidewalks::{Crossing, Side, SidewalkGraph, SidewalkSample};
 pub use signals::Signal;
 
 /// Names of the built-in procedural towns, in the order `pedsynth town list` shows them. They are modelled on
@@ -488,7 +490,7 @@ pub struct RoadNetwork {
     pub bounds: (DVec2, DVec2),
     index: index::LaneIndex,
     lane_graph: routes::LaneGraph,
-    sidewalk_graph: routes::SidewalkGraph,
+    sidewalk_graph: sidewalks::SidewalkGraph,
     obstacle_index: obstacles::ObstacleIndex,
 }
 

@@ -12,11 +12,12 @@
 use std::sync::Arc;
 
 use arrow_array::{ArrayRef, Float32Array, Int64Array, RecordBatch, StringArray, UInt8Array, UInt16Array, UInt32Array};
-use arrow_schema::{DataType, Field, Schema, SchemaRef};
+use arrow_schema::SchemaRef;
 use parquet::arrow::ArrowWriter;
 use sha2::{Digest, Sha256};
 
 use super::Layout;
+use super::columns::Table;
 use super::sensors::{IndexRow, LIDAR_STREAM, hex};
 use super::tables::{self, FileMeta};
 use crate::error::Error;
@@ -26,43 +27,55 @@ use crate::sensors::scene::actor_of_instance;
 use crate::spec::types::{Lidar, LidarFormat, Output};
 use crate::util::files::{AtomicFile, write_atomically_unsynced};
 
-/// The schema of a clip's LiDAR Parquet file.
+/// The schema of a clip's LiDAR Parquet file (the table of no points): see [`lidar_batch`].
 pub fn lidar_schema() -> SchemaRef {
-    Arc::new(Schema::new(vec![
-        Field::new("clip_id", DataType::Utf8, false),
-        Field::new("frame", DataType::UInt32, false),
-        Field::new("timestamp_ns", DataType::Int64, false),
-        Field::new("x", DataType::Float32, false),
-        Field::new("y", DataType::Float32, false),
-        Field::new("z", DataType::Float32, false),
-        Field::new("intensity", DataType::Float32, false),
-        Field::new("cos_incidence", DataType::Float32, false),
-        Field::new("tag", DataType::UInt8, false),
-        Field::new("instance", DataType::UInt16, false),
-        Field::new("actor_id", DataType::UInt32, true),
-    ]))
+    lidar_batch("", 0, 0, &[]).schema()
 }
 
-/// One tick's points as a record batch of [`lidar_schema`].
+/// One tick's points: per point its position and intensity in the sensor's frame, the cosine of the incidence
+/// angle, CARLA's semantic tag, the instance id and the actor id it maps to (null for the town).
 pub fn lidar_batch(clip_id: &str, frame: u32, timestamp_ns: i64, points: &[LidarPoint]) -> RecordBatch {
     let f =
         |get: fn(&LidarPoint) -> f32| -> ArrayRef { Arc::new(Float32Array::from_iter_values(points.iter().map(get))) };
-    let columns: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(points.iter().map(|_| clip_id))),
-        Arc::new(UInt32Array::from_iter_values(points.iter().map(|_| frame))),
-        Arc::new(Int64Array::from_iter_values(points.iter().map(|_| timestamp_ns))),
-        f(|p| p.x_m),
-        f(|p| p.y_m),
-        f(|p| p.z_m),
-        f(|p| p.intensity),
-        f(|p| p.cos_incidence),
-        Arc::new(UInt8Array::from_iter_values(points.iter().map(|p| p.tag))),
-        Arc::new(UInt16Array::from_iter_values(points.iter().map(|p| p.instance))),
-        Arc::new(UInt32Array::from_iter(
-            points.iter().map(|p| actor_of_instance(p.instance)),
-        )),
-    ];
-    RecordBatch::try_new(lidar_schema(), columns).expect("columns match their schema")
+    Table::new()
+        .column(
+            "clip_id",
+            false,
+            Arc::new(StringArray::from_iter_values(points.iter().map(|_| clip_id))),
+        )
+        .column(
+            "frame",
+            false,
+            Arc::new(UInt32Array::from_iter_values(points.iter().map(|_| frame))),
+        )
+        .column(
+            "timestamp_ns",
+            false,
+            Arc::new(Int64Array::from_iter_values(points.iter().map(|_| timestamp_ns))),
+        )
+        .column("x", false, f(|p| p.x_m))
+        .column("y", false, f(|p| p.y_m))
+        .column("z", false, f(|p| p.z_m))
+        .column("intensity", false, f(|p| p.intensity))
+        .column("cos_incidence", false, f(|p| p.cos_incidence))
+        .column(
+            "tag",
+            false,
+            Arc::new(UInt8Array::from_iter_values(points.iter().map(|p| p.tag))),
+        )
+        .column(
+            "instance",
+            false,
+            Arc::new(UInt16Array::from_iter_values(points.iter().map(|p| p.instance))),
+        )
+        .column(
+            "actor_id",
+            true,
+            Arc::new(UInt32Array::from_iter(
+                points.iter().map(|p| actor_of_instance(p.instance)),
+            )),
+        )
+        .finish()
 }
 
 /// The seed's `.bin` layout of one tick: little-endian f32 `x y z intensity` per point.

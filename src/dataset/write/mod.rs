@@ -14,6 +14,7 @@
 //! skips, so a clip interrupted while rendering is rendered again whole.
 
 pub mod card;
+pub(crate) mod columns;
 pub mod layout;
 pub mod lidar;
 pub mod manifest;

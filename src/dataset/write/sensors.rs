@@ -21,15 +21,14 @@
 
 use std::sync::Arc;
 
-use arrow_array::{
-    ArrayRef, BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array,
-};
-use arrow_schema::{DataType, Field, Schema, SchemaRef};
+use arrow_array::{BooleanArray, Int64Array, RecordBatch, StringArray, UInt16Array, UInt32Array, UInt64Array};
+use arrow_schema::SchemaRef;
 use parquet::arrow::ArrowWriter;
 use rayon::prelude::*;
 use sha2::{Digest, Sha256};
 
 use super::Layout;
+use super::columns::Table;
 use super::tables::{self, FileMeta};
 use crate::error::{Error, code};
 use crate::sensors::SensorFrame;
@@ -405,51 +404,82 @@ pub(crate) fn hex(bytes: &[u8]) -> String {
     })
 }
 
-/// The schema of a clip's DVS events: `frame` (the frame whose interval (previous, this] holds the event),
-/// `t_ns`, `x`, `y`, `polarity` (true: brighter).
+/// The schema of a clip's DVS events (the table of no events): see [`dvs_batch`].
 fn dvs_schema() -> SchemaRef {
-    Arc::new(Schema::new(vec![
-        Field::new("frame", DataType::UInt32, false),
-        Field::new("t_ns", DataType::Int64, false),
-        Field::new("x", DataType::UInt16, false),
-        Field::new("y", DataType::UInt16, false),
-        Field::new("polarity", DataType::Boolean, false),
-    ]))
+    dvs_batch(0, &[]).schema()
 }
 
-/// One frame's DVS events as a record batch of [`dvs_schema`].
+/// One frame's DVS events: `frame` (the frame whose interval (previous, this] holds the event), `t_ns`, `x`,
+/// `y`, `polarity` (true: brighter).
 pub fn dvs_batch(frame: u32, events: &[dvs::Event]) -> RecordBatch {
-    let columns: Vec<ArrayRef> = vec![
-        Arc::new(UInt32Array::from_iter_values(events.iter().map(|_| frame))),
-        Arc::new(Int64Array::from_iter_values(events.iter().map(|e| e.t_ns))),
-        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.x))),
-        Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.y))),
-        Arc::new(BooleanArray::from_iter(events.iter().map(|e| Some(e.positive)))),
-    ];
-    RecordBatch::try_new(dvs_schema(), columns).expect("columns match their schema")
+    Table::new()
+        .column(
+            "frame",
+            false,
+            Arc::new(UInt32Array::from_iter_values(events.iter().map(|_| frame))),
+        )
+        .column(
+            "t_ns",
+            false,
+            Arc::new(Int64Array::from_iter_values(events.iter().map(|e| e.t_ns))),
+        )
+        .column(
+            "x",
+            false,
+            Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.x))),
+        )
+        .column(
+            "y",
+            false,
+            Arc::new(UInt16Array::from_iter_values(events.iter().map(|e| e.y))),
+        )
+        .column(
+            "polarity",
+            false,
+            Arc::new(BooleanArray::from_iter(events.iter().map(|e| Some(e.positive)))),
+        )
+        .finish()
 }
 
 /// The `sensors` index table of a clip.
 pub fn index_batch(clip_id: &str, rows: &[IndexRow]) -> RecordBatch {
-    let schema = Schema::new(vec![
-        Field::new("clip_id", DataType::Utf8, false),
-        Field::new("frame", DataType::UInt32, true),
-        Field::new("timestamp_ns", DataType::Int64, true),
-        Field::new("stream", DataType::Utf8, false),
-        Field::new("path", DataType::Utf8, false),
-        Field::new("bytes", DataType::UInt64, false),
-        Field::new("sha256", DataType::Utf8, false),
-    ]);
-    let columns: Vec<ArrayRef> = vec![
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|_| clip_id))),
-        Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.frame))),
-        Arc::new(Int64Array::from_iter(rows.iter().map(|r| r.timestamp_ns))),
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.stream))),
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.path.as_str()))),
-        Arc::new(UInt64Array::from_iter_values(rows.iter().map(|r| r.bytes))),
-        Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.sha256.as_str()))),
-    ];
-    RecordBatch::try_new(Arc::new(schema), columns).expect("columns match their schema")
+    Table::new()
+        .column(
+            "clip_id",
+            false,
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|_| clip_id))),
+        )
+        .column(
+            "frame",
+            true,
+            Arc::new(UInt32Array::from_iter(rows.iter().map(|r| r.frame))),
+        )
+        .column(
+            "timestamp_ns",
+            true,
+            Arc::new(Int64Array::from_iter(rows.iter().map(|r| r.timestamp_ns))),
+        )
+        .column(
+            "stream",
+            false,
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.stream))),
+        )
+        .column(
+            "path",
+            false,
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.path.as_str()))),
+        )
+        .column(
+            "bytes",
+            false,
+            Arc::new(UInt64Array::from_iter_values(rows.iter().map(|r| r.bytes))),
+        )
+        .column(
+            "sha256",
+            false,
+            Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.sha256.as_str()))),
+        )
+        .finish()
 }
 
 #[cfg(test)]

@@ -189,15 +189,6 @@ impl std::ops::Mul for V3 {
     }
 }
 
-/// `x.floor()` per lane as an integer, for `|x| < 2^31` (NaN and larger values give `i32::MIN`): rounding
-/// to nearest, then one down where that went up.
-#[inline(always)]
-pub fn floor_int(x: F) -> I {
-    let r = x.fast_round_int();
-    let up: I = wide::bytemuck::cast(r.round_float().simd_gt(x));
-    r + up
-}
-
 /// `e^x` per lane (Cephes' `expf` polynomial, relative error below 2·10⁻⁷), `x` clamped to [−87.3, 88.3].
 #[inline(always)]
 pub fn exp_lanes(x: F) -> F {
@@ -222,15 +213,6 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        #[test]
-        fn the_lane_floor_is_the_floor(a in -2.0e9f32..2.0e9, b in -1.0e4f32..1.0e4, c in -3.0f32..3.0) {
-            let v = [a, b, c, b.trunc() - 0.5, -a, -b, -c, 0.5 - b.trunc()];
-            let got = floor_int(F::new(v)).to_array();
-            for (g, x) in got.iter().zip(v) {
-                prop_assert_eq!(*g as f32, x.floor(), "{}", x);
-            }
-        }
-
         #[test]
         fn the_lane_exp_is_within_a_few_ulps(x in -87.0f32..88.0) {
             let got = exp_lanes(F::splat(x)).to_array()[0];

@@ -6,7 +6,8 @@
 use glam::Vec3;
 use std::ops::Add;
 
-use super::lanes::{F, I, V3, floor_int, lanes_from};
+use super::lanes::{F, I, V3, lanes_from};
+use super::round::floor_int;
 use crate::spec::types::WeatherParams;
 
 /// The lighting of a clip.

@@ -6,41 +6,14 @@
 use glam::{Vec2, Vec3};
 use std::ops::{Add, Mul, Sub};
 
-use super::lanes::{F, LANES, V3, exp_lanes, floor_int, lanes_from, transpose_cells};
+use super::lanes::{F, LANES, V3, exp_lanes, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
+use super::round::{floor_i32, floor_int};
 use crate::sensors::scene::{
     CROSSWALK_PAINT, FrameScene, Mark, Material, PieceSurface, Prim, SceneCapsule, StaticScene, crosswalk_across,
     road_marking, road_paint_near, tag,
 };
 use crate::util::mix::splitmix64;
-
-/// `x.floor()` without the call into libm that `f32::floor` compiles to on x86-64 without SSE4.1 (a hot
-/// spot of texture lookups); the same value for every finite `x` and NaN (only `−0.0` becomes `+0.0`).
-#[inline(always)]
-pub fn floor_f32(x: f32) -> f32 {
-    // Every float of magnitude 2^23 or more is an integer already.
-    if x.abs() < 8_388_608.0 { floor_i32(x) as f32 } else { x }
-}
-
-/// Adding `1.5 × 2^23` to a float of magnitude below [`ROUNDING_RANGE`] rounds it to an integer, held in the
-/// sum's low mantissa bits (its unit in the last place is 1).
-const ROUNDING_MAGIC: f32 = 12_582_912.0;
-const ROUNDING_RANGE: f32 = 4_194_304.0;
-
-/// `x.floor()` as an integer, for `|x| < 2^31` (texture coordinates; NaN gives 0). Below 2^22 in magnitude
-/// (every texture and shadow-map coordinate) without the saturating float-to-integer conversion, whose
-/// range checks cost as much as the rest of a texture lookup.
-#[inline(always)]
-pub fn floor_i32(x: f32) -> i32 {
-    if x.abs() < ROUNDING_RANGE {
-        let big = x + ROUNDING_MAGIC;
-        let nearest = big.to_bits() as i32 - ROUNDING_MAGIC.to_bits() as i32;
-        nearest - i32::from(big - ROUNDING_MAGIC > x)
-    } else {
-        let t = x as i32;
-        t - i32::from(t as f32 > x)
-    }
-}
 
 /// A seeded tileable value-noise table, sampled bilinearly (values in [−1, 1]).
 ///
@@ -455,18 +428,6 @@ mod tests {
 
     proptest! {
         #[test]
-        fn fast_floors_equal_the_standard_floor(x in -3.0e9f32..3.0e9f32, small in -1.0e4f32..1.0e4f32) {
-            for v in [x, small, small.trunc(), small.trunc() - 0.5] {
-                prop_assert_eq!(floor_f32(v), v.floor(), "{}", v);
-                if v.abs() < 2.0e9 {
-                    prop_assert_eq!(floor_i32(v) as f32, v.floor(), "{}", v);
-                }
-            }
-        }
-    }
-
-    proptest! {
-        #[test]
         fn lane_noise_samples_equal_single_ones(x in proptest::array::uniform8(-3.0e3f32..3.0e3), y in proptest::array::uniform8(-3.0e3f32..3.0e3)) {
             let nz = Noise::new(17);
             let got = nz.sample_lanes(F::new(x), F::new(y)).to_array();
@@ -566,41 +527,5 @@ mod tests {
             "{crosswalk_painted} {lanes_painted}"
         );
         assert!(lanes_painted < 3 * 2 * 400 * LANES / 2, "{lanes_painted}");
-    }
-
-    #[test]
-    fn fast_floor_edge_cases() {
-        for v in [
-            0.0f32,
-            1.0,
-            -1.0,
-            -0.5,
-            0.5,
-            8_388_607.5,
-            -8_388_607.5,
-            8_388_608.0,
-            1.0e30,
-            -1.0e30,
-            4_194_303.5,
-            -4_194_303.5,
-            4_194_304.0,
-            -4_194_304.0,
-            4_194_304.5,
-            -4_194_304.5,
-            2.5,
-            -2.5,
-            3.5,
-            -3.5,
-            0.999_999_94,
-            -0.999_999_94,
-        ] {
-            assert_eq!(floor_f32(v), v.floor(), "{v}");
-            if v.abs() < 2.0e9 {
-                assert_eq!(floor_i32(v) as f32, v.floor(), "{v}");
-            }
-        }
-        assert!(floor_f32(f32::NAN).is_nan());
-        assert_eq!(floor_f32(f32::INFINITY), f32::INFINITY);
-        assert_eq!(floor_f32(f32::NEG_INFINITY), f32::NEG_INFINITY);
     }
 }

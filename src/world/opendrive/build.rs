@@ -12,7 +12,7 @@ use super::parse::{RawNetwork, RawRoad, RawSection, ref_at};
 use super::{MAX_LANE_OFFSET_M, MAX_PIECES, MAX_WIDTH_M};
 use crate::world::{
     Crosswalk, Junction, Lane, LanePiece, LaneType, Obstacle, ObstacleKind, Road, RoadNetwork, TownSource,
-    TravelDirection, WorldError, index, obstacles, routes,
+    TravelDirection, WorldError, index, obstacles, routes, sidewalks,
 };
 
 /// Per station: reference point, left normal, elevation, carriageway width, per-lane (inner t, outer t, width).
@@ -336,7 +336,7 @@ pub(crate) fn build_with(
         bounds: (lo, hi),
         index: index::LaneIndex::default(),
         lane_graph: routes::LaneGraph::default(),
-        sidewalk_graph: routes::SidewalkGraph::default(),
+        sidewalk_graph: sidewalks::SidewalkGraph::default(),
         obstacle_index: obstacles::ObstacleIndex::default(),
     };
     net.index = index::LaneIndex::build(&net);
@@ -347,7 +347,7 @@ pub(crate) fn build_with(
     };
     net.obstacle_index = obstacles::ObstacleIndex::build(&net.obstacles);
     net.lane_graph = routes::LaneGraph::build(&net);
-    net.sidewalk_graph = routes::SidewalkGraph::build(&net);
+    net.sidewalk_graph = sidewalks::SidewalkGraph::build(&net);
     net.signals = crate::world::signals::derive(&raw, &net, synthesize_signals);
     Ok(net)
 }

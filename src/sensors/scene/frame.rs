@@ -1,0 +1,364 @@
+//! The dynamic part of a scene ([`FrameScene`]), built per frame (or per DVS sub-step, between two frames):
+//! traffic vehicles (body, cabin, wheels, lamps, wear), cyclists and pedestrians (the capsules of
+//! [`body::pose`](crate::sensors::body::pose), the very body the keypoints come from), whose primitive ids
+//! follow the static scene's.
+
+use super::*;
+
+/// The dynamic part of a frame's scene (traffic and pedestrians); its primitive ids follow the static
+/// scene's.
+#[derive(Clone, Debug, Default)]
+pub struct FrameScene {
+    /// Triangles and primitives of the frame's agents.
+    pub mesh: Mesh,
+    /// Body capsules (for [`Material::Body`] normals).
+    pub capsules: Vec<SceneCapsule>,
+    /// Vehicle head lamps (position, forward axis), for lighting.
+    pub head_lamps: Vec<(Vec3, Vec3)>,
+}
+
+/// Linear interpolation of two vehicle frames (the DVS's sub-frame renders).
+pub(super) fn lerp_vehicle(a: &VehicleFrame, b: &VehicleFrame, t: f64) -> (DVec3, f64) {
+    lerp_pose(a.pos, a.yaw_rad, b.pos, b.yaw_rad, t)
+}
+
+/// Linear interpolation of two poses (position, yaw the short way round).
+pub(super) fn lerp_pose(a: DVec3, a_yaw: f64, b: DVec3, b_yaw: f64, t: f64) -> (DVec3, f64) {
+    let dyaw = (b_yaw - a_yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    (a.lerp(b, t), a_yaw + dyaw * t)
+}
+
+/// Linear interpolation of two pedestrian frames (state and flags of the nearer one).
+pub(super) fn lerp_ped(a: &PedFrame, b: &PedFrame, t: f64) -> PedFrame {
+    let wrap = |d: f64| (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    let mut out = if t < 0.5 { *a } else { *b };
+    out.pos = a.pos.lerp(b.pos, t);
+    out.yaw_rad = a.yaw_rad + wrap(b.yaw_rad - a.yaw_rad) * t;
+    out.head_yaw_rad = a.head_yaw_rad + wrap(b.head_yaw_rad - a.head_yaw_rad) * t;
+    out.velocity = a.velocity.lerp(b.velocity, t);
+    let mut dp = b.gait_phase - a.gait_phase;
+    dp -= dp.round();
+    out.gait_phase = (a.gait_phase + dp * t).rem_euclid(1.0);
+    if let (Some((ga, ta)), Some((gb, tb))) = (a.gesture, b.gesture)
+        && ga == gb
+    {
+        out.gesture = Some((ga, ta + (tb - ta) * t));
+    }
+    out
+}
+
+pub(super) const CAR_COLOURS: [[u8; 3]; 10] = [
+    [235, 235, 232],
+    [24, 24, 26],
+    [168, 170, 174],
+    [96, 98, 104],
+    [150, 20, 24],
+    [26, 52, 120],
+    [30, 70, 48],
+    [200, 190, 160],
+    [70, 110, 160],
+    [190, 120, 30],
+];
+
+/// Which colour of an identity each body capsule wears (see [`body::pose`]'s capsule order).
+#[derive(Clone, Copy)]
+pub(super) enum Wear {
+    Top,
+    Bottom,
+    Skin,
+    Shoes,
+    Head,
+    Sleeve,
+    Leg,
+}
+
+pub(super) const WEAR: [Wear; CAPSULES] = [
+    Wear::Top,    // torso
+    Wear::Top,    // shoulders
+    Wear::Head,   // head
+    Wear::Top,    // upper arms
+    Wear::Top,    //
+    Wear::Sleeve, // forearms
+    Wear::Sleeve, //
+    Wear::Bottom, // thighs
+    Wear::Bottom, //
+    Wear::Leg,    // shins
+    Wear::Leg,    //
+    Wear::Shoes,  // feet
+    Wear::Shoes,  //
+    Wear::Skin,   // neck
+];
+
+impl FrameScene {
+    /// The primitive of an id: the static scene's, or one of this frame's.
+    #[inline]
+    pub fn prim<'a>(&'a self, stat: &'a StaticScene, id: u32) -> &'a Prim {
+        stat.prims
+            .get(id as usize)
+            .unwrap_or_else(|| &self.mesh.prims[id as usize - stat.prims.len()])
+    }
+
+    /// Builds the dynamic scene at time `t`.
+    pub fn build(&mut self, stat: &StaticScene, script: &ClipScript, trace: &ClipTrace, t: SceneTime) {
+        self.mesh.clear(stat.prims.len() as u32);
+        self.capsules.clear();
+        self.head_lamps.clear();
+        let f0 = t.frame as usize;
+        for (vi, frames) in trace.vehicles.iter().enumerate() {
+            let Some(a) = frames.get(f0) else { continue };
+            let b = frames.get(f0 + 1).unwrap_or(a);
+            let (pos, yaw) = lerp_vehicle(a, b, t.alpha);
+            let id = script.vehicles.get(vi).map_or(vi as u32, |v| v.id);
+            let paint = stat.car_paint.get(vi).copied().unwrap_or(Vec3::splat(0.5));
+            // An emergency vehicle's light bar flashes red and blue, alternating at 2 Hz.
+            let flash = script.vehicles.get(vi).and_then(|v| v.emergency).map(|_| {
+                let time_s = (f64::from(t.frame) + t.alpha) / f64::from(trace.fps.max(1));
+                (time_s * 2.0).fract() < 0.5
+            });
+            self.push_vehicle(
+                stat.rel(pos),
+                yaw as f32,
+                paint,
+                VEHICLE_INSTANCE_BASE.saturating_add(id as u16),
+                flash,
+            );
+        }
+        // Traffic lights' lamps: red on top, amber, green at the bottom, the one of the frame's state lit.
+        for g in stat.signal_heads.iter().filter_map(|&k| trace.signals.get(k)) {
+            let Some(&state) = g.states.get(f0) else { continue };
+            let head = stat.rel(g.position);
+            let (s, c) = (g.facing_rad as f32).sin_cos();
+            let face = head.truncate() + Vec2::new(c, s) * (SIGNAL_HOUSING_HALF_DEPTH_M + 0.01);
+            for (k, lamp_state, colour) in [
+                (1.0f32, LightState::Red, [255, 30, 20]),
+                (0.0, LightState::Amber, [255, 170, 0]),
+                (-1.0, LightState::Green, [40, 255, 90]),
+            ] {
+                // The lit lamp glows (by day too); the others are dark glass.
+                let (material, albedo) = if state == lamp_state {
+                    (Material::Beacon, linear(colour))
+                } else {
+                    (Material::Metal, linear(colour) * 0.08)
+                };
+                let lamp = Prim {
+                    material,
+                    tag: tag::TRAFFIC_LIGHT,
+                    instance: 0,
+                    albedo,
+                    albedo2: albedo,
+                    normal: Vec3::Z,
+                    aux: 0,
+                };
+                let z = head.z + k * 0.28;
+                self.mesh.upright_box(
+                    face,
+                    g.facing_rad as f32,
+                    Vec2::new(0.02, SIGNAL_LAMP_HALF_M),
+                    [z - SIGNAL_LAMP_HALF_M, z + SIGNAL_LAMP_HALF_M],
+                    lamp,
+                    lamp,
+                );
+            }
+        }
+        for (pi, frames) in trace.pedestrians.iter().enumerate() {
+            let Some(a) = frames.get(f0) else { continue };
+            let b = frames.get(f0 + 1).unwrap_or(a);
+            let frame = if t.alpha > 0.0 { lerp_ped(a, b, t.alpha) } else { *a };
+            let Some(ps) = script.pedestrians.get(pi) else { continue };
+            let Some((outfit, child_outfit)) = stat.outfits.get(pi) else {
+                continue;
+            };
+            let pose = body::pose(&frame, ps.identity.height_m, DVec3::ZERO);
+            self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id), tag::PEDESTRIAN);
+            if let (Some(child), Some(child_outfit)) = (&ps.child, child_outfit) {
+                let child_frame = PedFrame { gesture: None, ..frame };
+                let pose = body::pose(&child_frame, child.height_m, CHILD_OFFSET_M);
+                let inst = CHILD_INSTANCE_BASE.saturating_add(ps.id.min(16_383) as u16);
+                self.push_body(stat, &pose, child_outfit, inst, tag::PEDESTRIAN);
+            }
+        }
+        for (ci, frames) in trace.cyclists.iter().enumerate() {
+            let (Some(a), Some(cs), Some((outfit, paint))) =
+                (frames.get(f0), script.cyclists.get(ci), stat.riders.get(ci))
+            else {
+                continue;
+            };
+            let b = frames.get(f0 + 1).unwrap_or(a);
+            let mut frame = *a;
+            if t.alpha > 0.0 {
+                let (pos, yaw) = lerp_pose(a.pos, a.yaw_rad, b.pos, b.yaw_rad, t.alpha);
+                frame.pos = pos;
+                frame.yaw_rad = yaw;
+                frame.ridden_m = a.ridden_m + (b.ridden_m - a.ridden_m) * t.alpha;
+                let mut dp = b.crank_phase - a.crank_phase;
+                dp -= dp.round();
+                frame.crank_phase = (a.crank_phase + dp * t.alpha).rem_euclid(1.0);
+            }
+            let instance = CYCLIST_INSTANCE_BASE.saturating_add(cs.id.min(16_383) as u16);
+            let rider = cyclist::rider_pose(&frame, cs.rider.height_m);
+            self.push_body(stat, &rider, outfit, instance, tag::RIDER);
+            let tyre = linear([22, 22, 22]);
+            let metal = linear([150, 150, 152]);
+            let forward = {
+                let (s, c) = (frame.yaw_rad as f32).sin_cos();
+                Vec3::new(c, s, 0.0)
+            };
+            for (k, cap) in cyclist::bicycle(&frame, cs.rider.height_m).iter().enumerate() {
+                // Frame tubes in the bicycle's colour; handlebar, saddle and cranks dark metal; wheels black.
+                let albedo = match k {
+                    0..=6 => *paint,
+                    7 | 9 | 10 => metal * 0.4,
+                    _ => tyre,
+                };
+                let sc = SceneCapsule {
+                    a: stat.rel(cap.a),
+                    b: stat.rel(cap.b),
+                    radius_m: cap.radius_m as f32,
+                };
+                self.capsules.push(sc);
+                let prim = self.mesh.prim(Prim {
+                    material: Material::Body,
+                    tag: tag::BICYCLE,
+                    instance,
+                    albedo,
+                    albedo2: albedo,
+                    normal: forward,
+                    aux: (self.capsules.len() - 1) as u32,
+                });
+                self.mesh.capsule(&sc, prim);
+            }
+            // Lights (emissive at night): a white lamp under the handlebar, a red one under the saddle.
+            let (sin, cos) = (frame.yaw_rad as f32).sin_cos();
+            let fwd = Vec2::new(cos, sin);
+            let centre = stat.rel(frame.pos);
+            let hip_z = cyclist::hip_height_m(cs.rider.height_m) as f32;
+            for (along, z, material, albedo) in [
+                (0.43f32, hip_z - 0.12, Material::HeadLamp, linear([240, 240, 230])),
+                (-0.36, hip_z - 0.16, Material::TailLamp, linear([200, 12, 12])),
+            ] {
+                let lamp = Prim {
+                    material,
+                    tag: tag::BICYCLE,
+                    instance,
+                    albedo,
+                    albedo2: albedo,
+                    normal: Vec3::Z,
+                    aux: 0,
+                };
+                self.mesh.upright_box(
+                    centre.truncate() + fwd * along,
+                    frame.yaw_rad as f32,
+                    Vec2::new(0.03, 0.035),
+                    [centre.z + z - 0.035, centre.z + z + 0.035],
+                    lamp,
+                    lamp,
+                );
+            }
+        }
+    }
+
+    /// Pushes a car; `light_bar`: an emergency vehicle's light bar on the roof, with its red half lit (`true`)
+    /// or its blue half.
+    fn push_vehicle(&mut self, pos: Vec3, yaw: f32, paint: Vec3, instance: u16, light_bar: Option<bool>) {
+        let (l, w, h) = (VEHICLE_LENGTH_M as f32, VEHICLE_WIDTH_M as f32, VEHICLE_HEIGHT_M as f32);
+        let (s, c) = yaw.sin_cos();
+        let fwd = Vec2::new(c, s);
+        let centre = pos.truncate();
+        let base = pos.z;
+        let car = |material, albedo| Prim {
+            material,
+            tag: tag::CAR,
+            instance,
+            albedo,
+            albedo2: albedo,
+            normal: Vec3::Z,
+            aux: 0,
+        };
+        let body = car(Material::CarPaint, paint);
+        let glass = car(Material::CarGlass, linear([14, 16, 20]));
+        let tyre = car(Material::Tyre, linear([20, 20, 20]));
+        // Lower body, cabin (glass sides, painted roof), four wheels.
+        self.mesh.upright_box(
+            centre,
+            yaw,
+            Vec2::new(l * 0.5, w * 0.5),
+            [base + 0.3, base + 0.55 * h + 0.15],
+            body,
+            body,
+        );
+        self.mesh.upright_box(
+            centre - fwd * (0.08 * l),
+            yaw,
+            Vec2::new(l * 0.26, w * 0.45),
+            [base + 0.55 * h + 0.15, base + h],
+            glass,
+            body,
+        );
+        for (fx, sy) in [(0.32f32, 1.0f32), (0.32, -1.0), (-0.32, 1.0), (-0.32, -1.0)] {
+            let wc = centre + fwd * (fx * l) + fwd.perp() * (sy * (w * 0.5 - 0.14));
+            self.mesh
+                .upright_box(wc, yaw, Vec2::new(0.33, 0.13), [base, base + 0.64], tyre, tyre);
+        }
+        // Lamps: small boxes standing just out of the front and rear faces.
+        for (fx, mat, albedo) in [
+            (0.5f32, Material::HeadLamp, linear([240, 240, 230])),
+            (-0.5, Material::TailLamp, linear([160, 10, 10])),
+        ] {
+            for sy in [1.0f32, -1.0] {
+                let lc = centre + fwd * (fx * l + fx.signum() * 0.01) + fwd.perp() * (sy * w * 0.33);
+                self.mesh.upright_box(
+                    lc,
+                    yaw,
+                    Vec2::new(0.03, 0.16),
+                    [base + 0.6, base + 0.75],
+                    car(mat, albedo),
+                    car(mat, albedo),
+                );
+            }
+        }
+        if let Some(red_lit) = light_bar {
+            let roof = centre - fwd * (0.08 * l);
+            for (sy, lit, colour) in [(1.0f32, red_lit, [255, 20, 20]), (-1.0, !red_lit, [30, 60, 255])] {
+                let albedo = if lit { linear(colour) } else { linear(colour) * 0.15 };
+                let lamp = car(Material::Beacon, albedo);
+                self.mesh.upright_box(
+                    roof + fwd.perp() * (sy * 0.3),
+                    yaw,
+                    Vec2::new(0.12, 0.28),
+                    [base + h, base + h + 0.14],
+                    lamp,
+                    lamp,
+                );
+            }
+        }
+        self.head_lamps.push((
+            Vec3::new(centre.x + fwd.x * 0.5 * l, centre.y + fwd.y * 0.5 * l, base + 0.7),
+            Vec3::new(fwd.x, fwd.y, -0.05).normalize(),
+        ));
+    }
+
+    fn push_body(&mut self, stat: &StaticScene, pose: &body::BodyPose, outfit: &Outfit, instance: u16, tag: u8) {
+        let forward = {
+            let (s, c) = (pose.yaw_rad as f32).sin_cos();
+            Vec3::new(c, s, 0.0)
+        };
+        for (cap, &(material, albedo)) in pose.capsules.iter().zip(&outfit.parts) {
+            let sc = SceneCapsule {
+                a: stat.rel(cap.a),
+                b: stat.rel(cap.b),
+                radius_m: cap.radius_m as f32,
+            };
+            self.capsules.push(sc);
+            let prim = self.mesh.prim(Prim {
+                material,
+                tag,
+                instance,
+                albedo,
+                albedo2: outfit.hair,
+                normal: forward,
+                aux: (self.capsules.len() - 1) as u32,
+            });
+            self.mesh.capsule(&sc, prim);
+        }
+    }
+}

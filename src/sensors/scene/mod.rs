@@ -1,0 +1,442 @@
+//! The renderable scene of a clip: triangles with a primitive table (material, CARLA semantic tag, instance
+//! id, albedo, normal), built from the town (once per clip) and from the trace (once per frame). One source for
+//! every camera stream and, later, for LiDAR: what a camera draws is what a ray would hit.
+//!
+//! - Static part ([`StaticScene`]): the lane pieces near the ego's path (roads at their elevation, sidewalks
+//!   raised by the world's curb, curb faces), a terrain plane, buildings (walls and roofs), trees, poles and
+//!   street lamps (synthesised along sidewalks; towns and maps rarely carry them). Lane markings and crosswalk
+//!   stripes are not geometry: they are painted by the surface functions ([`road_paint`]) from the lane
+//!   piece a road pixel belongs to, so the label streams and the image agree exactly.
+//! - Dynamic part ([`FrameScene`]): traffic vehicles (body, cabin, wheels, lamps) and pedestrians (the
+//!   capsules of [`super::body::pose`], the very body the keypoints come from) at a frame, or at a time between
+//!   two frames for the DVS's sub-frame renders.
+//!
+//! Positions are `f32` metres relative to the clip's [`StaticScene::origin`] (a world point near the ego's
+//! path), which keeps single precision at the millimetre over a town.
+
+mod frame;
+mod paint;
+mod town;
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+use glam::{DVec2, DVec3, Vec2, Vec3};
+
+use super::body::{self, CAPSULES, CHILD_OFFSET_M};
+use super::cyclist;
+use crate::plan::{ClipScript, EmergencyKind, Identity};
+use crate::sim::trace::{ClipTrace, LightState, PedFrame, VehicleFrame};
+use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
+use crate::util::mix::splitmix64;
+use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
+pub use frame::*;
+pub use paint::*;
+pub use town::*;
+
+/// CARLA's semantic tags (CARLA 0.9.14+, `carla.CityObjectLabel`), as written in the `semantic` stream.
+pub mod tag {
+    /// Nothing (never drawn: every pixel is something).
+    pub const UNLABELED: u8 = 0;
+    /// Road surface.
+    pub const ROAD: u8 = 1;
+    /// Sidewalk surface and curb.
+    pub const SIDEWALK: u8 = 2;
+    /// Buildings.
+    pub const BUILDING: u8 = 3;
+    /// Poles and street lamps.
+    pub const POLE: u8 = 6;
+    /// Traffic light heads.
+    pub const TRAFFIC_LIGHT: u8 = 7;
+    /// Trees.
+    pub const VEGETATION: u8 = 9;
+    /// Grass and soil beside the roads.
+    pub const TERRAIN: u8 = 10;
+    /// Sky.
+    pub const SKY: u8 = 11;
+    /// Pedestrians.
+    pub const PEDESTRIAN: u8 = 12;
+    /// A cyclist's rider.
+    pub const RIDER: u8 = 13;
+    /// Bicycles.
+    pub const BICYCLE: u8 = 19;
+    /// Cars.
+    pub const CAR: u8 = 14;
+    /// Lane markings and crosswalk stripes.
+    pub const ROAD_LINE: u8 = 24;
+    /// Paved ground that is neither road nor sidewalk (medians, borders, shoulders).
+    pub const GROUND: u8 = 25;
+    /// Names of the tags, indexed by id (CARLA's spelling).
+    pub const NAMES: [&str; 29] = [
+        "Unlabeled",
+        "Road",
+        "Sidewalk",
+        "Building",
+        "Wall",
+        "Fence",
+        "Pole",
+        "TrafficLight",
+        "TrafficSign",
+        "Vegetation",
+        "Terrain",
+        "Sky",
+        "Pedestrian",
+        "Rider",
+        "Car",
+        "Truck",
+        "Bus",
+        "Train",
+        "Motorcycle",
+        "Bicycle",
+        "Static",
+        "Dynamic",
+        "Other",
+        "Water",
+        "RoadLine",
+        "Ground",
+        "Bridge",
+        "RailTrack",
+        "GuardRail",
+    ];
+    /// CARLA's palette for the tags (the CityScapes colours), indexed by id.
+    pub const PALETTE: [[u8; 3]; 29] = [
+        [0, 0, 0],
+        [128, 64, 128],
+        [244, 35, 232],
+        [70, 70, 70],
+        [102, 102, 156],
+        [190, 153, 153],
+        [153, 153, 153],
+        [250, 170, 30],
+        [220, 220, 0],
+        [107, 142, 35],
+        [152, 251, 152],
+        [70, 130, 180],
+        [220, 20, 60],
+        [255, 0, 0],
+        [0, 0, 142],
+        [0, 0, 70],
+        [0, 60, 100],
+        [0, 80, 100],
+        [0, 0, 230],
+        [119, 11, 32],
+        [110, 190, 160],
+        [170, 120, 50],
+        [55, 90, 80],
+        [45, 60, 150],
+        [157, 234, 50],
+        [81, 0, 81],
+        [150, 100, 100],
+        [230, 150, 140],
+        [180, 165, 180],
+    ];
+}
+
+/// Instance ids of the `instance` stream (16-bit): 0 for static scenery and sky, `1 + pedestrian` for a
+/// pedestrian (its id in the tables), [`CHILD_INSTANCE_BASE`]` + parent` for the child walking beside a parent,
+/// [`VEHICLE_INSTANCE_BASE`]` + vehicle` for a traffic vehicle (its id in the `vehicles` table),
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist.
+pub const CHILD_INSTANCE_BASE: u16 = 16_384;
+/// See [`CHILD_INSTANCE_BASE`].
+pub const VEHICLE_INSTANCE_BASE: u16 = 32_768;
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist (rider and bicycle; its id in the `cyclists` table).
+pub const CYCLIST_INSTANCE_BASE: u16 = 49_152;
+
+/// The instance id of pedestrian `id`.
+pub fn pedestrian_instance(id: u32) -> u16 {
+    (1 + id).min(u32::from(CHILD_INSTANCE_BASE) - 1) as u16
+}
+
+/// The actor an instance id belongs to, as the tables number it: the pedestrian id (for a pedestrian and the
+/// child walking with it), the vehicle id or the cyclist id; `None` for the static scene. Undoes
+/// [`pedestrian_instance`], [`CHILD_INSTANCE_BASE`], [`VEHICLE_INSTANCE_BASE`] and [`CYCLIST_INSTANCE_BASE`].
+pub fn actor_of_instance(instance: u16) -> Option<u32> {
+    match instance {
+        0 => None,
+        i if i >= CYCLIST_INSTANCE_BASE => Some(u32::from(i - CYCLIST_INSTANCE_BASE)),
+        i if i >= VEHICLE_INSTANCE_BASE => Some(u32::from(i - VEHICLE_INSTANCE_BASE)),
+        i if i >= CHILD_INSTANCE_BASE => Some(u32::from(i - CHILD_INSTANCE_BASE)),
+        i => Some(u32::from(i) - 1),
+    }
+}
+
+/// How a primitive's surface is shaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Material {
+    /// Asphalt with lane markings and crosswalks; `aux` is the lane piece's [`PieceSurface`] index.
+    Road,
+    /// Sidewalk tiles.
+    Sidewalk,
+    /// Curb stone faces.
+    Curb,
+    /// Grass and soil.
+    Terrain,
+    /// A building wall with windows; `aux` is the building's index (window lighting seed).
+    Wall,
+    /// A flat roof.
+    Roof,
+    /// Painted metal (poles, lamp arms).
+    Metal,
+    /// A street lamp's head (emissive at night).
+    LampHead,
+    /// Tree bark.
+    Trunk,
+    /// Tree foliage.
+    Foliage,
+    /// Car paint.
+    CarPaint,
+    /// Car windows.
+    CarGlass,
+    /// Tyres.
+    Tyre,
+    /// Headlamps (emissive at night).
+    HeadLamp,
+    /// Tail lamps (emissive at night).
+    TailLamp,
+    /// An emergency vehicle's flashing light (emits its albedo, by day too).
+    Beacon,
+    /// Skin or clothing of a body part; `aux` is the capsule's index in [`FrameScene::capsules`] (smooth
+    /// normals).
+    Body,
+    /// A head: skin in front, hair on top and at the back (`albedo2`); `aux` as for [`Material::Body`],
+    /// `normal` is the body's forward axis.
+    Head,
+}
+
+/// One primitive: everything the shading and the label streams need of a surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prim {
+    /// Shading model.
+    pub material: Material,
+    /// CARLA semantic tag.
+    pub tag: u8,
+    /// Instance id (0 for scenery).
+    pub instance: u16,
+    /// Base colour, linear RGB.
+    pub albedo: Vec3,
+    /// Second colour (hair for heads), linear RGB.
+    pub albedo2: Vec3,
+    /// Unit normal for flat surfaces (see [`Material::Head`] for heads).
+    pub normal: Vec3,
+    /// Material-specific index (see [`Material`]).
+    pub aux: u32,
+}
+
+/// A triangle of the scene: three vertices (metres, relative to the scene origin) and its primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tri {
+    /// Vertices.
+    pub v: [Vec3; 3],
+    /// Index into the primitive table.
+    pub prim: u32,
+}
+
+/// Triangles and their primitives under construction. Primitive ids start at `base`: a frame's agents
+/// ([`FrameScene`]) number theirs after the static scene's, which are not copied per frame.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Triangles.
+    pub tris: Vec<Tri>,
+    /// Primitives; `prims[i]` has id `base + i`.
+    pub prims: Vec<Prim>,
+    /// Id of the first primitive.
+    pub base: u32,
+}
+
+impl Mesh {
+    /// Empties the mesh; new primitives are numbered from `base`.
+    pub fn clear(&mut self, base: u32) {
+        self.tris.clear();
+        self.prims.clear();
+        self.base = base;
+    }
+
+    /// Adds a primitive; returns its id.
+    pub fn prim(&mut self, prim: Prim) -> u32 {
+        self.prims.push(prim);
+        self.base + (self.prims.len() - 1) as u32
+    }
+
+    /// Adds a quad (corners in order) as two triangles.
+    pub fn quad(&mut self, q: [Vec3; 4], prim: u32) {
+        self.tris.push(Tri {
+            v: [q[0], q[1], q[2]],
+            prim,
+        });
+        self.tris.push(Tri {
+            v: [q[0], q[2], q[3]],
+            prim,
+        });
+    }
+
+    /// Adds an upright box (footprint centre, heading, half extents along and across, z range): four sides of
+    /// `side` and a top of `top`, each face its own primitive with its flat normal.
+    pub fn upright_box(&mut self, centre: Vec2, heading_rad: f32, half: Vec2, z: [f32; 2], side: Prim, top: Prim) {
+        let (s, c) = heading_rad.sin_cos();
+        let ax = Vec2::new(c, s) * half.x;
+        let ay = Vec2::new(-s, c) * half.y;
+        let corners = [centre - ax - ay, centre + ax - ay, centre + ax + ay, centre - ax + ay];
+        for k in 0..4 {
+            let (a, b) = (corners[k], corners[(k + 1) % 4]);
+            let n = -(b - a).perp().normalize_or_zero();
+            let id = self.prim(Prim {
+                normal: Vec3::new(n.x, n.y, 0.0),
+                ..side
+            });
+            self.quad(
+                [
+                    Vec3::new(a.x, a.y, z[0]),
+                    Vec3::new(b.x, b.y, z[0]),
+                    Vec3::new(b.x, b.y, z[1]),
+                    Vec3::new(a.x, a.y, z[1]),
+                ],
+                id,
+            );
+        }
+        let id = self.prim(Prim { normal: Vec3::Z, ..top });
+        self.quad(corners.map(|c| Vec3::new(c.x, c.y, z[1])), id);
+    }
+
+    /// Adds a capsule as a closed polyhedron (8 sides, two rings per cap) of one primitive.
+    pub fn capsule(&mut self, c: &SceneCapsule, prim: u32) {
+        const N: usize = 8;
+        // Vertices sit slightly outside the surface so the polygon's silhouette matches the capsule's on average.
+        let r = c.radius_m * 1.04;
+        let d = c.b - c.a;
+        let axis = if d.length_squared() > 1e-10 {
+            d.normalize()
+        } else {
+            Vec3::Z
+        };
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        let ring = |centre: Vec3, radius: f32| -> [Vec3; N] {
+            std::array::from_fn(|k| {
+                let (s, co) = (k as f32 * std::f32::consts::TAU / N as f32).sin_cos();
+                centre + (u * co + v * s) * radius
+            })
+        };
+        let h = std::f32::consts::FRAC_1_SQRT_2;
+        let rings = [
+            ring(c.a - axis * r * h, r * h),
+            ring(c.a, r),
+            ring(c.b, r),
+            ring(c.b + axis * r * h, r * h),
+        ];
+        let poles = [c.a - axis * r, c.b + axis * r];
+        for k in 0..N {
+            let k1 = (k + 1) % N;
+            self.tris.push(Tri {
+                v: [poles[0], rings[0][k1], rings[0][k]],
+                prim,
+            });
+            self.tris.push(Tri {
+                v: [poles[1], rings[3][k], rings[3][k1]],
+                prim,
+            });
+            for r2 in 0..3 {
+                let (p, q) = (&rings[r2], &rings[r2 + 1]);
+                self.quad([p[k], p[k1], q[k1], q[k]], prim);
+            }
+        }
+    }
+}
+
+struct Builder {
+    origin: DVec3,
+    mesh: Mesh,
+}
+
+impl Builder {
+    fn rel(&self, p: DVec3) -> Vec3 {
+        (p - self.origin).as_vec3()
+    }
+}
+
+fn flat(material: Material, tag: u8, albedo: Vec3, normal: Vec3, aux: u32) -> Prim {
+    Prim {
+        material,
+        tag,
+        instance: 0,
+        albedo,
+        albedo2: albedo,
+        normal,
+        aux,
+    }
+}
+
+/// A capsule of a body in the frame: ends, radius (scene-relative).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneCapsule {
+    /// One end.
+    pub a: Vec3,
+    /// Other end.
+    pub b: Vec3,
+    /// Radius, metres.
+    pub radius_m: f32,
+}
+
+impl SceneCapsule {
+    /// The outward unit normal at a surface point `p`.
+    pub fn normal(&self, p: Vec3) -> Vec3 {
+        let d = self.b - self.a;
+        let t = ((p - self.a).dot(d) / d.length_squared().max(1e-12)).clamp(0.0, 1.0);
+        (p - (self.a + d * t)).normalize_or(Vec3::Z)
+    }
+}
+
+/// A time within a clip: frame `frame` plus `alpha` ∈ [0, 1) of the way to the next frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneTime {
+    /// Frame index.
+    pub frame: u32,
+    /// Fraction of a frame after it.
+    pub alpha: f64,
+}
+
+impl SceneTime {
+    /// Exactly at a frame.
+    pub fn at(frame: u32) -> SceneTime {
+        SceneTime { frame, alpha: 0.0 }
+    }
+}
+
+/// Where the ego is at a time: ground position and yaw.
+pub fn ego_at(trace: &ClipTrace, t: SceneTime) -> (DVec3, f64) {
+    let f = t.frame as usize;
+    let a = &trace.ego[f.min(trace.ego.len() - 1)];
+    let b = &trace.ego[(f + 1).min(trace.ego.len() - 1)];
+    lerp_vehicle(a, b, t.alpha)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_in_polygon_handles_a_square() {
+        let sq = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        assert!(point_in_polygon(&sq, Vec2::splat(0.5)));
+        assert!(!point_in_polygon(&sq, Vec2::new(1.5, 0.5)));
+    }
+
+    #[test]
+    fn actor_ids_undo_the_instance_numbering() {
+        assert_eq!(actor_of_instance(0), None);
+        assert_eq!(actor_of_instance(pedestrian_instance(7)), Some(7));
+        assert_eq!(actor_of_instance(CHILD_INSTANCE_BASE + 7), Some(7));
+        assert_eq!(actor_of_instance(VEHICLE_INSTANCE_BASE + 3), Some(3));
+        assert_eq!(actor_of_instance(CYCLIST_INSTANCE_BASE + 2), Some(2));
+    }
+
+    #[test]
+    fn capsule_normals_point_outwards() {
+        let c = SceneCapsule {
+            a: Vec3::ZERO,
+            b: Vec3::Z,
+            radius_m: 0.1,
+        };
+        assert!((c.normal(Vec3::new(0.1, 0.0, 0.5)) - Vec3::X).length() < 1e-6);
+        assert!((c.normal(Vec3::new(0.0, 0.0, 1.1)) - Vec3::Z).length() < 1e-6);
+    }
+}

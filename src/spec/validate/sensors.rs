@@ -1,0 +1,255 @@
+//! Validation of `sensors` (mounts, cameras, H.264 sizes, DVS, LiDAR) and `annotations`.
+
+use super::*;
+
+impl Validator<'_> {
+    /// H.264 video (4:2:0, OpenH264): an even width and height, at most 3840 × 2160 (or 2160 × 3840).
+    pub(super) fn h264_size(&mut self, rgb: &Rgb) {
+        for (path, value) in [
+            ("sensors.rgb.width_px", rgb.width_px),
+            ("sensors.rgb.height_px", rgb.height_px),
+        ] {
+            if value % 2 != 0 {
+                let problem = Problem::new(
+                    code::OUT_OF_RANGE,
+                    format!("`{path}` must be even for `output.rgb_encoding: h264`, found {value}"),
+                )
+                .at(self.span(path), "odd")
+                .help(format!(
+                    "H.264 stores colour at half resolution (4:2:0): use {} or {}, or another rgb_encoding",
+                    value - 1,
+                    value + 1
+                ));
+                self.problems.push(problem);
+            }
+        }
+        let (long, short) = (rgb.width_px.max(rgb.height_px), rgb.width_px.min(rgb.height_px));
+        if long > 3840 || short > 2160 {
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!(
+                    "an H.264 video can be at most 3840 × 2160, found {} × {}",
+                    rgb.width_px, rgb.height_px
+                ),
+            )
+            .at(self.span("sensors.rgb.width_px"), "too large for H.264")
+            .help("OpenH264 encodes up to level 5.2: use png or jpeg for larger images");
+            self.problems.push(problem);
+        }
+    }
+
+    pub(super) fn mount(&mut self, base: &str, m: &Mount) {
+        self.num(
+            &format!("{base}.forward_m"),
+            m.forward_m,
+            -10.0,
+            10.0,
+            "a position in metres",
+        );
+        self.num(&format!("{base}.left_m"), m.left_m, -5.0, 5.0, "a position in metres");
+        self.num(&format!("{base}.up_m"), m.up_m, 0.0, 10.0, "a height in metres");
+        self.num(
+            &format!("{base}.pitch_deg"),
+            m.pitch_deg,
+            -90.0,
+            90.0,
+            "an angle in degrees",
+        );
+        self.num(
+            &format!("{base}.yaw_deg"),
+            m.yaw_deg,
+            -180.0,
+            180.0,
+            "an angle in degrees",
+        );
+        self.num(
+            &format!("{base}.roll_deg"),
+            m.roll_deg,
+            -180.0,
+            180.0,
+            "an angle in degrees",
+        );
+    }
+
+    pub(super) fn sensors(&mut self, s: &Sensors) {
+        self.num(
+            "sensors.rgb.width_px",
+            f64::from(s.rgb.width_px),
+            16.0,
+            16384.0,
+            "an image width in pixels",
+        );
+        self.num(
+            "sensors.rgb.height_px",
+            f64::from(s.rgb.height_px),
+            16.0,
+            16384.0,
+            "an image height in pixels",
+        );
+        self.num(
+            "sensors.rgb.fov_deg",
+            s.rgb.fov_deg,
+            1.0,
+            170.0,
+            "a horizontal field of view in degrees",
+        );
+        self.mount("sensors.rgb.mount", &s.rgb.mount);
+        let l = &s.lidar;
+        self.num(
+            "sensors.lidar.channels",
+            f64::from(l.channels),
+            1.0,
+            256.0,
+            "a number of laser channels",
+        );
+        self.positive("sensors.lidar.range_m", l.range_m, 1000.0, "a range in metres");
+        self.num(
+            "sensors.lidar.points_per_second",
+            f64::from(l.points_per_second),
+            1.0,
+            10_000_000.0,
+            "points per second",
+        );
+        self.positive(
+            "sensors.lidar.rotation_hz",
+            l.rotation_hz,
+            100.0,
+            "a rotation frequency in Hz",
+        );
+        self.num(
+            "sensors.lidar.upper_fov_deg",
+            l.upper_fov_deg,
+            -90.0,
+            90.0,
+            "an elevation in degrees",
+        );
+        self.num(
+            "sensors.lidar.lower_fov_deg",
+            l.lower_fov_deg,
+            -90.0,
+            90.0,
+            "an elevation in degrees",
+        );
+        if l.lower_fov_deg > l.upper_fov_deg {
+            self.problems.push(
+                Problem::new(
+                    code::EMPTY_RANGE,
+                    format!(
+                        "`sensors.lidar.lower_fov_deg` ({}) is above `upper_fov_deg` ({})",
+                        fmt_num(l.lower_fov_deg),
+                        fmt_num(l.upper_fov_deg)
+                    ),
+                )
+                .at(self.span("sensors.lidar.lower_fov_deg"), "lower")
+                .also(self.span("sensors.lidar.upper_fov_deg"), "upper")
+                .help("the bottom channel's elevation must not exceed the top channel's"),
+            );
+        }
+        self.positive(
+            "sensors.lidar.horizontal_fov_deg",
+            l.horizontal_fov_deg,
+            360.0,
+            "an angle in degrees",
+        );
+        self.num(
+            "sensors.lidar.atmosphere_attenuation_per_m",
+            l.atmosphere_attenuation_per_m,
+            0.0,
+            1.0,
+            "an attenuation rate per metre",
+        );
+        self.probability("sensors.lidar.dropoff_general_rate", l.dropoff_general_rate);
+        self.probability("sensors.lidar.dropoff_intensity_limit", l.dropoff_intensity_limit);
+        self.probability("sensors.lidar.dropoff_zero_intensity", l.dropoff_zero_intensity);
+        self.num(
+            "sensors.lidar.noise_stddev_m",
+            l.noise_stddev_m,
+            0.0,
+            1.0,
+            "a noise level in metres",
+        );
+        self.mount("sensors.lidar.mount", &l.mount);
+        let d = &s.dvs;
+        self.positive(
+            "sensors.dvs.positive_threshold",
+            d.positive_threshold,
+            10.0,
+            "a log-intensity contrast threshold",
+        );
+        self.positive(
+            "sensors.dvs.negative_threshold",
+            d.negative_threshold,
+            10.0,
+            "a log-intensity contrast threshold",
+        );
+        self.num(
+            "sensors.dvs.sigma_positive_threshold",
+            d.sigma_positive_threshold,
+            0.0,
+            10.0,
+            "a standard deviation",
+        );
+        self.num(
+            "sensors.dvs.sigma_negative_threshold",
+            d.sigma_negative_threshold,
+            0.0,
+            10.0,
+            "a standard deviation",
+        );
+        self.positive(
+            "sensors.dvs.log_eps",
+            d.log_eps,
+            1.0,
+            "an epsilon added before the logarithm",
+        );
+        self.num(
+            "sensors.dvs.substeps",
+            f64::from(d.substeps),
+            1.0,
+            16.0,
+            "images rendered per frame interval",
+        );
+    }
+
+    pub(super) fn annotations(&mut self, a: &Annotations) {
+        let v = &a.visibility;
+        if !v.require_in_front {
+            let path = "annotations.visibility.require_in_front";
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!("`{path}` must be true: stage 2 of the gate cannot be turned off"),
+            )
+            .at(self.span(path), "must be true")
+            .help("a pedestrian behind the camera has no image box, so it is never annotated; remove the key");
+            self.problems.push(problem);
+        }
+        self.positive(
+            "annotations.visibility.max_distance_m",
+            v.max_distance_m,
+            1000.0,
+            "a distance in metres",
+        );
+        self.box_size("annotations.visibility.min_box_px", v.min_box_px);
+        self.positive(
+            "annotations.visibility.far_distance_m",
+            v.far_distance_m,
+            1000.0,
+            "a distance in metres",
+        );
+        self.box_size("annotations.visibility.min_box_far_px", v.min_box_far_px);
+        self.probability("annotations.visibility.max_occlusion", v.max_occlusion);
+        self.num(
+            "annotations.crossing_label_smoothing_frames",
+            f64::from(a.crossing_label_smoothing_frames),
+            0.0,
+            300.0,
+            "a number of frames",
+        );
+        self.positive(
+            "annotations.look_cone_deg",
+            a.look_cone_deg,
+            90.0,
+            "the half-angle of the cone around the gaze in which the camera counts as looked at, degrees",
+        );
+    }
+}
