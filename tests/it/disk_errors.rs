@@ -3,9 +3,8 @@
 //! leaves no temporary file and no clip that looks finished but is not, and, for the full disk, the same command
 //! resumes after space is freed and the dataset equals one written without trouble, byte for byte.
 //!
-//! Mounting a tmpfs and dropping privileges need root (CI runs as root). Elsewhere the tests that need it skip,
-//! saying why; with `PEDSYNTH_REQUIRE_ROOT_TESTS=1` (set by `.ci/run`) they fail instead, so CI cannot pass by
-//! skipping.
+//! Mounting a tmpfs and dropping privileges need root (CI runs as root): those tests are `#[ignore]`d, and
+//! `cargo test -- --include-ignored` (CI) runs them, failing where it is not root.
 
 use crate::common;
 
@@ -38,18 +37,9 @@ fn is_root() -> bool {
     })
 }
 
-/// Whether the root-only tests may run; otherwise says why (or panics where skipping is forbidden).
-fn root_tests(test: &str) -> bool {
-    if is_root() {
-        return true;
-    }
-    let why = format!("{test} needs root (to mount a tmpfs / drop privileges)");
-    if std::env::var_os("PEDSYNTH_REQUIRE_ROOT_TESTS").is_some_and(|v| !v.is_empty() && v != "0") {
-        panic!("{why}; PEDSYNTH_REQUIRE_ROOT_TESTS forbids skipping");
-    }
-    use std::io::Write;
-    writeln!(std::io::stderr(), "skipped: {why}").ok();
-    false
+/// Fails the test unless it runs as root (the root-only tests are `#[ignore]`d for that reason).
+fn require_root(test: &str) {
+    assert!(is_root(), "{test} needs root (to mount a tmpfs / drop privileges)");
 }
 
 /// A tmpfs mounted for the test's lifetime.
@@ -116,10 +106,9 @@ fn nothing_half_written(dir: &Path) {
 }
 
 #[test]
+#[ignore = "needs root (mounts a tmpfs or drops privileges): cargo test -- --include-ignored"]
 fn a_full_disk_fails_cleanly_and_the_same_command_resumes_after_freeing_space() {
-    if !root_tests("a_full_disk_fails_cleanly") {
-        return;
-    }
+    require_root("a_full_disk_fails_cleanly");
     let tmp = common::Scratch::new("diskfull");
     let reference = tmp.path().join("reference");
     let o = generate(&reference).output().unwrap();
@@ -182,10 +171,9 @@ fn walk_bytes(dir: &Path) -> u64 {
 }
 
 #[test]
+#[ignore = "needs root (mounts a tmpfs or drops privileges): cargo test -- --include-ignored"]
 fn a_read_only_file_system_is_refused_naming_the_path() {
-    if !root_tests("a_read_only_file_system_is_refused") {
-        return;
-    }
+    require_root("a_read_only_file_system_is_refused");
     let tmp = common::Scratch::new("readonly");
     let mnt = Tmpfs::mount(&tmp.path().join("ro"), "ro,size=1m");
     let out = mnt.0.join("dataset");

@@ -8,7 +8,7 @@
 //!   windows of both classes;
 //! - no crosser but a mid-road jaywalker has C = 1 in its first annotated frame.
 //!
-//! Slow statistical tests: they run with `PEDSYNTH_SLOW_TESTS=1` (`.ci/run` sets it).
+//! Slow statistical tests: `#[ignore]`d, run by `cargo test -- --include-ignored` (CI).
 
 use crate::common;
 
@@ -146,17 +146,13 @@ fn check(spec: &str, name: &str) {
 }
 
 #[test]
+#[ignore = "slow statistical test (the held-out intention statistics): cargo test -- --include-ignored"]
 fn crossers_are_seen_before_they_cross_on_a_held_out_spec() {
-    if !common::slow_tests("the held-out intention statistics") {
-        return;
-    }
     check("tests/data/specs/heldout_crossing.yaml", "heldout");
 }
 
 #[test]
+#[ignore = "slow statistical test (the PedSynth++ intention statistics): cargo test -- --include-ignored"]
 fn crossers_are_seen_before_they_cross_on_pedsynth_pp() {
-    if !common::slow_tests("the PedSynth++ intention statistics") {
-        return;
-    }
     check("specs/pedsynth_pp.yaml", "pedsynth_pp");
 }

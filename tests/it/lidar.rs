@@ -206,14 +206,22 @@ fn brute_force_hit(t: &Tri, o: Vec3, d: Vec3) -> Option<f32> {
 
 #[test]
 fn the_static_acceleration_structures_return_the_nearest_triangle() {
-    // A built-in town and the real CARLA Town01 (OpenDRIVE heights): rays from sensor-like positions along
-    // the ego's path, in every direction the sensor casts, against every static triangle by brute force.
-    let mut specs = vec![spec("quickstart.yaml")];
-    if common::carla_map("Town01").is_some() {
-        specs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/carla_town01.yaml"));
-    }
-    for spec_path in specs {
-        let c = clip_of(&spec_path);
+    // A built-in town: rays from sensor-like positions along the ego's path, in every direction the sensor
+    // casts, against every static triangle by brute force.
+    tracer_equals_brute_force(&spec("quickstart.yaml"));
+}
+
+#[test]
+#[ignore = "reads CARLA's maps (../shared/maps/carla): cargo test -- --include-ignored"]
+fn the_static_acceleration_structures_return_the_nearest_triangle_on_a_carla_map() {
+    // The real CARLA Town01 (OpenDRIVE heights).
+    common::carla_map("Town01");
+    tracer_equals_brute_force(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/carla_town01.yaml"));
+}
+
+fn tracer_equals_brute_force(spec_path: &Path) {
+    {
+        let c = clip_of(spec_path);
         let tracer = Tracer::new(&c.stat);
         let mut rng = 0x5eed_u64;
         let mut next = move || {

@@ -40,25 +40,26 @@ fn frames_of(trace: &ClipTrace, v: VehicleId) -> &[pedsynth::sim::trace::Vehicle
 }
 
 #[test]
-fn carla_maps_keep_their_lights_and_built_in_towns_signalise_their_junctions() {
+#[ignore = "reads CARLA's maps (../shared/maps/carla): cargo test -- --include-ignored"]
+fn carla_maps_keep_their_lights() {
     // CARLA's Town01: 36 three-light heads, three controllers per junction, each its own phase.
-    if let Some(path) = common::carla_map("Town01") {
-        let net = RoadNetwork::from_xodr_file(&path).expect("Town01 loads");
-        assert_eq!(net.signals.len(), 36);
-        let s = net.summary();
-        assert_eq!((s.signalised_junction_count, s.signal_controller_count), (12, 36));
-        for g in &net.signals {
-            assert!(!g.synthesized);
-            assert!(g.phase < 3, "{}: phase {}", g.id, g.phase);
-        }
+    let net = RoadNetwork::from_xodr_file(&common::carla_map("Town01")).expect("Town01 loads");
+    assert_eq!(net.signals.len(), 36);
+    let s = net.summary();
+    assert_eq!((s.signalised_junction_count, s.signal_controller_count), (12, 36));
+    for g in &net.signals {
+        assert!(!g.synthesized);
+        assert!(g.phase < 3, "{}: phase {}", g.id, g.phase);
     }
-    if let Some(path) = common::carla_map("Town03") {
-        let net = RoadNetwork::from_xodr_file(&path).expect("Town03 loads");
-        assert!(
-            net.signals.is_empty(),
-            "a map without <signal> records gets no invented light"
-        );
-    }
+    let net = RoadNetwork::from_xodr_file(&common::carla_map("Town03")).expect("Town03 loads");
+    assert!(
+        net.signals.is_empty(),
+        "a map without <signal> records gets no invented light"
+    );
+}
+
+#[test]
+fn built_in_towns_signalise_their_junctions() {
     for name in pedsynth::world::BUILTIN_TOWN_NAMES {
         let net = RoadNetwork::builtin(name).expect("built-in town");
         assert!(!net.signals.is_empty(), "{name}: no traffic light");

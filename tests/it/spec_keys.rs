@@ -439,8 +439,9 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
 }
 
 #[test]
+#[ignore = "reads CARLA's maps (../shared/maps/carla): cargo test -- --include-ignored"]
 fn every_key_changes_the_plan_or_the_tables_or_is_reported_as_not_implemented() {
-    let Some(map) = common::carla_map("Town01") else { return };
+    let map = common::carla_map("Town01");
     let base_yaml = format!(
         "version: 1\n\
          dataset:\n  name: walk\n  seed: 3\n  clips: {{count: 1, per: town_and_weather}}\n  weathers: [clear_noon]\n  \

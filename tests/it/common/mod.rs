@@ -1,12 +1,9 @@
-//! Helpers shared by the integration tests: where the real CARLA maps are (one setting), whether the slow
-//! statistical tests run, and the checks shared by the CARLA-map and built-in-town tests (lane classification of
-//! sampled points, routes, crossing vectors).
+//! Helpers shared by the integration tests: where the real CARLA maps are (one setting), and the checks shared
+//! by the CARLA-map and built-in-town tests (lane classification of sampled points, routes, crossing vectors).
 //!
 //! - `PEDSYNTH_CARLA_MAPS`: the directory of CARLA's `Town01.xodr` ... (default `../shared/maps/carla` beside
-//!   the repository). Tests that need the maps skip, saying why, when they are absent; with
-//!   `PEDSYNTH_REQUIRE_CARLA_MAPS=1` (set by `.ci/run`) a missing map fails the test instead, so CI cannot pass
-//!   by skipping.
-//! - `PEDSYNTH_SLOW_TESTS=1` (set by `.ci/run`): run the long statistical tests too.
+//!   the repository). The tests that read them are `#[ignore]`d (\"reads CARLA's maps\"); a run that includes them
+//!   (`cargo test -- --include-ignored`, as CI does) fails where a map is missing.
 //!
 //! Also: planning a spec with `--set` overrides (`plan_spec`), `generate` through the library, every file of a dataset (`all_files`), and the overrides that turn the
 //! sensors off (`NO_SENSORS`, `NO_CAMERAS`), and the --jobs 1 / --jobs 2 comparison.
@@ -26,40 +23,16 @@ pub fn carla_dir() -> std::path::PathBuf {
     }
 }
 
-/// The path of CARLA map `town` (e.g. `Town01`), or `None` when it is absent and the test should skip (the
-/// reason is printed). Panics instead when `$PEDSYNTH_REQUIRE_CARLA_MAPS` is set, so CI cannot skip.
-pub fn carla_map(town: &str) -> Option<std::path::PathBuf> {
+/// The path of CARLA map `town` (e.g. `Town01`). Panics when it is absent: the tests that call this are
+/// `#[ignore]`d for that reason, and a run that includes them must have the maps.
+pub fn carla_map(town: &str) -> std::path::PathBuf {
     let path = carla_dir().join(format!("{town}.xodr"));
-    if path.is_file() {
-        return Some(path);
-    }
-    let why = format!(
+    assert!(
+        path.is_file(),
         "the CARLA map {} is absent (set PEDSYNTH_CARLA_MAPS to the directory of CARLA's Town*.xodr)",
         path.display()
     );
-    if std::env::var_os("PEDSYNTH_REQUIRE_CARLA_MAPS").is_some_and(|v| !v.is_empty() && v != "0") {
-        panic!("{why}; PEDSYNTH_REQUIRE_CARLA_MAPS forbids skipping");
-    }
-    static SAID: std::sync::Once = std::sync::Once::new();
-    SAID.call_once(|| skip(&why));
-    None
-}
-
-/// Whether the slow statistical tests run (`PEDSYNTH_SLOW_TESTS=1`); prints why a test is skipped otherwise.
-pub fn slow_tests(test: &str) -> bool {
-    let on = std::env::var_os("PEDSYNTH_SLOW_TESTS").is_some_and(|v| !v.is_empty() && v != "0");
-    if !on {
-        skip(&format!(
-            "{test} is a slow statistical test; set PEDSYNTH_SLOW_TESTS=1 to run it"
-        ));
-    }
-    on
-}
-
-/// Says on stderr, past the test harness's capture (which only takes the print macros), why a test is skipped.
-fn skip(why: &str) {
-    use std::io::Write;
-    writeln!(std::io::stderr(), "skipped: {why}").ok();
+    path
 }
 
 /// A point inside lane piece `pi`: `along` ∈ [0,1] between its stations, `across` ∈ [0,1] inner→outer.
