@@ -7,8 +7,8 @@
 //! the clip has it (`exec::realise`); rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline
 //! alone gives) also lower the baseline, crossing-heavy ones (0.9, 0.95, 1) also adapt the layers (every
 //! pedestrian a crosser, no crossing groups, more crossers mid-road). Measured with the realisation example
-//! (the same clips as `generate`): misses of at most 0.52 pp. Slow statistical tests: they run with
-//! They are `#[ignore]`d: `cargo test -- --include-ignored` (CI) runs them.
+//! (the same clips as `generate`): misses of at most 0.52 pp. Slow statistical tests: `#[ignore]`d, run by
+//! `cargo test -- --include-ignored` (CI).
 
 use crate::common;
 

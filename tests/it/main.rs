@@ -16,6 +16,7 @@ mod docs;
 mod emergency;
 mod export;
 mod fuzz_corpus;
+mod hashes;
 mod intention;
 mod lidar;
 mod plan_file;
