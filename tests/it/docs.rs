@@ -1,12 +1,13 @@
 //! Generated documentation stays in step with the code: README.md's table of diagnostic codes is
-//! `error::codes_markdown()` (rewrite it with `INSTA_UPDATE=always cargo test`, the project's one update
+//! `error::codes_markdown()` (src/error/codes.rs) (rewrite it with `INSTA_UPDATE=always cargo test`, the project's one update
 //! switch), and every code string that appears in the source is registered in `error::CODES`.
 
 use std::path::Path;
 
+use crate::common;
 use pedsynth::error::{CODES, codes_markdown};
 
-const START: &str = "<!-- diagnostic codes: generated from src/error.rs by `INSTA_UPDATE=always cargo test` -->\n";
+const START: &str = "<!-- diagnostic codes: generated from src/error/codes.rs by `INSTA_UPDATE=always cargo test` -->\n";
 const END: &str = "<!-- end of diagnostic codes -->";
 
 fn root() -> &'static Path {
@@ -67,4 +68,56 @@ fn every_code_in_the_source_is_registered() {
         unregistered.is_empty(),
         "codes used but not registered in error::CODES: {unregistered:?}"
     );
+}
+
+/// The text of DATASET.md's section whose heading starts with `heading` (up to the next heading of any level).
+fn dataset_md_section<'a>(doc: &'a str, heading: &str) -> &'a str {
+    let start = doc.find(heading).unwrap_or_else(|| panic!("DATASET.md has no section `{heading}`"));
+    let body = &doc[start + heading.len()..];
+    let end = body.find("\n#").map_or(body.len(), |e| e + 1);
+    &body[..end]
+}
+
+#[test]
+fn dataset_md_documents_every_arrow_field_the_writer_declares() {
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("DATASET.md")).unwrap();
+    let scratch = common::Scratch::new("dataset-md");
+    let out = scratch.path().join("quickstart");
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.extend(["traffic.signals.enabled=true", "traffic.cyclists.per_clip=[1, 2]"]);
+    let (code, _, stderr) = common::generate(&spec, &overrides, &out, None);
+    assert_eq!(code, 0, "{stderr}");
+    // Every table as written: (where DATASET.md documents it, its schema).
+    let mut schemas = Vec::new();
+    for table in pedsynth::dataset::write::tables::TABLES {
+        let dir = out.join("tables").join(table);
+        let file = std::fs::read_dir(&dir)
+            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+            .next()
+            .expect("a file per clip")
+            .unwrap()
+            .path();
+        let reader = ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(&file).unwrap()).unwrap();
+        schemas.push((format!("### `{table}`"), reader.schema().clone()));
+    }
+    // The sensor streams' Parquet files, from the writer's own (empty) batches.
+    use pedsynth::dataset::write::{lidar, sensors};
+    schemas.push(("### LiDAR".to_owned(), lidar::lidar_batch("", 0, 0, &[]).schema()));
+    schemas.push(("| `dvs` |".to_owned(), sensors::dvs_batch(0, &[]).schema()));
+    schemas.push(("### `sensors`".to_owned(), sensors::index_batch("", &[]).schema()));
+    let mut missing = Vec::new();
+    let mut fields = 0;
+    for (heading, schema) in &schemas {
+        let section = dataset_md_section(&doc, heading);
+        for field in schema.fields() {
+            fields += 1;
+            if !section.contains(&format!("`{}`", field.name())) {
+                missing.push(format!("{heading}: `{}`", field.name()));
+            }
+        }
+    }
+    assert!(schemas.len() == 14 && fields > 200, "{} schemas, {fields} fields", schemas.len());
+    assert!(missing.is_empty(), "DATASET.md does not document:\n{}", missing.join("\n"));
 }
