@@ -17,6 +17,8 @@
 //! - [`dataset`] — the dataset on disk: writing, generating, reading, verifying, exporting.
 //! - [`cli`] — one function per command, called by `src/main.rs`.
 #![forbid(unsafe_code)]
+// What only the crate uses is `pub(crate)`: a `pub` item must be reachable from the crate root.
+#![warn(unreachable_pub)]
 
 pub mod cli;
 pub mod dataset;

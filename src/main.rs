@@ -1,4 +1,5 @@
 //! Command-line entry point: parses arguments (clap) and calls the library's commands.
+#![forbid(unsafe_code)]
 
 use std::path::PathBuf;
 use std::process::ExitCode;

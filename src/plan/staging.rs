@@ -41,7 +41,7 @@ pub(crate) struct EgoSchedule {
 
 impl EgoSchedule {
     /// Without lights: the ego cruises.
-    pub fn cruising(cruise_mps: f64) -> EgoSchedule {
+    pub(super) fn cruising(cruise_mps: f64) -> EgoSchedule {
         EgoSchedule {
             cruise_mps,
             waits: Vec::new(),
@@ -50,7 +50,7 @@ impl EgoSchedule {
 
     /// With the clip's `plans`: the ego waits at each stop line of `route` whose light is not green when it
     /// gets there.
-    pub fn with_lights(cruise_mps: f64, net: &RoadNetwork, route: &Route, plans: &SignalPlans) -> EgoSchedule {
+    pub(super) fn with_lights(cruise_mps: f64, net: &RoadNetwork, route: &Route, plans: &SignalPlans) -> EgoSchedule {
         let mut schedule = EgoSchedule::cruising(cruise_mps);
         for (s_entry_m, signal) in signalised_entries(net, route) {
             let Some(light) = net.signals.get(signal as usize) else {
@@ -66,7 +66,7 @@ impl EgoSchedule {
 
     /// When the ego reaches arc length `s_m` of its route (it starts at 0), seconds: the waits at stop lines
     /// before `s_m` count, one at `s_m` itself does not.
-    pub fn time_at(&self, s_m: f64) -> f64 {
+    pub(super) fn time_at(&self, s_m: f64) -> f64 {
         let waited: f64 = self.waits.iter().filter(|&&(s, _)| s < s_m).map(|&(_, w)| w).sum();
         s_m.max(0.0) / self.cruise_mps.max(0.1) + waited
     }

@@ -37,7 +37,7 @@ pub(crate) struct Contacts {
 
 impl Contacts {
     /// No contacts yet between `vehicles` vehicles and `pedestrians` pedestrians.
-    pub fn new(vehicles: usize, pedestrians: usize) -> Contacts {
+    pub(super) fn new(vehicles: usize, pedestrians: usize) -> Contacts {
         Contacts {
             pedestrians,
             vehicles,
@@ -47,7 +47,7 @@ impl Contacts {
     }
 
     /// Detects, records (as events of `frame`) and resolves the contacts of this step.
-    pub fn resolve(&mut self, frame: u32, vehicles: &mut [Vehicle], peds: &mut [Ped], events: &mut Vec<Event>) {
+    pub(super) fn resolve(&mut self, frame: u32, vehicles: &mut [Vehicle], peds: &mut [Ped], events: &mut Vec<Event>) {
         let (np, nv) = (self.pedestrians, self.vehicles);
         for (vi, v) in vehicles.iter_mut().enumerate() {
             for (pi, p) in peds.iter_mut().enumerate() {

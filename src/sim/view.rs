@@ -35,7 +35,7 @@ pub(crate) struct ViewProxy {
 
 impl ViewProxy {
     /// The proxy of a plan's camera and gate.
-    pub fn new(params: &SimParams) -> ViewProxy {
+    pub(crate) fn new(params: &SimParams) -> ViewProxy {
         ViewProxy {
             camera: Camera::from_spec(&params.camera),
             gate: params.visibility.clone(),
@@ -43,7 +43,7 @@ impl ViewProxy {
     }
 
     /// The camera on the ego for this step.
-    pub fn camera_at(&self, ego: &Vehicle) -> CameraPose {
+    pub(crate) fn camera_at(&self, ego: &Vehicle) -> CameraPose {
         self.camera.at(
             DVec3::new(ego.pose.pos.x, ego.pose.pos.y, ego.pose.z_m),
             ego.pose.heading_rad,
@@ -54,7 +54,7 @@ impl ViewProxy {
     /// seen past the other vehicles (`vehicles[0]` is the ego itself), the other pedestrians (`people`: ground
     /// point and height, this one's own entry `me` skipped) and the town's buildings.
     #[allow(clippy::too_many_arguments)]
-    pub fn sees(
+    pub(crate) fn sees(
         &self,
         cam: &CameraPose,
         ground: DVec3,

@@ -21,7 +21,7 @@ impl CellGrid {
     /// A grid over the box `lo`–`hi` (at least 1 m each way) with square cells of `min_cell_m`, doubled until
     /// there are at most `max_cells` cells, holding items `0..count`, each in every cell that its bounding box
     /// `bounds(k)` touches (cells clamped to the grid; `None` leaves the item out). `lo` and `hi` must be finite.
-    pub fn build(
+    pub(crate) fn build(
         lo: DVec2,
         hi: DVec2,
         min_cell_m: f64,
@@ -80,25 +80,25 @@ impl CellGrid {
 
     /// Whether the grid has no cells (the default grid).
     #[inline]
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         self.nx == 0
     }
 
     /// Side of a cell, metres.
     #[inline]
-    pub fn cell_m(&self) -> f64 {
+    pub(crate) fn cell_m(&self) -> f64 {
         self.cell_m
     }
 
     /// Number of cells along x and y.
     #[inline]
-    pub fn size(&self) -> (usize, usize) {
+    pub(crate) fn size(&self) -> (usize, usize) {
         (self.nx, self.ny)
     }
 
     /// Cell coordinates of `p`, clamped to the grid (not empty).
     #[inline]
-    pub fn clamped_cell(&self, p: DVec2) -> (usize, usize) {
+    pub(crate) fn clamped_cell(&self, p: DVec2) -> (usize, usize) {
         let q = (p - self.origin) / self.cell_m;
         let x = (q.x.floor().max(0.0) as usize).min(self.nx - 1);
         let y = (q.y.floor().max(0.0) as usize).min(self.ny - 1);
@@ -107,7 +107,7 @@ impl CellGrid {
 
     /// The cell containing `p`, or `None` outside the grid.
     #[inline]
-    pub fn cell_containing(&self, p: DVec2) -> Option<(usize, usize)> {
+    pub(crate) fn cell_containing(&self, p: DVec2) -> Option<(usize, usize)> {
         let q = (p - self.origin) / self.cell_m;
         (q.x >= 0.0 && q.y >= 0.0 && q.x < self.nx as f64 && q.y < self.ny as f64)
             .then_some((q.x as usize, q.y as usize))
@@ -115,26 +115,26 @@ impl CellGrid {
 
     /// Cell coordinates of `p`, not clamped (for ring searches that may start outside the grid).
     #[inline]
-    pub fn cell_coords(&self, p: DVec2) -> (i64, i64) {
+    pub(crate) fn cell_coords(&self, p: DVec2) -> (i64, i64) {
         let q = ((p - self.origin) / self.cell_m).floor();
         (q.x as i64, q.y as i64)
     }
 
     /// The items of cell (`x`, `y`).
     #[inline]
-    pub fn items_in(&self, x: usize, y: usize) -> &[u32] {
+    pub(crate) fn items_in(&self, x: usize, y: usize) -> &[u32] {
         self.items_in_row(y, x, x)
     }
 
     /// The items of cells `x0..=x1` of row `y`, cell by cell (an item in several of them appears once per cell).
     #[inline]
-    pub fn items_in_row(&self, y: usize, x0: usize, x1: usize) -> &[u32] {
+    pub(crate) fn items_in_row(&self, y: usize, x0: usize, x1: usize) -> &[u32] {
         let row = y * self.nx;
         &self.items[self.starts[row + x0] as usize..self.starts[row + x1 + 1] as usize]
     }
 
     /// Calls `f` with every item listed in the 3 × 3 cells around the cell of `p` (not empty).
-    pub fn for_items_around(&self, p: DVec2, mut f: impl FnMut(usize)) {
+    pub(crate) fn for_items_around(&self, p: DVec2, mut f: impl FnMut(usize)) {
         let (cx, cy) = self.clamped_cell(p);
         let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(self.nx - 1));
         for y in cy.saturating_sub(1)..=(cy + 1).min(self.ny - 1) {

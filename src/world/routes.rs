@@ -17,7 +17,7 @@ use crate::world::{LaneType, RoadNetwork, TravelDirection};
 const JOIN_M: f64 = 0.5;
 const JOIN_HEADING_RAD: f64 = 0.6;
 /// A bike lane counts as beside a driving lane across buffer lanes narrower than this, metres.
-pub const BIKE_LANE_BUFFER_MAX_M: f32 = 1.0;
+pub(super) const BIKE_LANE_BUFFER_MAX_M: f32 = 1.0;
 
 /// Centre-line points of a lane, in its direction of travel (reference direction if undirected).
 pub(crate) fn lane_centre_line(net: &RoadNetwork, lane: u32) -> Vec<DVec2> {

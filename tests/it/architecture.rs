@@ -393,3 +393,14 @@ fn main_only_parses_arguments_and_calls_the_cli() {
         );
     }
 }
+
+#[test]
+fn the_crate_forbids_unsafe_code_and_keeps_crate_items_pub_crate() {
+    let sources = sources();
+    let text = |file: &str| sources.iter().find(|s| s.file == file).map(|s| s.text.as_str()).unwrap_or("");
+    for file in ["lib.rs", "main.rs"] {
+        assert!(text(file).contains("#![forbid(unsafe_code)]"), "{file}: no #![forbid(unsafe_code)]");
+    }
+    // With clippy's -D warnings in CI, a `pub` item the crate root cannot reach fails the build.
+    assert!(text("lib.rs").contains("#![warn(unreachable_pub)]"));
+}

@@ -7,7 +7,8 @@ use std::path::Path;
 use crate::common;
 use pedsynth::error::{CODES, codes_markdown};
 
-const START: &str = "<!-- diagnostic codes: generated from src/error/codes.rs by `INSTA_UPDATE=always cargo test` -->\n";
+const START: &str =
+    "<!-- diagnostic codes: generated from src/error/codes.rs by `INSTA_UPDATE=always cargo test` -->\n";
 const END: &str = "<!-- end of diagnostic codes -->";
 
 fn root() -> &'static Path {
@@ -72,7 +73,9 @@ fn every_code_in_the_source_is_registered() {
 
 /// The text of DATASET.md's section whose heading starts with `heading` (up to the next heading of any level).
 fn dataset_md_section<'a>(doc: &'a str, heading: &str) -> &'a str {
-    let start = doc.find(heading).unwrap_or_else(|| panic!("DATASET.md has no section `{heading}`"));
+    let start = doc
+        .find(heading)
+        .unwrap_or_else(|| panic!("DATASET.md has no section `{heading}`"));
     let body = &doc[start + heading.len()..];
     let end = body.find("\n#").map_or(body.len(), |e| e + 1);
     &body[..end]
@@ -118,6 +121,14 @@ fn dataset_md_documents_every_arrow_field_the_writer_declares() {
             }
         }
     }
-    assert!(schemas.len() == 14 && fields > 200, "{} schemas, {fields} fields", schemas.len());
-    assert!(missing.is_empty(), "DATASET.md does not document:\n{}", missing.join("\n"));
+    assert!(
+        schemas.len() == 14 && fields > 200,
+        "{} schemas, {fields} fields",
+        schemas.len()
+    );
+    assert!(
+        missing.is_empty(),
+        "DATASET.md does not document:\n{}",
+        missing.join("\n")
+    );
 }

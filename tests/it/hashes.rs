@@ -18,7 +18,9 @@ use pedsynth::sensors;
 use pedsynth::sim::{self, rig::Rig};
 
 fn golden(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/hashes").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden/hashes")
+        .join(name)
 }
 
 /// Compares `lines` (`key hash`, sorted) with the golden file, or re-mints it (`INSTA_UPDATE=always`) with the
@@ -57,7 +59,12 @@ fn check(name: &str, what: &str, lines: &BTreeMap<String, String>) {
         .filter(|(k, h)| committed.get(k.as_str()) != Some(&h.as_str()))
         .map(|(k, h)| format!("{k}: {h} (committed: {})", committed.get(k.as_str()).unwrap_or(&"none")))
         .collect();
-    differ.extend(committed.keys().filter(|k| !lines.contains_key(**k)).map(|k| format!("{k}: no longer made")));
+    differ.extend(
+        committed
+            .keys()
+            .filter(|k| !lines.contains_key(**k))
+            .map(|k| format!("{k}: no longer made")),
+    );
     panic!(
         "{} differ from {} (a change of output: re-mint with a reason, see tests/it/hashes.rs):\n{}",
         what,
@@ -70,7 +77,9 @@ fn check(name: &str, what: &str, lines: &BTreeMap<String, String>) {
 fn a_rendered_frame_per_weather_hashes_as_committed() {
     let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/specs/weathers.yaml");
     let options = pedsynth::spec::LoadOptions {
-        overrides: ["sensors.rgb.width_px=640", "sensors.rgb.height_px=360"].map(String::from).to_vec(),
+        overrides: ["sensors.rgb.width_px=640", "sensors.rgb.height_px=360"]
+            .map(String::from)
+            .to_vec(),
         allow_large: false,
     };
     let (_, towns, plan) =
@@ -87,7 +96,9 @@ fn a_rendered_frame_per_weather_hashes_as_committed() {
             counts[r.frame as usize] += 1;
         }
         // The busiest frame, the earliest of equals.
-        let frame = (0..counts.len()).max_by_key(|&f| (counts[f], std::cmp::Reverse(f))).unwrap_or(0) as u32;
+        let frame = (0..counts.len())
+            .max_by_key(|&f| (counts[f], std::cmp::Reverse(f)))
+            .unwrap_or(0) as u32;
         let img = sensors::render_frame(script, &trace, &rig, net, frame);
         let mut h = blake3::Hasher::new();
         h.update(&img.rgb);
@@ -100,7 +111,11 @@ fn a_rendered_frame_per_weather_hashes_as_committed() {
         }
         lines.insert(format!("{}@{frame}", script.weather), h.finalize().to_hex().to_string());
     }
-    check("frames.txt", "one rendered frame per weather (RGB, depth, semantic, instance)", &lines);
+    check(
+        "frames.txt",
+        "one rendered frame per weather (RGB, depth, semantic, instance)",
+        &lines,
+    );
 }
 
 #[test]

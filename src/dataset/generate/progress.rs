@@ -20,7 +20,7 @@ pub(crate) struct Progress {
 
 impl Progress {
     /// Progress over `total` clips.
-    pub fn new(total: usize, quiet: bool) -> Self {
+    pub(crate) fn new(total: usize, quiet: bool) -> Self {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let bar = indicatif::ProgressBar::new(total as u64);
             bar.set_style(
@@ -41,7 +41,7 @@ impl Progress {
     }
 
     /// Progress as one JSON object per finished clip on stderr (`generate --progress json`).
-    pub fn json(total: usize) -> Self {
+    pub(crate) fn json(total: usize) -> Self {
         Progress {
             json: true,
             ..Progress::new(total, true)
@@ -49,7 +49,7 @@ impl Progress {
     }
 
     /// One clip of `frames` frames is done.
-    pub fn clip_done(&self, clip_id: &str, frames: u64) {
+    pub(crate) fn clip_done(&self, clip_id: &str, frames: u64) {
         let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
         let frames = self.frames.fetch_add(frames, Ordering::Relaxed) + frames;
         let secs = self.started.elapsed().as_secs_f64().max(1e-6);
@@ -90,7 +90,7 @@ impl Progress {
     }
 
     /// Clears the bar.
-    pub fn finish(&self) {
+    pub(crate) fn finish(&self) {
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }

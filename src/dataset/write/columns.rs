@@ -9,25 +9,25 @@ use arrow_schema::{DataType, Field, Schema};
 
 /// A record batch under construction, column by column.
 #[derive(Default)]
-pub struct Table {
+pub(crate) struct Table {
     fields: Vec<Field>,
     columns: Vec<ArrayRef>,
 }
 
 impl Table {
     /// A table without columns.
-    pub fn new() -> Table {
+    pub(crate) fn new() -> Table {
         Table::default()
     }
 
     /// Appends a column whose Arrow type is its array's.
-    pub fn column(self, name: &str, nullable: bool, values: ArrayRef) -> Table {
+    pub(crate) fn column(self, name: &str, nullable: bool, values: ArrayRef) -> Table {
         let data_type = values.data_type().clone();
         self.column_of_type(name, data_type, nullable, values)
     }
 
     /// Appends a column of the given Arrow type (for nested types whose item field must be named as declared).
-    pub fn column_of_type(mut self, name: &str, data_type: DataType, nullable: bool, values: ArrayRef) -> Table {
+    pub(crate) fn column_of_type(mut self, name: &str, data_type: DataType, nullable: bool, values: ArrayRef) -> Table {
         self.fields.push(Field::new(name, data_type, nullable));
         self.columns.push(values);
         self
@@ -35,14 +35,14 @@ impl Table {
 
     /// The record batch. Every column has its field's type and the same length: a mismatch is a bug in the
     /// table's declaration, caught by any test that writes the table.
-    pub fn finish(self) -> RecordBatch {
+    pub(crate) fn finish(self) -> RecordBatch {
         RecordBatch::try_new(Arc::new(Schema::new(self.fields)), self.columns)
             .expect("a table's columns match their declaration")
     }
 }
 
 /// A column of `n` copies of `value`.
-pub fn repeated_utf8(n: usize, value: &str) -> ArrayRef {
+pub(crate) fn repeated_utf8(n: usize, value: &str) -> ArrayRef {
     Arc::new(StringArray::from_iter_values(std::iter::repeat_n(value, n)))
 }
 

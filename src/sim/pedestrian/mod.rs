@@ -111,15 +111,15 @@ pub(crate) struct Line {
 
 impl Line {
     /// Signed distance along the crossing from the near curb, metres.
-    pub fn along_m(&self, p: DVec2) -> f64 {
+    pub(crate) fn along_m(&self, p: DVec2) -> f64 {
         (p - self.near_curb).dot(self.dir)
     }
     /// Where a crosser waits at the curb.
-    pub fn curb_point(&self) -> DVec2 {
+    pub(crate) fn curb_point(&self) -> DVec2 {
         self.near_curb - self.dir * CURB_STANDOFF_M
     }
     /// Distance along the line from the near curb to the end point, metres.
-    pub fn end_along_m(&self) -> f64 {
+    pub(crate) fn end_along_m(&self) -> f64 {
         self.along_m(self.end).max(self.width_m + FINISH_BEYOND_CURB_M)
     }
 }
@@ -238,7 +238,7 @@ pub(crate) struct StepCtx<'a> {
 impl Ped {
     /// Sets a pedestrian up from its script; draws its per-pedestrian constants from its own stream, and its
     /// gesture draws from `gesture_rng` (a stream of its own, so gestures shift no other draw).
-    pub fn new(
+    pub(crate) fn new(
         script: &PedestrianScript,
         params: &SimParams,
         net: &RoadNetwork,
@@ -343,12 +343,12 @@ impl Ped {
     }
 
     /// The labelled behaviour state.
-    pub fn state(&self) -> PedState {
+    pub(crate) fn state(&self) -> PedState {
         self.activity.label()
     }
 
     /// Whether it holds a phone.
-    pub fn on_phone(&self) -> bool {
+    pub(crate) fn on_phone(&self) -> bool {
         self.activity.on_phone()
     }
 
@@ -358,7 +358,7 @@ impl Ped {
     }
 
     /// The pedestrian's own speed in its current state, m/s.
-    pub fn own_speed_mps(&self, m: &SpeedProfileMultipliers) -> f64 {
+    pub(crate) fn own_speed_mps(&self, m: &SpeedProfileMultipliers) -> f64 {
         state_speed_mps(
             self.state(),
             self.traits.base_speed_mps,
@@ -369,7 +369,7 @@ impl Ped {
     }
 
     /// The leader's index, for a group follower.
-    pub fn leader(&self) -> Option<usize> {
+    pub(crate) fn leader(&self) -> Option<usize> {
         match self.group {
             Group::Follower(l) => Some(l),
             _ => None,
@@ -378,7 +378,7 @@ impl Ped {
 
     /// Whether the ego's camera has seen the pedestrian for its planned time before crossing, `lead_s` seconds
     /// from now (always, without a timeline).
-    pub fn seen_long_enough(&self, lead_s: f64) -> bool {
+    pub(crate) fn seen_long_enough(&self, lead_s: f64) -> bool {
         self.traits
             .in_view_before_crossing_s
             .is_none_or(|t| self.in_view_s + lead_s >= t)
@@ -386,19 +386,19 @@ impl Ped {
 
     /// Whether its signalised crosswalk shows "don't walk" (or flashes) and it is not one to cross against the
     /// signal: it waits for "walk", and drivers with green do not stop for it.
-    pub fn waits_for_walk(&self) -> bool {
+    pub(crate) fn waits_for_walk(&self) -> bool {
         self.percept.walk.is_some_and(|w| w != WalkSignal::Walk) && !self.traits.red_light_violator
     }
 
     /// Whether it heads for its curb point or waits there (a crosser or hard negative on the sidewalk, not yet
     /// across): what makes the ego ease off.
-    pub fn heading_for_curb(&self) -> bool {
+    pub(crate) fn heading_for_curb(&self) -> bool {
         !self.waits_for_walk() && self.traits.line.is_some() && !self.attempt.over() && !self.activity.crossing_motion()
     }
 
     /// Whether it waits at its curb point attentively (looking, checking the traffic, hesitating): what makes the
     /// ego stop short and let it go.
-    pub fn waiting_at_curb(&self) -> bool {
+    pub(crate) fn waiting_at_curb(&self) -> bool {
         !self.waits_for_walk()
             && self.attempt.at_curb()
             && !self.attempt.over()
@@ -409,7 +409,7 @@ impl Ped {
     }
 
     /// The followers' indices (empty unless a group leader).
-    pub fn followers(&self) -> &[usize] {
+    pub(crate) fn followers(&self) -> &[usize] {
         match &self.group {
             Group::Leader(f) => f,
             _ => &[],
@@ -435,7 +435,7 @@ pub(crate) struct LeaderFacts {
 
 impl LeaderFacts {
     /// The facts of leader `p`, with its progress `fraction` along its crossing.
-    pub fn of(p: &Ped, fraction: f64) -> LeaderFacts {
+    pub(crate) fn of(p: &Ped, fraction: f64) -> LeaderFacts {
         LeaderFacts {
             activity: p.activity,
             decided: p.attempt.decided(),

@@ -204,7 +204,7 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
 impl Ped {
     /// Head yaw relative to the body for this frame: scanning sweeps, checks look at the nearest vehicle, a
     /// gesture looks at the ego (`vehicles[0]`).
-    pub fn update_head(&mut self, time_s: f64, vehicles: &[Vehicle]) {
+    pub(crate) fn update_head(&mut self, time_s: f64, vehicles: &[Vehicle]) {
         let pos = self.body.pos;
         let toward = |v: &Vehicle| {
             let d = v.pose.pos - pos;
@@ -236,7 +236,7 @@ impl Ped {
     /// the pedestrian (ahead, near and slow): an acknowledgement by a crosser that has just stepped out, a
     /// wave-through by a hard negative checking the traffic at the curb, each with its probability, decided by
     /// the pedestrian's own gesture draws. At most one gesture per pedestrian; none on the phone.
-    pub fn update_gesture(&mut self, dt_s: f64, ego: &Vehicle, g: &Gestures) {
+    pub(crate) fn update_gesture(&mut self, dt_s: f64, ego: &Vehicle, g: &Gestures) {
         if let Some((kind, elapsed_s)) = &mut self.gesture {
             *elapsed_s += dt_s;
             if *elapsed_s >= kind.duration_s() {
@@ -280,7 +280,7 @@ impl Ped {
     }
 
     /// The reaction to a vehicle that the current activity shows (JAAD's `reaction`).
-    pub fn reaction(&self) -> Option<Reaction> {
+    pub(crate) fn reaction(&self) -> Option<Reaction> {
         match self.activity {
             Activity::Crossing(CrossMode::RunningAcross) => Some(Reaction::SpeedUp),
             Activity::PausingMidCross {

@@ -82,7 +82,7 @@ pub(crate) enum Activity {
 
 impl Activity {
     /// The labelled behaviour state.
-    pub fn label(self) -> PedState {
+    pub(crate) fn label(self) -> PedState {
         match self {
             Activity::WalkingSidewalk => PedState::WalkingSidewalk,
             Activity::LookingAround => PedState::LookingAround,
@@ -97,7 +97,7 @@ impl Activity {
     }
 
     /// Whether the pedestrian holds a phone.
-    pub fn on_phone(self) -> bool {
+    pub(crate) fn on_phone(self) -> bool {
         matches!(
             self,
             Activity::DistractedBehavior { .. }
@@ -109,7 +109,7 @@ impl Activity {
     }
 
     /// Whether the pedestrian moves under manual control along its crossing line (crossing states and retreat).
-    pub fn crossing_motion(self) -> bool {
+    pub(crate) fn crossing_motion(self) -> bool {
         self.label().is_crossing() || self == Activity::Retreat
     }
 }
@@ -141,17 +141,17 @@ pub(crate) enum Attempt {
 
 impl Attempt {
     /// Whether the decision to cross has been taken.
-    pub fn decided(self) -> bool {
+    pub(crate) fn decided(self) -> bool {
         matches!(self, Attempt::Committed { .. } | Attempt::Over { decided: true })
     }
 
     /// Whether the attempt is over (finished, abandoned, or never planned).
-    pub fn over(self) -> bool {
+    pub(crate) fn over(self) -> bool {
         matches!(self, Attempt::Over { .. })
     }
 
     /// Whether a crosser waits at its curb point (decided or not).
-    pub fn at_curb(self) -> bool {
+    pub(crate) fn at_curb(self) -> bool {
         match self {
             Attempt::Undecided { at_curb, .. } | Attempt::Committed { at_curb, .. } => at_curb,
             Attempt::Over { .. } => false,
@@ -159,14 +159,14 @@ impl Attempt {
     }
 
     /// Marks the curb point as reached.
-    pub fn reach_curb(&mut self) {
+    pub(crate) fn reach_curb(&mut self) {
         if let Attempt::Undecided { at_curb, .. } | Attempt::Committed { at_curb, .. } = self {
             *at_curb = true;
         }
     }
 
     /// Decides to cross; returns whether this is a new decision.
-    pub fn decide(&mut self) -> bool {
+    pub(crate) fn decide(&mut self) -> bool {
         match *self {
             Attempt::Undecided { at_curb, .. } => {
                 *self = Attempt::Committed {
@@ -184,7 +184,7 @@ impl Attempt {
     }
 
     /// Ends the attempt (crossed or given up).
-    pub fn end(&mut self) {
+    pub(crate) fn end(&mut self) {
         *self = Attempt::Over {
             decided: self.decided(),
         };

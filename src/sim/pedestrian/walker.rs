@@ -19,7 +19,7 @@ pub(crate) struct SidewalkWalker {
 impl SidewalkWalker {
     /// A walker at `pos` heading along `heading`, bound for the nearest graph node (or the next one if that is
     /// behind it).
-    pub fn start(net: &RoadNetwork, pos: DVec2, heading: DVec2) -> SidewalkWalker {
+    pub(crate) fn start(net: &RoadNetwork, pos: DVec2, heading: DVec2) -> SidewalkWalker {
         let g = net.sidewalk_graph();
         let Some(n) = g.nearest_node(pos) else {
             return SidewalkWalker::default();
@@ -37,12 +37,12 @@ impl SidewalkWalker {
     }
 
     /// The node it walks to.
-    pub fn target(&self, net: &RoadNetwork) -> DVec2 {
+    pub(crate) fn target(&self, net: &RoadNetwork) -> DVec2 {
         net.sidewalk_graph().nodes[self.node as usize]
     }
 
     /// Moves on to the best next node; turns back at a dead end, and stops where there is nowhere to go.
-    pub fn advance(&mut self, net: &RoadNetwork, heading: DVec2) {
+    pub(crate) fn advance(&mut self, net: &RoadNetwork, heading: DVec2) {
         let g = net.sidewalk_graph();
         let here = g.nodes[self.node as usize];
         let mut best: Option<(f64, u32)> = None;
@@ -71,7 +71,7 @@ impl SidewalkWalker {
     }
 
     /// Turns around: walks back to the node it came from.
-    pub fn turn_around(&mut self) {
+    pub(crate) fn turn_around(&mut self) {
         if let Some(prev) = self.prev {
             self.turn_back_to(prev);
         }

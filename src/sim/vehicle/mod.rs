@@ -130,7 +130,7 @@ pub(crate) const LIGHT_RANGE_M: f64 = 80.0;
 
 impl Vehicle {
     /// The ego vehicle, at its route start, at its target speed.
-    pub fn ego(script: &EgoScript, net: &RoadNetwork) -> Vehicle {
+    pub(crate) fn ego(script: &EgoScript, net: &RoadNetwork) -> Vehicle {
         let path = VehiclePath::from_route(&script.route, net);
         Self::new(
             VehicleId::Ego,
@@ -158,7 +158,7 @@ impl Vehicle {
     }
 
     /// A traffic vehicle, at its route start, at its target speed.
-    pub fn traffic(script: &VehicleScript, net: &RoadNetwork) -> Vehicle {
+    pub(crate) fn traffic(script: &VehicleScript, net: &RoadNetwork) -> Vehicle {
         let path = VehiclePath::from_route(&script.route, net);
         Self::new(
             VehicleId::Traffic(script.id),
@@ -175,7 +175,7 @@ impl Vehicle {
     }
 
     /// A cyclist, at its route start, at its cruising speed, `edge_offset_m` from its lane's right edge.
-    pub fn cyclist(script: &CyclistScript, net: &RoadNetwork) -> Vehicle {
+    pub(crate) fn cyclist(script: &CyclistScript, net: &RoadNetwork) -> Vehicle {
         let path = VehiclePath::from_route(&script.route, net);
         let lane_width_m = script
             .route
@@ -214,13 +214,13 @@ impl Vehicle {
     }
 
     /// Whether it is a bicycle.
-    pub fn is_cyclist(&self) -> bool {
+    pub(crate) fn is_cyclist(&self) -> bool {
         self.cruise_mps.is_some()
     }
 
     /// The distance of `p` from the centre line of its corridor (its path moved `lane_offset_m` to the right),
     /// given `p`'s projection `s_p` on the path and its unsigned distance `lateral_m` from it, metres.
-    pub fn corridor_lateral_m(&self, p: DVec2, s_p: f64, lateral_m: f64) -> f64 {
+    pub(crate) fn corridor_lateral_m(&self, p: DVec2, s_p: f64, lateral_m: f64) -> f64 {
         if self.lane_offset_m == 0.0 {
             return lateral_m;
         }
@@ -230,7 +230,7 @@ impl Vehicle {
     /// Sets a cyclist's ride offset for where it is now: a bike lane's centre where its route has one beside
     /// it, else `edge_offset_m` from its lane's edge. It leaves a bike lane early enough to be back at the edge
     /// offset where the lane ends ([`BIKE_LANE_LOOKAHEAD_M`]); it enters one where it begins.
-    pub fn follow_bike_lane(&mut self) {
+    pub(crate) fn follow_bike_lane(&mut self) {
         if self.ride_offsets.is_empty() {
             return;
         }
@@ -250,7 +250,7 @@ impl Vehicle {
     }
 
     /// Where `p` lies across the path at arc length `s_p`: metres to the left (negative: right).
-    pub fn signed_lateral_m(&self, p: DVec2, s_p: f64) -> f64 {
+    pub(crate) fn signed_lateral_m(&self, p: DVec2, s_p: f64) -> f64 {
         let at = self.path.pose_at(s_p);
         (p - at.pos).dot(at.dir.perp())
     }
@@ -266,25 +266,25 @@ impl Vehicle {
     }
 
     /// Sets the stop lines along its path; those its front bumper has passed are behind it.
-    pub fn set_stop_lines(&mut self, stop_lines: Vec<super::signals::StopLine>) {
+    pub(crate) fn set_stop_lines(&mut self, stop_lines: Vec<super::signals::StopLine>) {
         let front = self.s_m + self.half_length_m;
         self.next_stop = stop_lines.iter().take_while(|l| l.s_m <= front).count();
         self.stop_lines = stop_lines;
     }
 
     /// Whether red lights bind it (not for those drawn to ignore them, nor for emergency vehicles).
-    pub fn heeds_lights(&self) -> bool {
+    pub(crate) fn heeds_lights(&self) -> bool {
         !self.ignores_lights && self.emergency.is_none()
     }
 
     /// Whether the light at its next stop line binds it: it heeds lights and has not committed to the line.
-    pub fn bound_by_light(&self) -> bool {
+    pub(crate) fn bound_by_light(&self) -> bool {
         self.heeds_lights() && self.committed != Some(self.next_stop)
     }
 
     /// Whether it yields to the emergency vehicle `e`: `e` is nearer than [`YIELD_TO_SIREN_M`] and closing in,
     /// unless it follows this vehicle in the same direction (it cannot get past a stopped car in its lane).
-    pub fn yields_to(&self, e: &Vehicle) -> bool {
+    pub(crate) fn yields_to(&self, e: &Vehicle) -> bool {
         if self.emergency.is_some() || e.emergency.is_none() {
             return false;
         }
@@ -345,23 +345,23 @@ impl Vehicle {
     }
 
     /// Half its footprint's extents: along its heading, across, metres.
-    pub fn half_extents(&self) -> DVec2 {
+    pub(crate) fn half_extents(&self) -> DVec2 {
         DVec2::new(self.half_length_m, self.half_width_m)
     }
 
     /// Velocity vector, m/s.
-    pub fn velocity(&self) -> DVec2 {
+    pub(crate) fn velocity(&self) -> DVec2 {
         self.pose.dir * self.speed_mps
     }
 
     /// Target (desired) speed at the current position, m/s.
-    pub fn target_speed_mps(&self) -> f64 {
+    pub(crate) fn target_speed_mps(&self) -> f64 {
         let cruise = self.cruise_mps.unwrap_or(self.pose.speed_limit_mps * self.speed_factor);
         cruise.min(self.path.advisory_mps(self.s_m))
     }
 
     /// Advances by `dt_s` with acceleration `accel_mps2` (speed never negative), updating the cached pose.
-    pub fn integrate(&mut self, accel_mps2: f64, dt_s: f64) {
+    pub(crate) fn integrate(&mut self, accel_mps2: f64, dt_s: f64) {
         let v0 = self.speed_mps;
         let v1 = (v0 + accel_mps2 * dt_s).max(0.0);
         let s0 = self.s_m;
@@ -396,14 +396,14 @@ impl Vehicle {
 
     /// Counts the time the ego yields: while an attentive pedestrian waits at the curb ahead (`yielding`), for
     /// `dt_s` more; the count starts over once none does.
-    pub fn count_yield(&mut self, yielding: bool, dt_s: f64) {
+    pub(crate) fn count_yield(&mut self, yielding: bool, dt_s: f64) {
         if let Some(c) = self.courtesy.as_mut() {
             c.yielded_s = if yielding { c.yielded_s + dt_s } else { 0.0 };
         }
     }
 
     /// Whether a pedestrian waiting attentively at the curb is ahead within the courtesy zone.
-    pub fn sees_waiting_pedestrian(&self, peds: &[PedView]) -> bool {
+    pub(crate) fn sees_waiting_pedestrian(&self, peds: &[PedView]) -> bool {
         self.courtesy.is_some_and(|c| {
             peds.iter().filter(|p| p.waiting_at_curb).any(|p| {
                 self.path
@@ -414,7 +414,7 @@ impl Vehicle {
     }
 
     /// Moves the vehicle back along its path by `ds_m` and stops it (contact resolution).
-    pub fn back_off_and_stop(&mut self, ds_m: f64) {
+    pub(crate) fn back_off_and_stop(&mut self, ds_m: f64) {
         self.s_m = (self.s_m - ds_m).max(0.0);
         self.speed_mps = 0.0;
         self.place();
@@ -437,7 +437,7 @@ pub(crate) struct Courtesy {
 
 impl Courtesy {
     /// Whether the ego has waited long enough and drives on.
-    pub fn patience_spent(&self) -> bool {
+    pub(crate) fn patience_spent(&self) -> bool {
         self.yielded_s >= self.patience_s
     }
 }

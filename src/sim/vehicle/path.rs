@@ -92,7 +92,7 @@ pub(crate) struct PathPose {
 impl VehiclePath {
     /// Rebuilds the route polyline of `route` from its lane list, joining lanes exactly as
     /// `RoadNetwork::route_from` does, and resamples it. Lane indices outside the network are skipped.
-    pub fn from_route(route: &RouteScript, net: &RoadNetwork) -> VehiclePath {
+    pub(crate) fn from_route(route: &RouteScript, net: &RoadNetwork) -> VehiclePath {
         // The world joins lanes into a polyline (the same one the planner measured the route on).
         let lanes = route.lanes_in(net);
         let mut raw: Vec<(DVec2, f64, f64, f64)> = net // pos, z, limit, s
@@ -195,18 +195,18 @@ impl VehiclePath {
     }
 
     /// Advisory (curve) speed at arc length `s_m`, m/s.
-    pub fn advisory_mps(&self, s_m: f64) -> f64 {
+    pub(crate) fn advisory_mps(&self, s_m: f64) -> f64 {
         let i = ((s_m.max(0.0) / PATH_SPACING_M) as usize).min(self.advisory_mps.len().saturating_sub(1));
         self.advisory_mps[i]
     }
 
     /// Length of the path, metres.
-    pub fn length_m(&self) -> f64 {
+    pub(crate) fn length_m(&self) -> f64 {
         self.length_m
     }
 
     /// Pose at arc length `s_m` (clamped to the path).
-    pub fn pose_at(&self, s_m: f64) -> PathPose {
+    pub(crate) fn pose_at(&self, s_m: f64) -> PathPose {
         let s = s_m.clamp(0.0, self.length_m);
         let i = ((s / PATH_SPACING_M) as usize).min(self.points.len().saturating_sub(2));
         let a = &self.points[i];
@@ -233,7 +233,7 @@ impl VehiclePath {
     /// along the path, so every point of segment `k ≥ i` is within `(k − i + 1)·PATH_SPACING_M` of sample
     /// `a_i`, hence at least `|p − a_i| − (k − i + 1)·PATH_SPACING_M` from `p`. Anything whose bound exceeds
     /// both the best distance so far and `max_lateral_m` can neither win nor matter.
-    pub fn project(&self, p: DVec2, from_s_m: f64, to_s_m: f64, max_lateral_m: f64) -> Option<(f64, f64, f64)> {
+    pub(crate) fn project(&self, p: DVec2, from_s_m: f64, to_s_m: f64, max_lateral_m: f64) -> Option<(f64, f64, f64)> {
         let last = self.points.len().saturating_sub(1);
         if last == 0 {
             return None;

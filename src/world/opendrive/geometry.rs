@@ -135,7 +135,7 @@ impl Geometry {
     }
 
     /// World position and heading at `ds` metres from the start of the record (clamped to its length).
-    pub fn eval(&self, ds: f64) -> (DVec2, f64) {
+    pub(crate) fn eval(&self, ds: f64) -> (DVec2, f64) {
         let ds = ds.clamp(0.0, self.length);
         let (l, h) = self.local(ds);
         let (sn, cs) = self.hdg.sin_cos();
@@ -146,7 +146,7 @@ impl Geometry {
     }
 
     /// An upper estimate of |curvature| over the record, used to choose the station spacing.
-    pub fn max_curvature(&self) -> f64 {
+    pub(crate) fn max_curvature(&self) -> f64 {
         match self.kind {
             GeomKind::Line => 0.0,
             GeomKind::Arc { curvature } => curvature.abs(),
