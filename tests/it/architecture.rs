@@ -397,10 +397,53 @@ fn main_only_parses_arguments_and_calls_the_cli() {
 #[test]
 fn the_crate_forbids_unsafe_code_and_keeps_crate_items_pub_crate() {
     let sources = sources();
-    let text = |file: &str| sources.iter().find(|s| s.file == file).map(|s| s.text.as_str()).unwrap_or("");
+    let text = |file: &str| {
+        sources
+            .iter()
+            .find(|s| s.file == file)
+            .map(|s| s.text.as_str())
+            .unwrap_or("")
+    };
     for file in ["lib.rs", "main.rs"] {
-        assert!(text(file).contains("#![forbid(unsafe_code)]"), "{file}: no #![forbid(unsafe_code)]");
+        assert!(
+            text(file).contains("#![forbid(unsafe_code)]"),
+            "{file}: no #![forbid(unsafe_code)]"
+        );
     }
     // With clippy's -D warnings in CI, a `pub` item the crate root cannot reach fails the build.
     assert!(text("lib.rs").contains("#![warn(unreachable_pub)]"));
+}
+
+#[test]
+fn random_streams_are_seeded_chacha_and_the_plan_and_simulation_use_chacha20() {
+    let mut found = Vec::new();
+    let mut chacha20 = 0;
+    for src in sources() {
+        for word in [
+            "thread_rng",
+            "rand::rng()",
+            "from_entropy",
+            "from_os_rng",
+            "OsRng",
+            "StdRng",
+            "SmallRng",
+        ] {
+            if src.code.contains(word) {
+                found.push(format!("{}: {word}", src.file));
+            }
+        }
+        if src.module.first().is_some_and(|r| r == "plan" || r == "sim") {
+            chacha20 += src.code.matches("ChaCha20Rng").count();
+            for word in ["ChaCha8Rng", "ChaCha12Rng"] {
+                if src.code.contains(word) {
+                    found.push(format!(
+                        "{}: {word} (the plan's and the simulation's streams are ChaCha20)",
+                        src.file
+                    ));
+                }
+            }
+        }
+    }
+    assert!(chacha20 > 5, "{chacha20} uses of ChaCha20Rng in plan/ and sim/");
+    assert!(found.is_empty(), "{}", found.join("\n"));
 }
