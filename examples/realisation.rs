@@ -1,7 +1,7 @@
 //! Measures the crossing realisation that `src/calibration.rs` records: the share of planned crossers (layer 1)
 //! that end up labelled crossers (C = 1 in at least one annotated frame), per spec.
 //!
-//! It then realises every clip as `generate` does (`exec::realise`: promotions and demotions until the clip
+//! It then realises every clip as `generate` does (`sensors::realise`: promotions and demotions until the clip
 //! has its planned count of labelled crossers) and prints the resulting crossing ratio and how many clips met
 //! their count.
 //!
@@ -108,7 +108,7 @@ fn main() {
                         _ => {}
                     }
                 }
-                // The executor's realisation (`exec::realise`): (planned labelled crossers, labelled, clips with a
+                // The executor's realisation (`sensors::realise`): (planned labelled crossers, labelled, clips with a
                 // count, clips meeting it, re-simulations, squared miss).
                 let r = pedsynth::sensors::realise::realise(clip, &plan.spec, &plan.sim, &rig, net);
                 let wanted = clip.labelled_crossers.map_or(0, |w| w as usize);

@@ -25,7 +25,7 @@ pub const CROSSER_REALISATION: f64 = 0.851;
 pub const CROSSER_REALISATION_SPREAD: f64 = 0.008;
 
 /// The mean squared miss of a clip's labelled crossers from its planned count (`ClipScript::labelled_crossers`)
-/// after the executor's promotions and demotions (`exec::realise`), in pedestrians². Measured 2026-11-27 with
+/// after the executor's promotions and demotions (`sensors::realise`), in pedestrians². Measured 2026-11-27 with
 /// the command above on the held-out spec (180 clips) at targets 0, 0.05, 0.1, 0.2, ..., 0.8, 0.85, 0.9, 0.95
 /// and 1: 0 to 0.033 (0 to 6 clips miss, by 1 or 2); with traffic lights, 1–3 cyclists and emergency vehicles
 /// in a fifth of the clips at 0, 0.05, 0.1, ..., 0.95, 1: 0 to 0.111 (0 to 8 clips miss); 0 on balanced_50

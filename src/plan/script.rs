@@ -136,7 +136,7 @@ pub struct ClipScript {
     /// How many of the clip's pedestrians the dataset should label crossers (`crossing.target_ratio` of the
     /// stratum's pedestrians, shared among its clips by their planned crossers): the executor re-simulates the
     /// clip, promoting non-crossers or demoting crossers, until it has that many or runs out of candidates
-    /// (`exec::realise`). Absent without layer 1 (crosser allocation).
+    /// (`sensors::realise`). Absent without layer 1 (crosser allocation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub labelled_crossers: Option<u32>,
 }

@@ -4,7 +4,7 @@
 //! from the written tables only) reports: within 1 percentage point of the target, as issue 15 asks, and so
 //! with traffic lights, cyclists and emergency vehicles on as well (the same 21 targets). The
 //! planner gives each clip a count of labelled crossers and `generate` promotes or demotes pedestrians until
-//! the clip has it (`exec::realise`); rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline
+//! the clip has it (`sensors::realise`); rare-event targets (0, 0.05, 0.1: below what the default 9 % baseline
 //! alone gives) also lower the baseline, crossing-heavy ones (0.9, 0.95, 1) also adapt the layers (every
 //! pedestrian a crosser, no crossing groups, more crossers mid-road). Measured with the realisation example
 //! (the same clips as `generate`): misses of at most 0.52 pp. Slow statistical tests: `#[ignore]`d, run by

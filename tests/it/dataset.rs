@@ -779,7 +779,7 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
             }
         }
         // The pedestrians table describes the realised script (roles after promotions and demotions) and its
-        // sequence labels; every change from the plan is one `exec::realise` makes.
+        // sequence labels; every change from the plan is one `sensors::realise` makes.
         for (id, (q, planned_p)) in script.pedestrians.iter().zip(&planned.pedestrians).enumerate() {
             let p = &d.pedestrians[&(script.clip_id.clone(), id as u32)];
             assert_eq!(

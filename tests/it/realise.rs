@@ -1,4 +1,4 @@
-//! The executor's realisation (`exec::realise`): clips re-simulated with pedestrians promoted or demoted until
+//! The executor's realisation (`sensors::realise`): clips re-simulated with pedestrians promoted or demoted until
 //! they have their planned count of labelled crossers. On the held-out spec (3 clips per weather, 18 clips) at
 //! a middle and a crossing-heavy target: the clips meet their counts (measured on all 180 clips of the spec at
 //! 14 targets, with and without traffic lights, cyclists and emergency vehicles: at most 6 miss, by 1 to 3

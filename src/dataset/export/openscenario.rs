@@ -349,7 +349,7 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
     (x, entities.len(), vertices)
 }
 
-/// Fog extinction of the renderer (src/exec/observe/camera/light.rs), 1/m.
+/// Fog extinction of the renderer (src/sensors/camera/light.rs), 1/m.
 fn fog_per_m(fog_density_pct: f64) -> f64 {
     let f = (fog_density_pct / 100.0).clamp(0.0, 1.0);
     0.0002 + 0.05 * f * f

@@ -8,7 +8,7 @@
 //! - [`lidar`] — the LiDAR's points (a Parquet file per clip, or the seed's `.bin` per frame).
 //!
 //! A [`DatasetWriter`] opens `--out` for a plan (refusing a directory that holds anything else), writes each
-//! clip's files atomically (`fsutil::write_atomically`: a complete file or none), and derives the manifest from
+//! clip's files atomically (`util::files::write_atomically`: a complete file or none), and derives the manifest from
 //! the files on disk. A clip's sensor files are written first, then its tables (the `sensors` index among
 //! them, `clips` last): a clip is finished when all of its table files exist, which is what a resumed run
 //! skips, so a clip interrupted while rendering is rendered again whole.
@@ -479,7 +479,7 @@ fn is_startup_file(name: &str) -> bool {
 }
 
 /// Whether a file name is a temporary file left by an interrupted atomic write (`.NAME.tmp-PID`, see
-/// `fsutil::write_atomically`) or another `*.tmp` file.
+/// `util::files::write_atomically`) or another `*.tmp` file.
 fn is_temporary(name: &str) -> bool {
     let pid_suffix = name
         .rsplit_once(".tmp-")

@@ -306,7 +306,7 @@ fn write_road(x: &mut String, road: &RawRoad, objects: &[String], signals: &[Str
         left.sort_by_key(|l| -l.id);
         right.sort_by_key(|l| -l.id);
         let in_junction = road.junction.is_some();
-        // The marking on each lane's outer border, as the camera paints it (src/exec/observe/scene.rs).
+        // The marking on each lane's outer border, as the camera paints it (src/sensors/scene/paint.rs).
         let mark = |l: &RawLane| -> Option<(&str, &str)> {
             if in_junction || l.lane_type != LaneType::Driving {
                 return None;
