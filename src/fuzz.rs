@@ -1,5 +1,5 @@
 //! Entry points of the fuzz targets (`fuzz/`, run by `cargo fuzz` in CI) and of the corpus regression test
-//! (`tests/fuzz_corpus.rs`, run by `cargo test` on every input of `fuzz/corpus` and `fuzz/regressions`). Each
+//! (`tests/it/fuzz_corpus.rs`, run by `cargo test` on every input of `fuzz/corpus` and `fuzz/regressions`). Each
 //! takes arbitrary bytes as an untrusted file and must return, with an error where the input is bad, without
 //! panicking, hanging or allocating without bound.
 

@@ -271,7 +271,7 @@ pub enum Event {
         /// It heeds lights but had committed to the line: it could not stop when it first saw the light amber or
         /// red (the dilemma zone, or placed too close to a red light at the clip's start). A light run by a
         /// vehicle drawn to ignore lights, or by an emergency vehicle, never is; nor one run by a vehicle that
-        /// could have stopped (none should be: tests/signals.rs).
+        /// could have stopped (none should be: tests/it/signals.rs).
         unavoidable: bool,
     },
     /// A vehicle finished overtaking a cyclist: its rear passed the bicycle's front.

@@ -183,7 +183,7 @@ pub(crate) fn build(name: &str) -> Option<RoadNetwork> {
         Some(obstacles),
         true,
     )
-    .expect("built-in towns are valid OpenDRIVE (covered by tests/world_builtin.rs)");
+    .expect("built-in towns are valid OpenDRIVE (covered by tests/it/world_builtin.rs)");
     Some(net)
 }
 
