@@ -109,7 +109,22 @@ fn references(src: &Source) -> Vec<Vec<String>> {
         let indented = rest[..i].rsplit('\n').next().is_some_and(|l| l.starts_with(' '));
         let body_start = i + rest[i..].find("use ").unwrap() + 4;
         let end = body_start + rest[body_start..].find(';').unwrap_or(rest.len() - body_start);
-        for p in expand(&rest[body_start..end].split_whitespace().collect::<String>()) {
+        // `a::b as c` names `a::b`: drop each rename (keeping the group's punctuation after it), then the
+        // whitespace.
+        let words: Vec<&str> = rest[body_start..end].split_whitespace().collect();
+        let mut body = String::new();
+        let mut k = 0;
+        while k < words.len() {
+            if words[k] == "as" {
+                let after = words.get(k + 1).copied().unwrap_or("");
+                body.push_str(after.trim_start_matches(|c: char| c.is_alphanumeric() || c == '_'));
+                k += 2;
+            } else {
+                body.push_str(words[k]);
+                k += 1;
+            }
+        }
+        for p in expand(&body) {
             paths.push((p, indented));
         }
         rest = &rest[end..];
@@ -189,10 +204,10 @@ fn find_use(text: &str) -> Option<usize> {
     None
 }
 
-/// `a::{b, c::{d, e}}` → `a::b`, `a::c::d`, `a::c::e` (whitespace already removed; `as` renames dropped).
+/// `a::{b, c::{d, e}}` → `a::b`, `a::c::d`, `a::c::e` (whitespace and `as` renames already removed).
 fn expand(tree: &str) -> Vec<String> {
     let Some(open) = tree.find('{') else {
-        return vec![tree.split("as").next().unwrap_or(tree).to_owned()];
+        return vec![tree.to_owned()];
     };
     let close = tree.rfind('}').unwrap_or(tree.len());
     let (prefix, inner) = (&tree[..open], &tree[open + 1..close]);
@@ -280,8 +295,7 @@ fn no_file_names_a_room_of_a_later_layer() {
     let probe = Source {
         file: "sim/probe.rs".into(),
         module: vec!["sim".into(), "probe".into()],
-        code: "use crate::dataset::write::{DatasetWriter, layout::Layout};\nfn f() { crate::sensors::observe(); }"
-            .into(),
+        code: "use crate::dataset::write::Layout as L;\nfn f() { crate::sensors::observe(); }".into(),
         text: String::new(),
     };
     let named: BTreeSet<String> = references(&probe).iter().map(|p| p[0].clone()).collect();
