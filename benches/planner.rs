@@ -20,6 +20,7 @@ fn spec(town_override: &str, clips: u32) -> (spec::LoadedSpec, std::collections:
             format!("dataset.clips.count={clips}"),
         ],
         allow_large: true,
+        profile: None,
     };
     let loaded = spec::load_file(&path, &options).expect("valid spec");
     let towns = load_towns(&loaded).expect("towns load");

@@ -32,6 +32,7 @@ fn plan(
             "traffic.vehicles_per_clip=[10, 10]".to_owned(),
         ],
         allow_large: true,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).expect("feasible spec");
     (towns, plan)

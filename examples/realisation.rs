@@ -42,6 +42,7 @@ fn main() {
     let options = LoadOptions {
         overrides,
         allow_large: false,
+        profile: None,
     };
     for spec in specs {
         let (_, towns, plan) = match pedsynth::dataset::inputs::plan_spec_file(Path::new(&spec), &options) {

@@ -31,6 +31,7 @@ fn main() {
     let options = LoadOptions {
         overrides,
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) = match pedsynth::dataset::inputs::plan_spec_file(Path::new(spec), &options) {
         Ok(x) => x,

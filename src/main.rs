@@ -25,6 +25,9 @@ struct SpecArgs {
     /// Accept a spec beyond the sanity limits (clip count, image size, estimated dataset size).
     #[arg(long)]
     allow_large: bool,
+    /// Lay a profile over the spec before the overrides (a partial spec, e.g. written by `pedsynth calibrate`).
+    #[arg(long, value_name = "PROFILE.yaml")]
+    profile: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -191,6 +194,38 @@ enum Command {
         #[arg(long, value_name = "FRAMES", requires = "protocol")]
         min_track: Option<usize>,
     },
+    /// Fit a profile to real annotations (JAAD's or PIE's XML layout, or a Parquet/CSV table): the camera's
+    /// horizon, height and image size, the frame rate and how long crossers are seen before crossing; prints what
+    /// the real data shows (PedestrianActionBenchmark windows, cue table, ego actions). With --compare, the same
+    /// measured on a generated dataset, side by side.
+    Calibrate {
+        /// The real annotations' root directory.
+        real_dir: PathBuf,
+        /// Their layout.
+        #[arg(long, value_enum)]
+        format: RealFormat,
+        /// Splits to fit to, comma-separated (`all`: every video).
+        #[arg(long, value_delimiter = ',', default_value = "train")]
+        splits: Vec<String>,
+        /// The profile to write (a partial spec for `--profile`).
+        #[arg(long, value_name = "PROFILE.yaml")]
+        out: PathBuf,
+        /// Horizontal field of view assumed for the real camera, degrees (boxes do not fix it).
+        #[arg(long, default_value_t = 90.0)]
+        fov_deg: f64,
+        /// Overlap of the benchmark's windows (0.8 JAAD, 0.6 PIE).
+        #[arg(long, default_value_t = 0.8)]
+        overlap: f64,
+        /// A generated dataset to compare with the real annotations.
+        #[arg(long, value_name = "DATASET")]
+        compare: Option<PathBuf>,
+        /// Write the comparison as Markdown here.
+        #[arg(long, value_name = "REPORT.md", requires = "compare")]
+        report: Option<PathBuf>,
+        /// Print JSON instead of tables.
+        #[arg(long)]
+        json: bool,
+    },
     /// Draw a clip's camera or LiDAR stream with its labels (boxes, ids, states, skeletons): a contact sheet of nine
     /// frames (--out FILE.png) or an animation (--out FILE.gif).
     Preview {
@@ -255,6 +290,16 @@ enum PreviewStream {
 }
 
 /// Benchmark protocols of `stats --protocol`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum RealFormat {
+    /// JAAD's XML (annotations/, annotations_attributes/, annotations_vehicle/, split_ids/).
+    Jaad,
+    /// PIE's XML (annotations/<setNN>/, annotations_attributes/<setNN>/, annotations_vehicle/<setNN>/).
+    Pie,
+    /// Tables (videos, boxes, pedestrians, optional vehicle) as Parquet or CSV; DATASET.md documents them.
+    Table,
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum Protocol {
     /// PedestrianActionBenchmark (Kotseruba et al., WACV 2021).
@@ -333,6 +378,7 @@ fn main() -> ExitCode {
     let load_options = |spec_args: SpecArgs| LoadOptions {
         overrides: spec_args.overrides,
         allow_large: spec_args.allow_large,
+        profile: spec_args.profile,
     };
     let result = match cli.command {
         Command::Validate {
@@ -388,6 +434,37 @@ fn main() -> ExitCode {
                 min_track: min_track.unwrap_or(obs_length + tte.1),
             });
             cli::stats(&dir, json, options.as_ref(), &mut out)
+        }
+        Command::Calibrate {
+            real_dir,
+            format,
+            splits,
+            out: profile,
+            fov_deg,
+            overlap,
+            compare,
+            report,
+            json,
+        } => {
+            use pedsynth::dataset::calibrate::{CalibrateOptions, Format};
+            let mut options = CalibrateOptions {
+                format: match format {
+                    RealFormat::Jaad => Format::Jaad,
+                    RealFormat::Pie => Format::Pie,
+                    RealFormat::Table => Format::Table,
+                },
+                splits: splits.into_iter().filter(|s| s != "all").collect(),
+                fov_deg,
+                ..CalibrateOptions::default()
+            };
+            options.pab.overlap = overlap;
+            let paths = cli::CalibratePaths {
+                real_dir: &real_dir,
+                profile: &profile,
+                compare: compare.as_deref(),
+                report: report.as_deref(),
+            };
+            cli::calibrate(&paths, &options, json, &mut out)
         }
         Command::Preview {
             dir,

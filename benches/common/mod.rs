@@ -34,6 +34,7 @@ pub fn busy_quickstart_clip(overrides: &[String]) -> BusyClip {
     let options = LoadOptions {
         overrides: overrides.to_vec(),
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).expect("quickstart plans");
     let script = plan.clips[0].clone();

@@ -322,6 +322,82 @@ pub fn stats(
     emit(out, &text)
 }
 
+/// Where `pedsynth calibrate` reads and writes.
+pub struct CalibratePaths<'a> {
+    /// The real annotations.
+    pub real_dir: &'a Path,
+    /// The profile to write.
+    pub profile: &'a Path,
+    /// A generated dataset to compare with.
+    pub compare: Option<&'a Path>,
+    /// Where to write the comparison as Markdown.
+    pub report: Option<&'a Path>,
+}
+
+/// `pedsynth calibrate REAL_DIR --format F --out PROFILE.yaml [--compare DATASET [--report R.md]]`: fits and
+/// writes the profile (atomically), prints what was measured and fitted, and the comparison where asked.
+pub fn calibrate(
+    paths: &CalibratePaths,
+    options: &crate::dataset::calibrate::CalibrateOptions,
+    json: bool,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    use crate::dataset::calibrate as cal;
+    if !(options.fov_deg > 1.0 && options.fov_deg < 179.0) {
+        return Err(Error::new(
+            crate::error::code::REAL_INVALID,
+            format!("--fov-deg {} is not a field of view (1–179°)", options.fov_deg),
+        ));
+    }
+    options.pab.validate()?;
+    let real = cal::read_real(paths.real_dir, options.format, &options.splits)?;
+    let calibration = cal::calibrate(&real, options)?;
+    let source = paths.real_dir.file_name().map_or_else(
+        || paths.real_dir.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let yaml = cal::profile_yaml(&calibration, &source);
+    crate::util::files::write_atomically(paths.profile, yaml.as_bytes()).map_err(|e| Error::write(paths.profile, e))?;
+    let comparison = match paths.compare {
+        Some(dir) => Some(cal::compare(&real, &cal::synthetic_videos(dir)?, &options.pab)),
+        None => None,
+    };
+    if let (Some(c), Some(report)) = (&comparison, paths.report) {
+        let name = paths.compare.map(|d| d.display().to_string()).unwrap_or_default();
+        let text = cal::report_markdown(c, &source, &name);
+        crate::util::files::write_atomically(report, text.as_bytes()).map_err(|e| Error::write(report, e))?;
+    }
+    if json {
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            calibration: &'a cal::Calibration,
+            comparison: Option<&'a cal::Comparison>,
+        }
+        let value = Out {
+            calibration: &calibration,
+            comparison: comparison.as_ref(),
+        };
+        return emit(out, &(crate::error::to_json(&value, true)? + "\n"));
+    }
+    let mut text = format!("wrote {}:\n{yaml}", paths.profile.display());
+    match &comparison {
+        Some(c) => {
+            text += &cal::report_markdown(
+                c,
+                &source,
+                &paths.compare.unwrap_or(Path::new("")).display().to_string(),
+            )
+        }
+        None => {
+            text += "\ncues in the real data (AUC of each window quantity for crossing; 0.5 none, < 0.5 reversed):\n";
+            for (q, a) in &calibration.real.cues {
+                text += &format!("  {q:<14} {a:.2}\n");
+            }
+        }
+    }
+    emit(out, &text)
+}
+
 /// `pedsynth verify DIR [--tables-only]`: prints what was checked; a dataset with problems is an error
 /// (exit 2) that lists them all.
 pub fn verify(dir: &Path, tables_only: bool, out: &mut dyn Write) -> Result<(), Error> {

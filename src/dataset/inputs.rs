@@ -131,6 +131,7 @@ pub fn read_plan_bytes(bytes: &[u8], path: &Path) -> Result<(Plan, BTreeMap<Stri
     let options = LoadOptions {
         overrides: Vec::new(),
         allow_large: true,
+        profile: None,
     };
     let loaded = spec::load_bytes(yaml.as_bytes(), &name, &spec_dir, &options)?;
     let mut problems = Vec::new();

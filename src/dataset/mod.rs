@@ -8,9 +8,11 @@
 //! - [`verify`] — `pedsynth verify`: completeness, hashes, schemas, joins, sensor files.
 //! - [`export`] — a written dataset in other tools' layouts (PIE, JAAD, PedestrianActionBenchmark, the seed
 //!   system's CSV, OpenSCENARIO).
+//! - [`calibrate`] — `pedsynth calibrate`: real annotations measured, a profile fitted, real against generated.
 //! - [`inputs`] — what a dataset is made from, read from disk: a spec's towns, the compiled plan, a plan file
 //!   checked against its spec.
 
+pub mod calibrate;
 pub mod export;
 pub mod generate;
 pub mod inputs;

@@ -85,6 +85,9 @@ pub mod code {
     pub const DATASET_LOCKED: &str = "pedsynth::dataset::locked";
     /// A dataset that cannot be read as a pedsynth dataset (missing or malformed tables or manifest).
     pub const DATASET_INVALID: &str = "pedsynth::dataset::invalid";
+    /// Real annotations given to `pedsynth calibrate` that cannot be read or used (missing files, wrong layout,
+    /// an empty split).
+    pub const REAL_INVALID: &str = "pedsynth::calibrate::real_invalid";
     /// Options of `stats --protocol` that the protocol does not define.
     pub const PROTOCOL_OPTIONS: &str = "pedsynth::dataset::protocol_options";
     /// A file or directory that cannot be read.
@@ -221,6 +224,10 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::DATASET_INVALID,
         "a directory that cannot be read as a pedsynth dataset (missing or malformed manifest or tables)",
+    ),
+    input(
+        code::REAL_INVALID,
+        "real annotations `calibrate` cannot use (missing files, wrong layout, an empty split, too few boxes)",
     ),
     input(
         code::PROTOCOL_OPTIONS,

@@ -167,7 +167,9 @@ pub(super) fn draw_stratum(spec: &Spec, stratum_index: usize, stratum: &Stratum)
             let clip_seed = seeds::seed_u64(seed, &clip_id(&stratum.town, &stratum.weather, k));
             let mut rng = seeds::clip_rng(clip_seed, "basics");
             let duration_s = rng.random_range(d.clip_duration_s.min()..=d.clip_duration_s.max());
-            let frame_count = ((duration_s * f64::from(d.fps)).round() as u32).max(1);
+            // Whole frames within the range (a bound that is no whole number of frames is not rounded past).
+            let fps = f64::from(d.fps);
+            let frame_count = ((duration_s * fps).round().min((d.clip_duration_s.max() * fps).floor()) as u32).max(1);
             let p = &spec.pedestrians.per_clip;
             let v = &spec.traffic.vehicles_per_clip;
             let basics = ClipBasics {

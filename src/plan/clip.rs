@@ -113,12 +113,7 @@ pub(super) fn plan_clip(
         .iter()
         .filter_map(|p| timeline_duration_s(p, &schedule, plans.as_ref().map(|plans| (plans, net))))
         .fold(0.0, f64::max);
-    let extension_s = (needed_s - duration_s).clamp(0.0, (MAX_TIMELINE_EXTENSION - 1.0) * duration_s);
-    let frame_count = if extension_s > 0.0 {
-        ((duration_s + extension_s) * f64::from(fps)).round() as u32
-    } else {
-        basics.frame_count
-    };
+    let frame_count = lengthened_frame_count(&spec.dataset, basics.frame_count, needed_s);
 
     Ok(ClipScript {
         clip_id,
@@ -139,8 +134,14 @@ pub(super) fn plan_clip(
     })
 }
 
-/// A clip is lengthened to at most this multiple of its drawn duration for its crossers' timelines.
-pub(super) const MAX_TIMELINE_EXTENSION: f64 = 2.0;
+/// The frames of a clip drawn with `drawn_frames` whose crossers' timelines need `needed_s` seconds: as many as
+/// they need, up to `clip_duration_s`'s maximum plus `max_extension_s` (never fewer than drawn).
+pub(super) fn lengthened_frame_count(d: &crate::spec::types::Dataset, drawn_frames: u32, needed_s: f64) -> u32 {
+    let fps = f64::from(d.fps);
+    let cap = ((d.clip_duration_s.max() + d.max_extension_s) * fps).floor() as u32;
+    let needed = (needed_s * fps).ceil().min(f64::from(u32::MAX)) as u32;
+    needed.min(cap).max(drawn_frames)
+}
 
 /// Distance at which the planner estimates that the ego's camera starts to see a pedestrian, metres (the
 /// visibility gate admits an adult within about 30–35 m; the simulation decides the real moment).

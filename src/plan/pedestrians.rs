@@ -52,6 +52,18 @@ pub(super) fn plan_pedestrians(
             crate::world::signals::signalised_entries(net, route),
         )
     });
+    // Per-class scenario rules, drawn from a stream of their own (none while they are off, so that the paper's
+    // set-up draws exactly what it drew before they existed).
+    let scenario = &c.scenario;
+    let mut scenario_rng = (!scenario.is_off()).then(|| seeds::clip_rng(clip_seed, "plan/scenario"));
+    let walker_range = if scenario.walker_ahead_m.max() > 0.0 {
+        (
+            scenario.walker_ahead_m.min(),
+            scenario.walker_ahead_m.max().min(route.length_m() - 1.0),
+        )
+    } else {
+        (spawn_ahead.min(), far_m)
+    };
     // Group ids are numbered by leader, in pedestrian order.
     let mut leaders: Vec<u32> = peds.iter().filter_map(|a| a.group).collect();
     leaders.sort_unstable();
@@ -141,7 +153,7 @@ pub(super) fn plan_pedestrians(
                 }
                 // Walkers too start within the spawn range, so that the camera sees them about as long as crossers
                 // (the benchmark protocol counts a track only when it is long enough).
-                (Role::NonCrosser, _) => place_sidewalk(net, route, spawn_ahead.min(), far_m, &scripts, rng),
+                (Role::NonCrosser, _) => place_sidewalk(net, route, walker_range.0, walker_range.1, &scripts, rng),
             }
         };
         let (spawn, heading, ahead, crossing, place) = placed.ok_or_else(|| {
@@ -183,6 +195,12 @@ pub(super) fn plan_pedestrians(
             spawn_heading_rad: heading,
             ahead_of_ego_m: ahead,
             crossing,
+            step_out_ego_within_m: match scenario_rng.as_mut() {
+                Some(r) if in_view_before_crossing_s.is_some() && scenario.crosser_ego_within_m.max() > 0.0 => {
+                    Some(draw(r, scenario.crosser_ego_within_m))
+                }
+                _ => None,
+            },
             in_view_before_crossing_s,
             curb_wait_s,
             identity,

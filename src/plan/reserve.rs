@@ -86,6 +86,8 @@ pub fn promoted(
     let others: Vec<PedestrianScript> = clip.pedestrians.iter().filter(|q| q.id != p.id).cloned().collect();
     let (spawn, heading, ahead, crossing, place) =
         place_crosser(net, route, lo, hi, side, approach_m, &others, &mut rng)?;
+    let within = c.scenario.crosser_ego_within_m;
+    let step_out_ego_within_m = (within.max() > 0.0).then(|| draw(&mut rng, within));
     Some(PedestrianScript {
         role: Role::Crosser,
         crosser_source: CrosserSource::Promoted,
@@ -96,6 +98,7 @@ pub fn promoted(
         ahead_of_ego_m: ahead,
         crossing,
         in_view_before_crossing_s: Some(in_view_s),
+        step_out_ego_within_m,
         curb_wait_s: None,
         group: None,
         red_light_violator: false,
@@ -124,6 +127,7 @@ pub fn demoted(spec: &Spec, clip: &ClipScript, i: usize) -> Option<PedestrianScr
         crosser_source: CrosserSource::None,
         behaviour: Behaviour::HardNegative,
         in_view_before_crossing_s: None,
+        step_out_ego_within_m: None,
         curb_wait_s: Some(wait_s),
         group: None,
         red_light_violator: false,

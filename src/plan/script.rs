@@ -469,6 +469,10 @@ pub struct PedestrianScript {
     /// Time the pedestrian must have been in view of the ego's camera before it steps onto the road, seconds
     /// (crossers that start on a sidewalk; `crossing.timeline`).
     pub in_view_before_crossing_s: Option<f64>,
+    /// A crosser steps out only once the ego is within this distance of it, metres (`crossing.scenario`; absent
+    /// where that rule is off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_out_ego_within_m: Option<f64>,
     /// How long a hard negative waits at the curb before walking on, seconds.
     pub curb_wait_s: Option<f64>,
     /// Who the pedestrian is: body height and looks, the same for every sensor and label.

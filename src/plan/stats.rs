@@ -215,6 +215,12 @@ pub struct TimelineStats {
     pub lengthened_clips: usize,
     /// Mean lengthening of those clips, seconds.
     pub mean_lengthening_s: f64,
+    /// Clips longer than `dataset.clip_duration_s`'s maximum (only where `dataset.max_extension_s` allows).
+    pub clips_beyond_duration_range: usize,
+    /// The longest clip, seconds.
+    pub longest_clip_s: f64,
+    /// The longest a clip may be: `clip_duration_s`'s maximum plus `max_extension_s`, seconds.
+    pub duration_bound_s: f64,
 }
 
 fn round(x: f64, digits: i32) -> f64 {
@@ -335,11 +341,17 @@ pub fn compute(plan: &Plan, spec: &Spec) -> PlanStats {
                 counted_clips += 1;
             }
         }
+        let clip_s = f64::from(clip.frame_count) / f64::from(clip.fps.max(1));
+        stats.timeline.longest_clip_s = stats.timeline.longest_clip_s.max(round(clip_s, 3));
+        if clip_s > spec.dataset.clip_duration_s.max() + 1e-9 {
+            stats.timeline.clips_beyond_duration_range += 1;
+        }
         if clip.timeline_extension_s > 0.0 {
             stats.timeline.lengthened_clips += 1;
             lengthening_s += clip.timeline_extension_s;
         }
     }
+    stats.timeline.duration_bound_s = round(spec.dataset.clip_duration_s.max() + spec.dataset.max_extension_s, 3);
     in_view.sort_by(f64::total_cmp);
     stats.timeline.crossers = in_view.len();
     if !in_view.is_empty() {
@@ -612,12 +624,15 @@ impl std::fmt::Display for PlanStats {
         let t = &stats.timeline;
         writeln!(
             out,
-            "\ncrossing timeline\n  {} crossers step out after a planned time in view of the ego's camera: median {:.1} s, {:.0}% at least 76 frames\n  {} clips lengthened for their crossers' timelines (mean +{:.1} s)",
+            "\ncrossing timeline\n  {} crossers step out after a planned time in view of the ego's camera: median {:.1} s, {:.0}% at least 76 frames\n  {} clips lengthened for their crossers' timelines (mean +{:.1} s); longest clip {:.1} s, {} beyond `dataset.clip_duration_s` (bound {:.1} s: its maximum plus `dataset.max_extension_s`)",
             t.crossers,
             t.median_in_view_s,
             100.0 * t.share_at_least_76_frames,
             t.lengthened_clips,
-            t.mean_lengthening_s
+            t.mean_lengthening_s,
+            t.longest_clip_s,
+            t.clips_beyond_duration_range,
+            t.duration_bound_s
         )?;
         writeln!(out, "\nsplits")?;
         for (name, s) in &stats.splits {

@@ -7,7 +7,7 @@ use super::check;
 use super::diagnostic::{Problem, Sources, SpecErrors, code};
 use super::schema::spec_schema;
 use super::tree::{self, DisplayPath, Node, PathSeg, Span, Value};
-use super::types::{SPEC_VERSION, Spec};
+use super::types::{CameraProfile, SPEC_VERSION, Spec};
 use super::validate;
 
 /// How to load a spec.
@@ -17,6 +17,9 @@ pub struct LoadOptions {
     pub overrides: Vec<String>,
     /// Accept specs beyond the sanity limits (`--allow-large`).
     pub allow_large: bool,
+    /// A profile (`--profile FILE`, e.g. written by `pedsynth calibrate`): a partial spec laid over the spec
+    /// before the overrides.
+    pub profile: Option<PathBuf>,
 }
 
 /// A valid, fully defaulted spec.
@@ -110,6 +113,12 @@ pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptio
 
     // A malformed override is reported and skipped; the rest of the spec is still validated.
     let mut problems = Vec::new();
+    if let Some(path) = &options.profile {
+        match read_profile(path, &mut sources) {
+            Ok(profile) => overlay(&mut root, profile, None),
+            Err(problem) => problems.push(*problem),
+        }
+    }
     for (i, text) in options.overrides.iter().enumerate() {
         let id = sources.add(format!("--set #{}", i + 1), text.clone());
         if let Err(problem) = apply_override(&mut root, text, id) {
@@ -117,6 +126,7 @@ pub fn load_bytes(bytes: &[u8], name: &str, base_dir: &Path, options: &LoadOptio
         }
     }
 
+    apply_camera_profile(&mut root);
     if let Some(problem) = check_version(&root) {
         return fail(vec![problem], &sources);
     }
@@ -230,6 +240,88 @@ fn check_version(root: &Node) -> Option<Problem> {
             )),
         ),
         _ => None, // a wrong type is reported by the structural check
+    }
+}
+
+/// Reads and parses a profile file; its nodes' spans point into a source of its own.
+fn read_profile(path: &Path, sources: &mut Sources) -> Result<Node, Box<Problem>> {
+    let label = format!("profile {}", path.display());
+    let bytes = crate::util::files::read_capped(path, MAX_SPEC_BYTES).map_err(|err| {
+        Box::new(
+            Problem::new(code::IO, format!("cannot read profile `{}`: {err}", path.display()))
+                .help("check the path given to --profile"),
+        )
+    })?;
+    let Ok(text) = String::from_utf8(bytes) else {
+        return Err(Box::new(
+            Problem::new(
+                code::NOT_UTF8,
+                format!("profile `{}` is not valid UTF-8", path.display()),
+            )
+            .help("save the file as UTF-8"),
+        ));
+    };
+    let id = sources.add(label, text.clone());
+    let node = tree::parse(&text, id).map_err(|err| Box::new(yaml_problem(&err, &text, id)))?;
+    match node.value {
+        Value::Map(_) | Value::Null => Ok(node),
+        _ => Err(Box::new(
+            Problem::new(
+                code::WRONG_TYPE,
+                format!("profile `{}` must be a mapping of spec keys", path.display()),
+            )
+            .at(node.span, "not a mapping")
+            .help("a profile is a partial spec, e.g. `sensors: {rgb: {profile: jaad}}`"),
+        )),
+    }
+}
+
+/// Lays `over` onto `base`: mappings merge key by key (a mix, like a list or a scalar, is replaced whole), and
+/// `over`'s values win.
+fn overlay(base: &mut Node, over: Node, key: Option<&str>) {
+    let is_mix = key.is_some_and(is_mix_key);
+    match (&mut base.value, over.value) {
+        (Value::Map(entries), Value::Map(over_entries)) if !is_mix => {
+            for (k, v) in over_entries {
+                match entries.iter_mut().rev().find(|(existing, _)| existing.name == k.name) {
+                    Some((_, slot)) => overlay(slot, v, Some(&k.name)),
+                    None => entries.push((k, v)),
+                }
+            }
+        }
+        (_, Value::Null) if key.is_none() => {}
+        (_, value) => *base = Node { value, span: over.span },
+    }
+}
+
+/// Fills in the keys of `sensors.rgb.profile`'s camera preset that `sensors.rgb` does not set itself (an
+/// unknown profile name is left to the structural check).
+fn apply_camera_profile(root: &mut Node) {
+    let path = [
+        PathSeg::Key("sensors".into()),
+        PathSeg::Key("rgb".into()),
+        PathSeg::Key("profile".into()),
+    ];
+    let Some(node) = root.at(&path) else { return };
+    let Value::Str(name) = &node.value else { return };
+    let Ok(profile) = serde_json::from_value::<CameraProfile>(serde_json::Value::String(name.clone())) else {
+        return;
+    };
+    let span = node.span;
+    for (key, value) in profile.preset() {
+        let Ok(mut key_path) = tree::parse_path(key) else {
+            continue;
+        };
+        key_path.splice(0..0, path[..2].iter().cloned());
+        if root.at(&key_path).is_some() {
+            continue;
+        }
+        if let Ok(mut value) = tree::parse(value, span.source) {
+            value.span = span;
+            // Cannot fail: the path's parents are mappings or absent (a non-mapping `mount` keeps its own
+            // value, reported by the structural check).
+            let _ = root.set(&key_path, value, span);
+        }
     }
 }
 

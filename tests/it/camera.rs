@@ -29,6 +29,7 @@ fn options(overrides: &[&str]) -> LoadOptions {
     LoadOptions {
         overrides: overrides.iter().map(|s| s.to_string()).collect(),
         allow_large: false,
+        profile: None,
     }
 }
 
@@ -862,7 +863,7 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
     );
     let net = &c.towns[&c.script.town].network;
     let mut checked = 0;
-    for frame in (0..c.trace.frame_count as usize).step_by(15) {
+    for frame in (0..c.trace.frame_count as usize).step_by(10) {
         let ego = c.trace.ego[frame];
         let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
         let eye = cam.centre.truncate();

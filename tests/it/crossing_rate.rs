@@ -108,6 +108,7 @@ fn crossing_heavy_targets_are_met_by_adapting_the_layers() {
         let options = pedsynth::spec::LoadOptions {
             overrides: vec![format!("crossing.target_ratio={target}")],
             allow_large: false,
+            profile: None,
         };
         pedsynth::dataset::inputs::plan_spec_file(
             std::path::Path::new("tests/data/specs/heldout_crossing.yaml"),

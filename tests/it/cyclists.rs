@@ -242,6 +242,7 @@ fn bike_traces(dir: &Path, town: &str) -> (pedsynth::world::RoadNetwork, Vec<ped
     let options = LoadOptions {
         overrides: common::NO_SENSORS.iter().map(|s| (*s).to_owned()).collect(),
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&spec, &options).unwrap_or_else(|e| panic!("{e}"));
     let net = towns.values().next().expect("one town").network.clone();

@@ -77,6 +77,7 @@ fn options(overrides: &[&str]) -> LoadOptions {
             .map(|s| s.to_string())
             .collect(),
         allow_large: false,
+        profile: None,
     }
 }
 

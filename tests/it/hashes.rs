@@ -81,6 +81,7 @@ fn a_rendered_frame_per_weather_hashes_as_committed() {
             .map(String::from)
             .to_vec(),
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) =
         pedsynth::dataset::inputs::plan_spec_file(&spec, &options).unwrap_or_else(|e| panic!("{}", e.render()));

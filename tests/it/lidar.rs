@@ -169,6 +169,7 @@ fn clip_of(spec_path: &Path) -> Clip {
     let options = LoadOptions {
         overrides: Vec::new(),
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(spec_path, &options).expect("plans");
     let script = plan.clips[0].clone();

@@ -5,6 +5,7 @@
 
 mod architecture;
 mod behaviour_labels;
+mod calibrate;
 mod camera;
 mod common;
 mod crash;

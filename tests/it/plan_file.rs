@@ -68,6 +68,7 @@ fn plan_files_are_read_losslessly_and_edited_plans_are_refused_by_path() {
     let options = pedsynth::spec::LoadOptions {
         overrides: vec!["dataset.clips.count=3".into()],
         allow_large: false,
+        profile: None,
     };
     let (_, compiled) = pedsynth::dataset::inputs::compile_plan(&quickstart(), &options, None).unwrap();
     assert_eq!(

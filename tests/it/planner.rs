@@ -21,6 +21,7 @@ fn compile(spec: &str, overrides: &[String]) -> (spec::LoadedSpec, BTreeMap<Stri
     let options = LoadOptions {
         overrides: overrides.to_vec(),
         allow_large: true,
+        profile: None,
     };
     pedsynth::dataset::inputs::plan_spec_file(Path::new(spec), &options).unwrap_or_else(|e| panic!("{}", e.render()))
 }

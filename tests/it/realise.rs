@@ -25,6 +25,7 @@ fn plan(
             .chain(["dataset.clips.count=3".to_owned()])
             .collect(),
         allow_large: false,
+        profile: None,
     };
     let (_, towns, plan) =
         pedsynth::dataset::inputs::plan_spec_file(Path::new("tests/data/specs/heldout_crossing.yaml"), &options)

@@ -14,6 +14,7 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
             "dataset.weathers=[clear_noon, night_rainy]".to_owned(),
         ],
         allow_large: true,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options)?;
     assert!(plan.clips.len() >= 8);

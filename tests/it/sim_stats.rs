@@ -19,6 +19,7 @@ fn plan_and_simulate(spec: &str, overrides: &[&str]) -> (Plan, Vec<ClipTrace>) {
     let options = LoadOptions {
         overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
         allow_large: true,
+        profile: None,
     };
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
     let traces = sim::simulate_all(&plan, &towns).expect("towns present");
@@ -197,12 +198,13 @@ fn pedsynth_pp_behaviour_statistics() {
     assert!(s.pedestrians >= 2000, "{} pedestrians", s.pedestrians);
     let retreat = s.retreats as f64 / s.eligible_conflicts as f64;
     assert!(
-        s.eligible_conflicts >= 300,
+        s.eligible_conflicts >= 200,
         "only {} eligible conflicts",
         s.eligible_conflicts
     );
     // One draw per eligible conflict with the spec's probability: within 4 binomial standard errors of it
-    // (±5.4 pp at 373 conflicts; measured 0.107 after the curb-arrival fix, 0.13–0.16 before).
+    // (±5.4 pp at 373 conflicts, ±7.6 pp at the 248 since clips keep `clip_duration_s`; at least 200 conflicts
+    // keep it under 8.5 pp; measured 0.107 after the curb-arrival fix, 0.13–0.16 before).
     let p = plan.spec.crossing.retreat.probability;
     let se = (p * (1.0 - p) / s.eligible_conflicts as f64).sqrt();
     assert!(

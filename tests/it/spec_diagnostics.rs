@@ -49,6 +49,7 @@ fn load(path: &Path, overrides: &[&str]) -> Result<spec::LoadedSpec, SpecErrors>
     let options = LoadOptions {
         overrides: overrides.iter().map(|s| s.to_string()).collect(),
         allow_large: false,
+        profile: None,
     };
     // Relative names and directories (tests run in the crate root): no absolute path may reach a golden file.
     let name = display_name(path);

@@ -18,6 +18,7 @@ fn load_text(text: &[u8], overrides: Vec<String>) -> Result<spec::LoadedSpec, sp
         &LoadOptions {
             overrides,
             allow_large: false,
+            profile: None,
         },
     )
 }

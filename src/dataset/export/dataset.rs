@@ -228,6 +228,7 @@ impl Dataset {
         let options = LoadOptions {
             overrides: Vec::new(),
             allow_large: true,
+            profile: None,
         };
         let spec = crate::spec::load_bytes(&bytes, &spec_path.display().to_string(), dir, &options)
             .map_err(|e| refuse(format!("{}: not a valid spec: {e}", spec_path.display())))?

@@ -158,6 +158,8 @@ pub(crate) struct Traits {
     pub height_m: f64,
     /// A crosser steps out only after the ego's camera has seen it this long, seconds (its timeline).
     pub in_view_before_crossing_s: Option<f64>,
+    /// A crosser steps out only once the ego is within this distance of it, metres (`crossing.scenario`).
+    pub step_out_ego_within_m: Option<f64>,
     /// A hard negative waits at the curb this long before walking on, seconds.
     pub curb_wait_s: Option<f64>,
     /// Two uniform draws in [0, 1) from the pedestrian's gesture stream: whether it gestures when the occasion
@@ -279,6 +281,7 @@ impl Ped {
                 route_s_m: script.ahead_of_ego_m,
                 height_m: script.identity.height_m,
                 in_view_before_crossing_s: script.in_view_before_crossing_s,
+                step_out_ego_within_m: script.step_out_ego_within_m,
                 curb_wait_s: script.curb_wait_s,
                 gesture_draws: (gesture_rng.random::<f64>(), gesture_rng.random::<f64>()),
             },

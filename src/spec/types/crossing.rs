@@ -31,6 +31,10 @@ pub struct Crossing {
     pub timeline: Timeline,
     /// Non-crossers that approach the curb, stop and look, and then do not cross.
     pub hard_negatives: HardNegatives,
+    /// Where each class is relative to the ego around the event, as real driving shows it (off by default:
+    /// the paper's behaviour; `pedsynth calibrate`'s profiles turn it on).
+    #[serde(skip_serializing_if = "Scenario::is_off")]
+    pub scenario: Scenario,
 }
 
 impl Default for Crossing {
@@ -46,7 +50,39 @@ impl Default for Crossing {
             decision_window_m: Range(10.0, 40.0),
             timeline: Timeline::default(),
             hard_negatives: HardNegatives::default(),
+            scenario: Scenario::default(),
         }
+    }
+}
+
+/// Per-class scenario distributions. In real dashcam data (JAAD) crossers are near the car in the 1–2 s before
+/// they cross (the driver approaches and slows for them), while bystanders who do not cross are seen at every
+/// distance; a `[0, 0]` range turns its rule off.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scenario {
+    /// A crosser steps out only once the ego is within this distance of it (or has passed), metres `[min, max]`,
+    /// drawn per crosser; the ego, easing off for a waiting pedestrian, comes close. `[0, 0]` (default): no
+    /// such condition.
+    pub crosser_ego_within_m: Range,
+    /// Where non-crossers walking along the sidewalk start, ahead of the ego along its route, metres
+    /// `[min, max]`. `[0, 0]` (default): from layer 1's `spawn_ahead_m` minimum to the visibility distance.
+    pub walker_ahead_m: Range,
+}
+
+impl Default for Scenario {
+    fn default() -> Self {
+        Scenario {
+            crosser_ego_within_m: Range(0.0, 0.0),
+            walker_ahead_m: Range(0.0, 0.0),
+        }
+    }
+}
+
+impl Scenario {
+    /// Whether every rule is off (the default).
+    pub fn is_off(&self) -> bool {
+        *self == Scenario::default()
     }
 }
 

@@ -26,8 +26,13 @@ pub struct Dataset {
     pub weathers: WeatherSelection,
     /// Clip counts (the paper's `--videos_per_weather` and `--dataset_mode`).
     pub clips: Clips,
-    /// Clip duration range in seconds; each clip draws its duration uniformly from it.
+    /// Clip duration range in seconds; each clip draws its duration uniformly from it. A clip whose crossers'
+    /// timelines need more time is lengthened, up to the range's maximum plus `max_extension_s`.
     pub clip_duration_s: Range,
+    /// How far beyond `clip_duration_s`'s maximum a clip may be lengthened so that its crossers' timelines fit,
+    /// seconds. 0 (the default): every clip's duration lies in `clip_duration_s`.
+    #[serde(skip_serializing_if = "super::is_zero")]
+    pub max_extension_s: f64,
     /// Simulation and sensor frame rate.
     pub fps: u32,
     /// Split of each town (paper: Town01/02 train, Town03 val, Town05 test).
@@ -46,6 +51,7 @@ impl Default for Dataset {
             weathers: WeatherSelection::All(AllKeyword::All),
             clips: Clips::default(),
             clip_duration_s: Range(10.0, 15.0),
+            max_extension_s: 0.0,
             fps: 30,
             splits: BTreeMap::from([
                 (BuiltinTown::Town01Like.name().to_owned(), Split::Train),

@@ -25,6 +25,17 @@ pub use traffic::*;
 /// The spec language version this build understands.
 pub const SPEC_VERSION: u32 = 1;
 
+/// Whether `x` is 0: keys added after a spec's hash was first published are serialised only when they differ
+/// from their default, so that the hash of a spec that does not use them stays what it was.
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// Whether `x` is its type's default (see [`is_zero`]).
+fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
+}
+
 /// A closed interval `[min, max]` of real numbers.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Range(pub f64, pub f64);

@@ -75,12 +75,70 @@ impl Default for Mount {
     }
 }
 
+/// A named camera rig: the resolution, field of view and mount of a real dataset's camera (see
+/// [`CameraProfile::preset`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum CameraProfile {
+    /// CARLA's camera as the paper mounts it: 1280×720, 90°, 1.4 m, pitched 8° down (today's defaults).
+    #[default]
+    Carla,
+    /// JAAD's dashcams: 1920×1080; horizon and mount fitted to JAAD train + val's boxes.
+    Jaad,
+    /// PIE's camera: 1920×1080, the field of view of its calibrated focal length, its mount height.
+    Pie,
+}
+
+impl CameraProfile {
+    /// The keys under `sensors.rgb` a profile sets (as YAML values), where the spec does not set them itself.
+    ///
+    /// Sources:
+    /// - `carla`: the defaults of this spec language (the paper's camera).
+    /// - `jaad`: 1920×1080 from JAAD's annotations (every video, `videos.parquet` in ../shared/real). The mount is
+    ///   fitted with `pedsynth calibrate` to JAAD train + val's unoccluded boxes: their bottoms lie on
+    ///   `bottom = 0.618 + 0.80 × height` (fractions of the image height), a horizon 0.118 of the height below
+    ///   the centre (pitched up 7.6° at 90°) and a camera 0.80 × 1.70 m (an adult's mean height) = 1.36 m above
+    ///   the road. JAAD's authors do not publish the cameras' fields of view; 90° is assumed.
+    /// - `pie`: PIE's `calibration_data.json` (github.com/aras62/PIE): 1920×1080, `fx` 1004.8 px, i.e.
+    ///   2·atan(960 / 1004.8) = 87.4° horizontally, and `cam_height_mm` 1270. Its `cam_pitch_deg` (−10) comes
+    ///   without a convention and is not used: the pitch is 0, level with the road.
+    pub fn preset(self) -> &'static [(&'static str, &'static str)] {
+        match self {
+            CameraProfile::Carla => &[
+                ("width_px", "1280"),
+                ("height_px", "720"),
+                ("fov_deg", "90"),
+                ("mount.up_m", "1.4"),
+                ("mount.pitch_deg", "-8"),
+            ],
+            CameraProfile::Jaad => &[
+                ("width_px", "1920"),
+                ("height_px", "1080"),
+                ("fov_deg", "90"),
+                ("mount.up_m", "1.36"),
+                ("mount.pitch_deg", "7.6"),
+            ],
+            CameraProfile::Pie => &[
+                ("width_px", "1920"),
+                ("height_px", "1080"),
+                ("fov_deg", "87.4"),
+                ("mount.up_m", "1.27"),
+                ("mount.pitch_deg", "0"),
+            ],
+        }
+    }
+}
+
 /// RGB camera (pinhole; horizontal field of view).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Rgb {
     /// Whether RGB images are written.
     pub enabled: bool,
+    /// A real camera rig whose resolution, field of view and mount height and pitch are used where this
+    /// section does not set them: `carla` (the default), `jaad` or `pie`.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub profile: CameraProfile,
     /// Image width, pixels.
     pub width_px: u32,
     /// Image height, pixels.
@@ -95,6 +153,7 @@ impl Default for Rgb {
     fn default() -> Self {
         Rgb {
             enabled: true,
+            profile: CameraProfile::Carla,
             width_px: 1280,
             height_px: 720,
             fov_deg: 90.0,

@@ -219,6 +219,15 @@ impl Validator<'_> {
             60.0,
             "a time in view of the camera in seconds",
         );
+        for (key, range) in [
+            (
+                "crossing.scenario.crosser_ego_within_m",
+                c.scenario.crosser_ego_within_m,
+            ),
+            ("crossing.scenario.walker_ahead_m", c.scenario.walker_ahead_m),
+        ] {
+            self.range(key, range, 0.0, 500.0, "a distance to the ego in metres ([0, 0]: off)");
+        }
         self.range(
             "crossing.timeline.approach_m",
             c.timeline.approach_m,

@@ -122,6 +122,13 @@ impl Validator<'_> {
             600.0,
             "a clip duration in seconds",
         );
+        self.num(
+            "dataset.max_extension_s",
+            d.max_extension_s,
+            0.0,
+            600.0,
+            "a lengthening in seconds",
+        );
         self.num("dataset.fps", f64::from(d.fps), 1.0, 240.0, "the frame rate");
         let known: Vec<&str> = d
             .towns

@@ -248,6 +248,7 @@ pub fn generate(
     let options = pedsynth::spec::LoadOptions {
         overrides: overrides.iter().map(|s| s.to_string()).collect(),
         allow_large: false,
+        profile: None,
     };
     let (mut o, mut e) = (Vec::new(), Vec::new());
     let code = pedsynth::cli::finish(pedsynth::cli::generate(input, &options, &args, &mut o), &mut e);
@@ -338,6 +339,7 @@ pub fn plan_spec(
     let options = pedsynth::spec::LoadOptions {
         overrides: overrides.iter().map(|s| (*s).to_owned()).collect(),
         allow_large: false,
+        profile: None,
     };
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(spec);
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));

@@ -1,0 +1,388 @@
+//! What `pedsynth calibrate` measures in real (or generated) annotations: the camera's horizon and height from
+//! box bottoms against box heights, PedestrianActionBenchmark's observation windows and six quantities of each,
+//! how well each quantity tells crossers from non-crossers (the cue table), the ego's actions and the
+//! pedestrians' standing and looking in those windows, and how long crossers are seen before they cross.
+//!
+//! Window quantities (fractions of the image size, over the window's 16 boxes): `height` (mean box height),
+//! `bottom` (mean box bottom), `aspect` (mean width / height), `growth` (the height's mean relative growth per
+//! frame), `jitter` (the median |second difference| of the box centre's x, a measure of hand-drawn noise) and
+//! `toward_centre` (how much closer to the image's vertical centre line the box ends than it starts). They are
+//! the same as tools/transfer_eval.py's.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::real::{EgoAction, RealBox, RealVideo};
+use crate::dataset::read::protocol::PabOptions;
+
+/// The quantities of a window, in [`QUANTITIES`] order.
+pub type Quantities = [f64; 6];
+
+/// The names of the window quantities.
+pub const QUANTITIES: [&str; 6] = ["height", "bottom", "aspect", "growth", "jitter", "toward_centre"];
+
+/// One observation window.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Window {
+    /// Its track's sequence label.
+    pub crosser: bool,
+    /// Its quantities.
+    pub quantities: Quantities,
+    /// The ego's action in the window's last frame, where annotated.
+    pub ego_action: Option<EgoAction>,
+    /// Standing in the window's last frame, where annotated.
+    pub standing: Option<bool>,
+    /// Looking at the ego in the window's last frame, where annotated.
+    pub looking: Option<bool>,
+}
+
+/// The benchmark's windows of every track of `videos`.
+pub fn windows(videos: &[RealVideo], pab: &PabOptions) -> Vec<Window> {
+    let mut out = Vec::new();
+    for v in videos {
+        for t in &v.tracks {
+            let end = match t.crossing_frame {
+                Some(f) if t.crosser => t.boxes.partition_point(|b| b.frame <= f),
+                _ => t.boxes.len(),
+            };
+            let track = &t.boxes[..end];
+            if track.len() < pab.min_track || track.len() < pab.obs_length + pab.tte_frames.1 {
+                continue;
+            }
+            let first = track.len() - pab.obs_length - pab.tte_frames.1;
+            let last = track.len() - pab.obs_length - pab.tte_frames.0;
+            for start in (first..=last).step_by(pab.stride()) {
+                let w = &track[start..start + pab.obs_length];
+                let tail = w[w.len() - 1];
+                out.push(Window {
+                    crosser: t.crosser,
+                    quantities: quantities(w, v.width_px, v.height_px),
+                    ego_action: v.ego_actions.get(&tail.frame).copied(),
+                    standing: tail.standing,
+                    looking: tail.looking,
+                });
+            }
+        }
+    }
+    out
+}
+
+fn quantities(w: &[RealBox], width: f64, height: f64) -> Quantities {
+    let n = w.len() as f64;
+    let h = |b: &RealBox| (b.y_max_px - b.y_min_px) / height;
+    let cx = |b: &RealBox| 0.5 * (b.x_min_px + b.x_max_px) / width;
+    let mean_h = w.iter().map(h).sum::<f64>() / n;
+    let bottom = w.iter().map(|b| b.y_max_px / height).sum::<f64>() / n;
+    let aspect = w
+        .iter()
+        .map(|b| (b.x_max_px - b.x_min_px) / (b.y_max_px - b.y_min_px).max(1e-6))
+        .sum::<f64>()
+        / n;
+    let (h0, h1) = (h(&w[0]).max(1e-6), h(&w[w.len() - 1]).max(1e-6));
+    let growth = (h1 / h0).powf(1.0 / (n - 1.0).max(1.0)) - 1.0;
+    let mut d2: Vec<f64> = w
+        .windows(3)
+        .map(|t| (cx(&t[2]) - 2.0 * cx(&t[1]) + cx(&t[0])).abs())
+        .collect();
+    let jitter = median(&mut d2);
+    let toward = (cx(&w[0]) - 0.5).abs() - (cx(&w[w.len() - 1]) - 0.5).abs();
+    [mean_h, bottom, aspect, growth, jitter, toward]
+}
+
+/// The median (0 for none).
+pub fn median(xs: &mut [f64]) -> f64 {
+    quantile(xs, 0.5)
+}
+
+/// The `q` quantile, nearest rank (0 for none).
+pub fn quantile(xs: &mut [f64], q: f64) -> f64 {
+    if xs.is_empty() {
+        return 0.0;
+    }
+    xs.sort_by(f64::total_cmp);
+    let i = ((xs.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    xs[i]
+}
+
+/// ROC AUC of `score` for `positive` (Mann–Whitney, ties counted half); `None` without both classes.
+pub fn auc(samples: &[(f64, bool)]) -> Option<f64> {
+    let mut s: Vec<(f64, bool)> = samples.to_vec();
+    s.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let positives = s.iter().filter(|x| x.1).count() as f64;
+    let negatives = s.len() as f64 - positives;
+    if positives == 0.0 || negatives == 0.0 {
+        return None;
+    }
+    let mut rank_sum = 0.0;
+    let mut i = 0;
+    while i < s.len() {
+        let mut j = i;
+        while j < s.len() && s[j].0 == s[i].0 {
+            j += 1;
+        }
+        let rank = 0.5 * ((i + 1) + j) as f64;
+        rank_sum += rank * s[i..j].iter().filter(|x| x.1).count() as f64;
+        i = j;
+    }
+    Some((rank_sum - positives * (positives + 1.0) / 2.0) / (positives * negatives))
+}
+
+/// The camera's horizon and scale: box bottom = `horizon + slope × box height` (fractions of the image height),
+/// fitted by least squares to unoccluded boxes at least 2 % of the image height tall.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct HorizonFit {
+    /// Box bottom of a box of height 0 (the horizon), fraction of the image height from the top.
+    pub horizon: f64,
+    /// Growth of the bottom with the box height: the camera's height over the pedestrians' mean height.
+    pub slope: f64,
+    /// Coefficient of determination.
+    pub r2: f64,
+    /// Boxes fitted.
+    pub boxes: usize,
+}
+
+/// Fits [`HorizonFit`]; `None` with fewer than 10 boxes.
+pub fn horizon_fit(videos: &[RealVideo]) -> Option<HorizonFit> {
+    let (mut n, mut sx, mut sy, mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for v in videos {
+        for b in v.tracks.iter().flat_map(|t| &t.boxes).filter(|b| !b.occluded) {
+            let x = (b.y_max_px - b.y_min_px) / v.height_px;
+            let y = b.y_max_px / v.height_px;
+            if x < 0.02 || !x.is_finite() || !y.is_finite() {
+                continue;
+            }
+            n += 1.0;
+            sx += x;
+            sy += y;
+            sxx += x * x;
+            sxy += x * y;
+            syy += y * y;
+        }
+    }
+    let var_x = sxx - sx * sx / n;
+    if n < 10.0 || var_x <= 0.0 {
+        return None;
+    }
+    let slope = (sxy - sx * sy / n) / var_x;
+    let horizon = (sy - slope * sx) / n;
+    let var_y = syy - sy * sy / n;
+    let explained = slope * (sxy - sx * sy / n);
+    Some(HorizonFit {
+        horizon,
+        slope,
+        r2: if var_y > 0.0 { explained / var_y } else { 0.0 },
+        boxes: n as usize,
+    })
+}
+
+/// How far from the camera a pedestrian of `person_height_m` is whose box is `box_height_px` tall, through a
+/// pinhole of focal length `focal_px`, metres.
+pub fn distance_m(focal_px: f64, person_height_m: f64, box_height_px: f64) -> f64 {
+    focal_px * person_height_m / box_height_px.max(1.0)
+}
+
+/// `p10`, `p50`, `p90` of a sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Spread {
+    /// 10th percentile.
+    pub p10: f64,
+    /// Median.
+    pub p50: f64,
+    /// 90th percentile.
+    pub p90: f64,
+}
+
+impl Spread {
+    /// The spread of `xs`.
+    pub fn of(mut xs: Vec<f64>) -> Spread {
+        Spread {
+            p10: quantile(&mut xs, 0.1),
+            p50: quantile(&mut xs, 0.5),
+            p90: quantile(&mut xs, 0.9),
+        }
+    }
+}
+
+/// What one class's windows look like.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ClassSummary {
+    /// Windows.
+    pub windows: usize,
+    /// Each quantity's spread, by name.
+    pub quantities: BTreeMap<String, Spread>,
+    /// Share of windows ending with each ego action (of those with one annotated).
+    pub ego_actions: BTreeMap<String, f64>,
+    /// Share of windows ending standing (of those annotated).
+    pub standing: Option<f64>,
+    /// Share of windows ending looking at the ego (of those annotated).
+    pub looking: Option<f64>,
+}
+
+/// Everything measured in one set of annotations.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Measurements {
+    /// Videos (or clips).
+    pub videos: usize,
+    /// Pedestrian tracks.
+    pub tracks: usize,
+    /// Tracks of crossers.
+    pub crossers: usize,
+    /// The horizon fit, where there were enough boxes.
+    pub horizon: Option<HorizonFit>,
+    /// Crossing windows.
+    pub crossing: ClassSummary,
+    /// Not-crossing windows.
+    pub not_crossing: ClassSummary,
+    /// How well each quantity tells crossing from not-crossing windows (AUC; 0.5 none, below 0.5 reversed).
+    pub cues: BTreeMap<String, f64>,
+    /// How long crossers are annotated before their crossing point, seconds (those first annotated before it).
+    pub seen_before_crossing_s: Spread,
+}
+
+fn share(xs: impl Iterator<Item = bool>) -> Option<f64> {
+    let (mut yes, mut all) = (0usize, 0usize);
+    for x in xs {
+        all += 1;
+        yes += usize::from(x);
+    }
+    (all > 0).then(|| yes as f64 / all as f64)
+}
+
+fn summary(windows: &[&Window]) -> ClassSummary {
+    let quantities = QUANTITIES
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            (
+                (*name).to_owned(),
+                Spread::of(windows.iter().map(|w| w.quantities[i]).collect()),
+            )
+        })
+        .collect();
+    let with_action: Vec<EgoAction> = windows.iter().filter_map(|w| w.ego_action).collect();
+    let ego_actions = if with_action.is_empty() {
+        BTreeMap::new()
+    } else {
+        EgoAction::ALL
+            .iter()
+            .map(|a| {
+                let n = with_action.iter().filter(|x| *x == a).count();
+                (a.name().to_owned(), n as f64 / with_action.len() as f64)
+            })
+            .collect()
+    };
+    ClassSummary {
+        windows: windows.len(),
+        quantities,
+        ego_actions,
+        standing: share(windows.iter().filter_map(|w| w.standing)),
+        looking: share(windows.iter().filter_map(|w| w.looking)),
+    }
+}
+
+/// Measures `videos` with the benchmark's sampling `pab`.
+pub fn measure(videos: &[RealVideo], pab: &PabOptions) -> Measurements {
+    let all = windows(videos, pab);
+    let crossing: Vec<&Window> = all.iter().filter(|w| w.crosser).collect();
+    let not_crossing: Vec<&Window> = all.iter().filter(|w| !w.crosser).collect();
+    let cues = QUANTITIES
+        .iter()
+        .enumerate()
+        .filter_map(|(i, name)| {
+            let samples: Vec<(f64, bool)> = all.iter().map(|w| (w.quantities[i], w.crosser)).collect();
+            Some(((*name).to_owned(), auc(&samples)?))
+        })
+        .collect();
+    // Crossers already crossing when first annotated (about half of JAAD's) say nothing about the time before.
+    let seen: Vec<f64> = videos
+        .iter()
+        .flat_map(|v| {
+            v.tracks.iter().filter_map(move |t| {
+                let first = t.boxes.first()?.frame;
+                let at = t.crossing_frame.filter(|&f| t.crosser && f > first)?;
+                Some(f64::from(at - first) / v.fps)
+            })
+        })
+        .collect();
+    Measurements {
+        videos: videos.len(),
+        tracks: videos.iter().map(|v| v.tracks.len()).sum(),
+        crossers: videos.iter().flat_map(|v| &v.tracks).filter(|t| t.crosser).count(),
+        horizon: horizon_fit(videos),
+        crossing: summary(&crossing),
+        not_crossing: summary(&not_crossing),
+        cues,
+        seen_before_crossing_s: Spread::of(seen),
+    }
+}
+
+/// For each quantity, how well it alone tells windows of `a` from windows of `b` (AUC folded to ≥ 0.5:
+/// 0.5 = the same distribution).
+pub fn separation(a: &[Window], b: &[Window]) -> BTreeMap<String, f64> {
+    QUANTITIES
+        .iter()
+        .enumerate()
+        .filter_map(|(i, name)| {
+            let samples: Vec<(f64, bool)> = a
+                .iter()
+                .map(|w| (w.quantities[i], false))
+                .chain(b.iter().map(|w| (w.quantities[i], true)))
+                .collect();
+            let x = auc(&samples)?;
+            Some(((*name).to_owned(), x.max(1.0 - x)))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auc_counts_ties_half_and_orders() {
+        assert_eq!(auc(&[(1.0, false), (2.0, true)]), Some(1.0));
+        assert_eq!(auc(&[(2.0, false), (1.0, true)]), Some(0.0));
+        assert_eq!(auc(&[(1.0, false), (1.0, true)]), Some(0.5));
+        assert_eq!(auc(&[(1.0, true)]), None);
+        // Positives 1, 3, 4 against negatives 0, 2: 5 of the 6 pairs ordered.
+        let s = [(0.0, false), (2.0, false), (1.0, true), (3.0, true), (4.0, true)];
+        assert!((auc(&s).unwrap() - 5.0 / 6.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn horizon_fit_recovers_a_line() {
+        let boxes: Vec<RealBox> = (1..50)
+            .map(|i| {
+                let h = 10.0 + 4.0 * f64::from(i);
+                let bottom = 600.0 + 0.8 * h;
+                RealBox {
+                    frame: i as u32,
+                    x_min_px: 0.0,
+                    y_min_px: bottom - h,
+                    x_max_px: h / 3.0,
+                    y_max_px: bottom,
+                    occluded: false,
+                    standing: None,
+                    looking: None,
+                }
+            })
+            .collect();
+        let video = RealVideo {
+            name: "v".into(),
+            split: "train".into(),
+            width_px: 1920.0,
+            height_px: 1000.0,
+            fps: 30.0,
+            tracks: vec![super::super::real::RealTrack {
+                id: "p".into(),
+                crosser: false,
+                crossing_frame: None,
+                boxes,
+            }],
+            ego_actions: BTreeMap::new(),
+        };
+        let fit = horizon_fit(&[video]).unwrap();
+        assert!((fit.horizon - 0.6).abs() < 1e-9 && (fit.slope - 0.8).abs() < 1e-9 && fit.r2 > 0.999);
+    }
+}

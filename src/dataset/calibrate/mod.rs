@@ -1,0 +1,441 @@
+//! `pedsynth calibrate`: real annotations (JAAD's or PIE's XML layout, or a documented table) → what they show
+//! (the camera's horizon and height, PedestrianActionBenchmark windows per class, the cue table, the ego's
+//! actions, how long crossers are seen) → a profile, a partial spec that `plan` and `generate` lay over a spec
+//! with `--profile`; and, given a generated dataset, a side-by-side report of the two.
+//!
+//! - [`real`] — the one model every source is read into, and the table layout's reader.
+//! - [`xml`] — JAAD's and PIE's XML layouts.
+//! - [`measure`] — windows, quantities, fits and AUCs.
+
+pub mod measure;
+pub mod real;
+pub mod xml;
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use serde::Serialize;
+
+use self::measure::{Measurements, QUANTITIES};
+use self::real::{EgoAction, RealBox, RealTrack, RealVideo, invalid};
+use crate::dataset::read::protocol::PabOptions;
+use crate::error::Error;
+
+/// The layout real annotations come in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// JAAD's XML (github.com/ykotseruba/JAAD).
+    Jaad,
+    /// PIE's XML (github.com/aras62/PIE).
+    Pie,
+    /// The documented table layout, Parquet or CSV ([`real`]).
+    Table,
+}
+
+/// How to calibrate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CalibrateOptions {
+    /// The layout of the real annotations.
+    pub format: Format,
+    /// The splits to fit to (empty: every video).
+    pub splits: Vec<String>,
+    /// The field of view assumed for the real camera, degrees (boxes alone fix the horizon and the camera's
+    /// height, not the focal length).
+    pub fov_deg: f64,
+    /// The pedestrians' mean height assumed for the camera's height, metres.
+    pub person_height_m: f64,
+    /// The benchmark's sampling.
+    pub pab: PabOptions,
+}
+
+impl Default for CalibrateOptions {
+    fn default() -> Self {
+        CalibrateOptions {
+            format: Format::Table,
+            splits: vec!["train".to_owned()],
+            fov_deg: 90.0,
+            person_height_m: 1.70,
+            pab: PabOptions {
+                overlap: 0.8,
+                ..PabOptions::default()
+            },
+        }
+    }
+}
+
+/// The spec values a calibration fits.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Fit {
+    /// `sensors.rgb.width_px` / `height_px`: the most common image size.
+    pub width_px: u32,
+    /// Image height.
+    pub height_px: u32,
+    /// `sensors.rgb.fov_deg` (assumed, [`CalibrateOptions::fov_deg`]).
+    pub fov_deg: f64,
+    /// `sensors.rgb.mount.up_m`: the horizon fit's slope × the pedestrians' mean height.
+    pub up_m: f64,
+    /// `sensors.rgb.mount.pitch_deg`: the pitch that puts the horizon where the fit has it (positive looks up).
+    pub pitch_deg: f64,
+    /// `dataset.fps`: the most common frame rate.
+    pub fps: u32,
+    /// `crossing.timeline.in_view_before_crossing_s`: the 10th and 90th percentiles of how long crossers are
+    /// annotated before they cross (within the spec's limits, 0.5–30 s).
+    pub in_view_before_crossing_s: (f64, f64),
+    /// `crossing.scenario.crosser_ego_within_m`: the 10th and 90th percentiles of crossers' distance from the
+    /// camera at their crossing point (from the box height, the fitted camera and the mean height).
+    pub crosser_ego_within_m: (f64, f64),
+    /// `crossing.scenario.walker_ahead_m`: the 10th and 90th percentiles of non-crossers' distance when first
+    /// annotated, tracks of the benchmark's minimum length only.
+    pub walker_ahead_m: (f64, f64),
+}
+
+/// A calibration: what was read, measured and fitted.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Calibration {
+    /// The splits fitted to (empty: all).
+    pub splits: Vec<String>,
+    /// The measurements of the real annotations.
+    pub real: Measurements,
+    /// The fitted values.
+    pub fit: Fit,
+}
+
+/// Reads real annotations in `format` from `dir`, keeping the videos of `splits` (all if empty).
+pub fn read_real(dir: &Path, format: Format, splits: &[String]) -> Result<Vec<RealVideo>, Error> {
+    if !dir.is_dir() {
+        return Err(invalid(format!("{}: not a directory", dir.display())));
+    }
+    let videos = match format {
+        Format::Jaad => xml::read_jaad(dir)?,
+        Format::Pie => xml::read_pie(dir)?,
+        Format::Table => real::read_tables(dir)?,
+    };
+    let kept: Vec<RealVideo> = videos
+        .into_iter()
+        .filter(|v| splits.is_empty() || splits.contains(&v.split))
+        .collect();
+    if kept.is_empty() {
+        return Err(invalid(format!(
+            "{}: no videos in split{} {}",
+            dir.display(),
+            if splits.len() == 1 { "" } else { "s" },
+            splits.join(", ")
+        ))
+        .help("choose splits the annotations have with --splits (e.g. --splits train,val)"));
+    }
+    Ok(kept)
+}
+
+fn most_common<T: Ord + Copy>(xs: impl Iterator<Item = T>) -> Option<T> {
+    let mut counts: BTreeMap<T, usize> = BTreeMap::new();
+    for x in xs {
+        *counts.entry(x).or_default() += 1;
+    }
+    counts.into_iter().max_by_key(|&(_, n)| n).map(|(x, _)| x)
+}
+
+/// Measures `videos` and fits the spec values.
+pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Calibration, Error> {
+    let real = measure::measure(videos, &options.pab);
+    let horizon = real.horizon.ok_or_else(|| {
+        invalid("too few unoccluded boxes (10 at least, 2 % of the image height or taller) to fit the camera")
+    })?;
+    if real.crossing.windows == 0 || real.not_crossing.windows == 0 {
+        return Err(invalid(format!(
+            "the benchmark's sampling finds {} crossing and {} not-crossing windows: both classes are needed",
+            real.crossing.windows, real.not_crossing.windows
+        ))
+        .help("use more videos (--splits), or annotations with crossing labels and tracks of 76+ frames"));
+    }
+    let (width_px, height_px) =
+        most_common(videos.iter().map(|v| (v.width_px as u32, v.height_px as u32))).unwrap_or((1920, 1080));
+    let focal_px = f64::from(width_px) / 2.0 / (options.fov_deg.to_radians() / 2.0).tan();
+    let pitch_deg = ((horizon.horizon - 0.5) * f64::from(height_px) / focal_px)
+        .atan()
+        .to_degrees();
+    let seen = real.seen_before_crossing_s;
+    let distance = |b: &RealBox| measure::distance_m(focal_px, options.person_height_m, b.y_max_px - b.y_min_px);
+    let mut at_crossing = Vec::new();
+    let mut walkers_first = Vec::new();
+    for t in videos.iter().flat_map(|v| &v.tracks) {
+        match t.crossing_frame {
+            Some(f) if t.crosser => {
+                if let Some(b) = t.boxes.iter().rev().find(|b| b.frame <= f && !b.occluded) {
+                    at_crossing.push(distance(b));
+                }
+            }
+            _ if t.boxes.len() >= options.pab.min_track => {
+                if let Some(b) = t.boxes.iter().find(|b| !b.occluded) {
+                    walkers_first.push(distance(b));
+                }
+            }
+            _ => {}
+        }
+    }
+    let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
+    let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
+    let lo = round(seen.p10.clamp(0.5, 30.0), 1);
+    let fit = Fit {
+        width_px,
+        height_px,
+        fov_deg: options.fov_deg,
+        up_m: round((horizon.slope * options.person_height_m).clamp(0.5, 3.0), 2),
+        pitch_deg: round(pitch_deg.clamp(-30.0, 30.0), 1),
+        fps: most_common(videos.iter().map(|v| v.fps.round() as u32))
+            .unwrap_or(30)
+            .max(1),
+        in_view_before_crossing_s: (lo, round(seen.p90.clamp(lo, 30.0), 1)),
+        crosser_ego_within_m: (
+            round(crossers_at.p10.clamp(1.0, 100.0), 1),
+            round(crossers_at.p90.clamp(1.0, 100.0), 1),
+        ),
+        walker_ahead_m: (
+            round(walkers_at.p10.clamp(1.0, 200.0), 1),
+            round(walkers_at.p90.clamp(1.0, 200.0), 1),
+        ),
+    };
+    Ok(Calibration {
+        splits: options.splits.clone(),
+        real,
+        fit,
+    })
+}
+
+/// The profile a calibration writes: a partial spec, with what it was fitted to in comments.
+pub fn profile_yaml(c: &Calibration, source: &str) -> String {
+    let f = &c.fit;
+    let m = &c.real;
+    let h = m.horizon.unwrap_or(measure::HorizonFit {
+        horizon: 0.5,
+        slope: 0.0,
+        r2: 0.0,
+        boxes: 0,
+    });
+    let splits = if c.splits.is_empty() {
+        "all".to_owned()
+    } else {
+        c.splits.join(", ")
+    };
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# pedsynth profile fitted by `pedsynth calibrate` to {source} (splits: {splits}):"
+    );
+    let _ = writeln!(
+        out,
+        "# {} videos, {} pedestrian tracks ({} crossers), {} crossing and {} not-crossing benchmark windows.",
+        m.videos, m.tracks, m.crossers, m.crossing.windows, m.not_crossing.windows
+    );
+    let _ = writeln!(
+        out,
+        "# Camera: box bottom = {:.3} + {:.3} x box height (fractions of the image height; {} unoccluded boxes, R^2 {:.2}).",
+        h.horizon, h.slope, h.boxes, h.r2
+    );
+    let _ = writeln!(out, "# Use it with `pedsynth plan|generate SPEC --profile THIS_FILE`.");
+    let _ = writeln!(out, "dataset:\n  fps: {}", f.fps);
+    let _ = writeln!(
+        out,
+        "sensors:\n  rgb:\n    width_px: {}\n    height_px: {}\n    fov_deg: {}  # assumed: boxes do not fix the focal length",
+        f.width_px, f.height_px, f.fov_deg
+    );
+    let _ = writeln!(
+        out,
+        "    mount:\n      up_m: {}  # the fit's slope x a {:.2} m mean pedestrian\n      pitch_deg: {}  # puts the horizon {:.3} of the height from the top",
+        f.up_m,
+        f.up_m / h.slope.max(1e-6),
+        f.pitch_deg,
+        h.horizon
+    );
+    let _ = writeln!(
+        out,
+        "crossing:\n  timeline:\n    in_view_before_crossing_s: [{}, {}]  # crossers annotated before crossing: p10 {:.1} s, median {:.1} s, p90 {:.1} s",
+        f.in_view_before_crossing_s.0,
+        f.in_view_before_crossing_s.1,
+        m.seen_before_crossing_s.p10,
+        m.seen_before_crossing_s.p50,
+        m.seen_before_crossing_s.p90
+    );
+    let _ = writeln!(
+        out,
+        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p90)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p10, p90)",
+        f.crosser_ego_within_m.0, f.crosser_ego_within_m.1, f.walker_ahead_m.0, f.walker_ahead_m.1
+    );
+    out
+}
+
+/// A dataset written by pedsynth, read into the same model as real annotations: tight boxes, the crossing
+/// label and first crossing frame, standing and looking, the ego's action from its speed and acceleration
+/// ([`EgoAction::from_motion`]).
+pub fn synthetic_videos(dir: &Path) -> Result<Vec<RealVideo>, Error> {
+    let ds = crate::dataset::export::dataset::Dataset::open(dir)?;
+    let rgb = &ds.spec.sensors.rgb;
+    let mut videos = Vec::with_capacity(ds.clips.len());
+    for info in &ds.clips {
+        let clip = ds.load(info)?;
+        let tracks = clip
+            .pedestrians
+            .values()
+            .map(|p| RealTrack {
+                id: p.id.to_string(),
+                crosser: p.crosser,
+                crossing_frame: p.frames.iter().find(|f| f.crossing).map(|f| f.frame),
+                boxes: p
+                    .frames
+                    .iter()
+                    .map(|f| RealBox {
+                        frame: f.frame,
+                        x_min_px: f64::from(f.bbox_px[0]),
+                        y_min_px: f64::from(f.bbox_px[1]),
+                        x_max_px: f64::from(f.bbox_px[2]),
+                        y_max_px: f64::from(f.bbox_px[3]),
+                        occluded: f.occlusion > 0.0,
+                        standing: Some(f.action == "standing"),
+                        looking: Some(f.look),
+                    })
+                    .collect(),
+            })
+            .collect();
+        let ego_actions = clip
+            .ego
+            .iter()
+            .enumerate()
+            .map(|(i, e)| (i as u32, EgoAction::from_motion(e.speed_mps, e.accel_mps2)))
+            .collect();
+        videos.push(RealVideo {
+            name: info.clip_id.clone(),
+            split: info.split.clone(),
+            width_px: f64::from(rgb.width_px),
+            height_px: f64::from(rgb.height_px),
+            fps: f64::from(info.fps),
+            tracks,
+            ego_actions,
+        });
+    }
+    Ok(videos)
+}
+
+/// Real against generated, side by side.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Comparison {
+    /// The real annotations' measurements.
+    pub real: Measurements,
+    /// The generated dataset's.
+    pub synthetic: Measurements,
+    /// How well each quantity alone tells a synthetic window from a real one (AUC ≥ 0.5; 0.5 = the same).
+    pub separation: BTreeMap<String, f64>,
+}
+
+/// Compares real annotations with a generated dataset's.
+pub fn compare(real: &[RealVideo], synthetic: &[RealVideo], pab: &PabOptions) -> Comparison {
+    Comparison {
+        real: measure::measure(real, pab),
+        synthetic: measure::measure(synthetic, pab),
+        separation: measure::separation(&measure::windows(real, pab), &measure::windows(synthetic, pab)),
+    }
+}
+
+/// The comparison as Markdown: counts, the camera fit, each quantity's spread per class and its separation,
+/// the cue table, the ego's actions and the pedestrians' standing and looking.
+pub fn report_markdown(c: &Comparison, real_name: &str, synthetic_name: &str) -> String {
+    let (r, s) = (&c.real, &c.synthetic);
+    let mut out = String::new();
+    let _ = writeln!(out, "# Real ({real_name}) against generated ({synthetic_name})\n");
+    let _ = writeln!(out, "| | real | generated |\n|---|---|---|");
+    let _ = writeln!(out, "| videos / clips | {} | {} |", r.videos, s.videos);
+    let _ = writeln!(
+        out,
+        "| tracks (crossers) | {} ({}) | {} ({}) |",
+        r.tracks, r.crossers, s.tracks, s.crossers
+    );
+    let _ = writeln!(
+        out,
+        "| windows crossing / not | {} / {} | {} / {} |",
+        r.crossing.windows, r.not_crossing.windows, s.crossing.windows, s.not_crossing.windows
+    );
+    let fit = |m: &Measurements| {
+        m.horizon.map_or("–".to_owned(), |h| {
+            format!("{:.3} + {:.3} × height", h.horizon, h.slope)
+        })
+    };
+    let _ = writeln!(out, "| box bottom (fraction of the height) | {} | {} |", fit(r), fit(s));
+    let _ = writeln!(
+        out,
+        "| crossers seen before crossing, median s | {:.1} | {:.1} |\n",
+        r.seen_before_crossing_s.p50, s.seen_before_crossing_s.p50
+    );
+    let _ = writeln!(
+        out,
+        "## Window quantities (median, p10–p90), and how well each alone tells generated from real (AUC; 0.5 = same)\n"
+    );
+    let _ = writeln!(
+        out,
+        "| quantity | real C | generated C | real NC | generated NC | separation AUC |\n|---|---|---|---|---|---|"
+    );
+    let spread = |m: &measure::ClassSummary, q: &str| {
+        m.quantities.get(q).map_or("–".to_owned(), |x| {
+            format!("{:.4} ({:.4}–{:.4})", x.p50, x.p10, x.p90)
+        })
+    };
+    for q in QUANTITIES {
+        let _ = writeln!(
+            out,
+            "| {q} | {} | {} | {} | {} | {:.2} |",
+            spread(&r.crossing, q),
+            spread(&s.crossing, q),
+            spread(&r.not_crossing, q),
+            spread(&s.not_crossing, q),
+            c.separation.get(q).copied().unwrap_or(f64::NAN)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\n## Cues: how well each quantity tells crossing from not-crossing windows (AUC; 0.5 none, < 0.5 reversed)\n"
+    );
+    let _ = writeln!(out, "| quantity | real | generated | difference |\n|---|---|---|---|");
+    for q in QUANTITIES {
+        let (a, b) = (
+            r.cues.get(q).copied().unwrap_or(f64::NAN),
+            s.cues.get(q).copied().unwrap_or(f64::NAN),
+        );
+        let _ = writeln!(out, "| {q} | {a:.2} | {b:.2} | {:+.2} |", b - a);
+    }
+    let _ = writeln!(
+        out,
+        "\n## The ego's action and the pedestrian's in each window's last frame (shares)\n"
+    );
+    let _ = writeln!(
+        out,
+        "| | real C | generated C | real NC | generated NC |\n|---|---|---|---|---|"
+    );
+    let pct = |x: Option<f64>| x.map_or("–".to_owned(), |x| format!("{:.0} %", 100.0 * x));
+    for a in EgoAction::ALL {
+        let get = |m: &measure::ClassSummary| pct(m.ego_actions.get(a.name()).copied());
+        let _ = writeln!(
+            out,
+            "| ego {} | {} | {} | {} | {} |",
+            a.name(),
+            get(&r.crossing),
+            get(&s.crossing),
+            get(&r.not_crossing),
+            get(&s.not_crossing)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "| standing | {} | {} | {} | {} |",
+        pct(r.crossing.standing),
+        pct(s.crossing.standing),
+        pct(r.not_crossing.standing),
+        pct(s.not_crossing.standing)
+    );
+    let _ = writeln!(
+        out,
+        "| looking | {} | {} | {} | {} |",
+        pct(r.crossing.looking),
+        pct(s.crossing.looking),
+        pct(r.not_crossing.looking),
+        pct(s.not_crossing.looking)
+    );
+    out
+}

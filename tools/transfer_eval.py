@@ -1,0 +1,235 @@
+#!/usr/bin/env python3
+"""How well pedsynth data transfers to real data, box-only, with PedestrianActionBenchmark's crossing protocol.
+
+Real data: JAAD's train + val annotations as the Parquet tables in ../shared/real/jaad_trainval (or any table in
+that layout). Train is used to fit, val to evaluate; JAAD's test split is never read.
+
+Protocol (PedestrianActionBenchmark, `get_data_sequence` with JAAD's `_get_crossing`, sample type `all`):
+observation 16 frames, time to event 30-60 frames, overlap 0.8, tracks of at least 76 frames. A JAAD track ends
+at its `crossing_point` (behaviour tracks of crossers) or two frames before its last frame (everyone else), as
+`_get_crossing` cuts it; a pedsynth track ends at its first crossing frame (crossers) or its last frame. A window's
+label is its track's: 1 for a crosser. Features are the 16 boxes normalised by the image size (64 numbers); the
+classifier is scikit-learn's HistGradientBoostingClassifier with fixed settings and seed.
+
+It prints (and with --json writes) four things:
+  * transfer: ROC AUC on JAAD val of the classifier trained on JAAD train and of one trained on the synthetic
+    set alone;
+  * domain: 5-fold ROC AUC of a classifier telling synthetic windows from JAAD train windows (balanced by
+    subsampling the larger side; 0.5 = indistinguishable);
+  * single quantities: for each window quantity, the AUC with which it alone separates the two (folded to
+    >= 0.5);
+  * cues: within each dataset, the AUC with which each quantity predicts crossing (0.5 = no cue, below 0.5 =
+    the opposite direction).
+
+Usage:
+    python3 tools/transfer_eval.py SYNTH_DATASET [--real ../shared/real/jaad_trainval] [--json OUT.json]
+        [--check]   # exit 1 unless issue 42's acceptance figures hold
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+import pyarrow.dataset as ds
+import pyarrow.parquet as pq
+import yaml
+from sklearn.ensemble import HistGradientBoostingClassifier
+from sklearn.metrics import roc_auc_score
+from sklearn.model_selection import StratifiedKFold
+
+OBS = 16
+TTE = (30, 60)
+OVERLAP = 0.8
+MIN_TRACK = OBS + TTE[1]
+SEED = 42
+
+QUANTITIES = ["height", "bottom", "aspect", "growth", "jitter", "toward_centre"]
+CUES = ["height", "bottom", "growth", "toward_centre"]
+
+
+def windows(track: np.ndarray) -> list[np.ndarray]:
+    """`get_data_sequence`'s slicing of one track (rows of boxes ending at the event)."""
+    olap_res = max(1, int((1 - OVERLAP) * OBS))
+    start = len(track) - OBS - TTE[1]
+    end = len(track) - OBS - TTE[0]
+    return [track[i : i + OBS] for i in range(start, end + 1, olap_res)]
+
+
+def real_windows(real: Path, split: str) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    videos = pq.read_table(real / "videos.parquet").to_pylist()
+    keep = {v["video"] for v in videos if v["split"] == split}
+    if not keep:
+        raise SystemExit(f"{real}: no videos in split `{split}`")
+    size = (videos[0]["width"], videos[0]["height"])
+    peds = {(p["video"], p["pedestrian"]): p for p in pq.read_table(real / "pedestrians.parquet").to_pylist()}
+    boxes = pq.read_table(real / "boxes.parquet", columns=["video", "pedestrian", "frame", "x_min", "y_min", "x_max", "y_max"])
+    tracks = defaultdict(list)
+    for r in boxes.to_pylist():
+        if r["video"] in keep and "p" not in r["pedestrian"]:
+            tracks[(r["video"], r["pedestrian"])].append((r["frame"], r["x_min"], r["y_min"], r["x_max"], r["y_max"]))
+    xs, ys = [], []
+    for key in sorted(tracks):
+        rows = sorted(tracks[key])
+        frames = [r[0] for r in rows]
+        p = peds.get(key, {})
+        event = p.get("crossing_point") if "b" in key[1] else -1
+        event = -1 if event is None else int(event)
+        end = -3 if event == -1 else frames.index(event)
+        rows = rows[: end + 1] if end != -3 else rows[:-2]
+        label = 1 if ("b" in key[1] and (p.get("crossing") or 0) > 0) else 0
+        if len(rows) < MIN_TRACK:
+            continue
+        arr = np.array([r[1:] for r in rows], dtype=np.float64)
+        for w in windows(arr):
+            xs.append(w)
+            ys.append(label)
+    return np.array(xs), np.array(ys), size
+
+
+def synth_windows(root: Path) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
+    rgb = yaml.safe_load((root / "spec.resolved.yaml").read_text())["sensors"]["rgb"]
+    size = (rgb["width_px"], rgb["height_px"])
+    crosser = {
+        (r["clip_id"], r["pedestrian"]): r["crosser"]
+        for r in ds.dataset(str(root / "tables" / "pedestrians"), format="parquet")
+        .to_table(columns=["clip_id", "pedestrian", "crosser"])
+        .to_pylist()
+    }
+    table = ds.dataset(str(root / "tables" / "annotations"), format="parquet").to_table(
+        columns=["clip_id", "pedestrian", "frame", "crossing", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max"]
+    )
+    cols = {n: table.column(n).to_numpy(zero_copy_only=False) for n in table.column_names}
+    tracks = defaultdict(list)
+    for i in range(table.num_rows):
+        tracks[(cols["clip_id"][i], int(cols["pedestrian"][i]))].append(i)
+    xs, ys = [], []
+    for key in sorted(tracks):
+        idx = sorted(tracks[key], key=lambda i: cols["frame"][i])
+        if crosser[key]:
+            first = next((k for k, i in enumerate(idx) if cols["crossing"][i]), None)
+            idx = idx[: first + 1] if first is not None else []
+        if len(idx) < MIN_TRACK:
+            continue
+        arr = np.stack([cols[c][idx] for c in ("bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max")], axis=1)
+        for w in windows(arr.astype(np.float64)):
+            xs.append(w)
+            ys.append(1 if crosser[key] else 0)
+    return np.array(xs), np.array(ys), size
+
+
+def features(w: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    scale = np.array([size[0], size[1], size[0], size[1]], dtype=np.float64)
+    return (w / scale).reshape(len(w), -1)
+
+
+def quantities(w: np.ndarray, size: tuple[int, int]) -> dict[str, np.ndarray]:
+    width, height = size
+    h = (w[:, :, 3] - w[:, :, 1]) / height
+    bw = (w[:, :, 2] - w[:, :, 0]) / width
+    cx = (w[:, :, 0] + w[:, :, 2]) / 2 / width
+    d2 = np.abs(np.diff(cx, n=2, axis=1))
+    return {
+        "height": h.mean(axis=1),
+        "bottom": (w[:, :, 3] / height).mean(axis=1),
+        "aspect": (bw * width / np.maximum(h * height, 1e-6)).mean(axis=1),
+        "growth": (h[:, -1] / np.maximum(h[:, 0], 1e-6)) ** (1 / (OBS - 1)) - 1,
+        "jitter": np.median(d2, axis=1),
+        "toward_centre": np.abs(cx[:, 0] - 0.5) - np.abs(cx[:, -1] - 0.5),
+    }
+
+
+def classifier() -> HistGradientBoostingClassifier:
+    return HistGradientBoostingClassifier(max_iter=200, learning_rate=0.1, random_state=SEED)
+
+
+def auc(y: np.ndarray, score: np.ndarray) -> float:
+    return float(roc_auc_score(y, score)) if len(set(y.tolist())) == 2 else float("nan")
+
+
+def domain_auc(a: np.ndarray, b: np.ndarray) -> float:
+    rng = np.random.default_rng(SEED)
+    n = min(len(a), len(b))
+    a = a[rng.choice(len(a), n, replace=False)]
+    b = b[rng.choice(len(b), n, replace=False)]
+    x = np.concatenate([a, b])
+    y = np.concatenate([np.zeros(n), np.ones(n)])
+    scores = np.zeros(len(y))
+    for train, test in StratifiedKFold(5, shuffle=True, random_state=SEED).split(x, y):
+        scores[test] = classifier().fit(x[train], y[train]).predict_proba(x[test])[:, 1]
+    return auc(y, scores)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("synth", type=Path)
+    parser.add_argument("--real", type=Path, default=Path(__file__).resolve().parents[2] / "shared/real/jaad_trainval")
+    parser.add_argument("--json", type=Path)
+    parser.add_argument("--check", action="store_true")
+    args = parser.parse_args()
+
+    xr, yr, size_r = real_windows(args.real, "train")
+    xv, yv, size_v = real_windows(args.real, "val")
+    xs, ys, size_s = synth_windows(args.synth)
+    if len(xs) == 0 or len(set(ys.tolist())) < 2:
+        raise SystemExit(f"{args.synth}: the synthetic set needs windows of both classes ({len(xs)} windows)")
+    fr, fv, fs = features(xr, size_r), features(xv, size_v), features(xs, size_s)
+    result = {
+        "windows": {
+            "real_train": [int((yr == 1).sum()), int((yr == 0).sum())],
+            "real_val": [int((yv == 1).sum()), int((yv == 0).sum())],
+            "synthetic": [int((ys == 1).sum()), int((ys == 0).sum())],
+        },
+        "transfer_auc": {
+            "real_train": auc(yv, classifier().fit(fr, yr).predict_proba(fv)[:, 1]),
+            "synthetic": auc(yv, classifier().fit(fs, ys).predict_proba(fv)[:, 1]),
+        },
+        "domain_auc": domain_auc(fr, fs),
+    }
+    qr, qs = quantities(xr, size_r), quantities(xs, size_s)
+    single = {}
+    for q in QUANTITIES:
+        y = np.concatenate([np.zeros(len(qr[q])), np.ones(len(qs[q]))])
+        a = auc(y, np.concatenate([qr[q], qs[q]]))
+        single[q] = {"auc": max(a, 1 - a), "real_median": float(np.median(qr[q])), "synthetic_median": float(np.median(qs[q]))}
+    result["single_quantity_auc"] = single
+    result["cues"] = {q: {"real": auc(yr, qr[q]), "synthetic": auc(ys, qs[q])} for q in CUES}
+
+    w = result["windows"]
+    print(f"windows (crossing/not): JAAD train {w['real_train']}, JAAD val {w['real_val']}, synthetic {w['synthetic']}")
+    t = result["transfer_auc"]
+    print(f"JAAD val AUC: trained on JAAD train {t['real_train']:.3f}, on synthetic alone {t['synthetic']:.3f}")
+    print(f"domain classifier AUC (synthetic vs JAAD train, 5-fold): {result['domain_auc']:.3f}")
+    print("single quantity          AUC   JAAD median  synthetic median")
+    for q, s in single.items():
+        print(f"  {q:<20} {s['auc']:6.3f}  {s['real_median']:11.4f}  {s['synthetic_median']:11.4f}")
+    print("cue (C vs NC AUC)        JAAD  synthetic")
+    for q, c in result["cues"].items():
+        print(f"  {q:<20} {c['real']:6.3f}  {c['synthetic']:6.3f}")
+    if args.json:
+        args.json.write_text(json.dumps(result, indent=2, sort_keys=True) + "\n")
+    if args.check:
+        problems = []
+        if not t["synthetic"] >= t["real_train"]:
+            problems.append(f"transfer AUC {t['synthetic']:.3f} < JAAD train's {t['real_train']:.3f}")
+        if not result["domain_auc"] <= 0.75:
+            problems.append(f"domain AUC {result['domain_auc']:.3f} > 0.75")
+        for q, s in single.items():
+            if not s["auc"] <= 0.65:
+                problems.append(f"single quantity {q}: AUC {s['auc']:.3f} > 0.65")
+        for q, c in result["cues"].items():
+            if not abs(c["real"] - c["synthetic"]) <= 0.1:
+                problems.append(f"cue {q}: {c['synthetic']:.3f} against JAAD's {c['real']:.3f} (more than 0.1 apart)")
+        if problems:
+            print("transfer: FAILS\n  " + "\n  ".join(problems))
+            return 1
+        print("transfer: holds")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
