@@ -267,6 +267,10 @@ enum Command {
         /// Copy images (same as `--link copy`).
         #[arg(long, conflicts_with = "link")]
         copy: bool,
+        /// The 2D box to export: `tight` (the silhouette's) or `annotator` (as a person draws it); default: the
+        /// dataset spec's `annotations.export_box`.
+        #[arg(long = "box", value_enum)]
+        export_box: Option<BoxArg>,
     },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
@@ -290,6 +294,14 @@ enum PreviewStream {
 }
 
 /// Benchmark protocols of `stats --protocol`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum BoxArg {
+    /// The tight box of the projected body.
+    Tight,
+    /// The annotator box, as a person draws it.
+    Annotator,
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum RealFormat {
     /// JAAD's XML (annotations/, annotations_attributes/, annotations_vehicle/, split_ids/).
@@ -498,13 +510,18 @@ fn main() -> ExitCode {
             out: to,
             link,
             copy,
+            export_box,
         } => {
             let link = if copy {
                 pedsynth::dataset::export::LinkMode::Copy
             } else {
                 link
             };
-            cli::export(&dir, format, &to, link, &mut out, &mut err)
+            let export_box = export_box.map(|b| match b {
+                BoxArg::Tight => pedsynth::spec::types::ExportBox::Tight,
+                BoxArg::Annotator => pedsynth::spec::types::ExportBox::Annotator,
+            });
+            cli::export(&dir, format, &to, (link, export_box), &mut out, &mut err)
         }
         Command::Merge {
             input,

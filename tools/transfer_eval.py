@@ -92,16 +92,20 @@ def real_windows(real: Path, split: str) -> tuple[np.ndarray, np.ndarray, tuple[
 
 
 def synth_windows(root: Path) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
-    rgb = yaml.safe_load((root / "spec.resolved.yaml").read_text())["sensors"]["rgb"]
+    spec = yaml.safe_load((root / "spec.resolved.yaml").read_text())
+    rgb = spec["sensors"]["rgb"]
     size = (rgb["width_px"], rgb["height_px"])
+    # The box the spec's `annotations.export_box` chooses (the tight box by default).
+    box = "annotator" if spec.get("annotations", {}).get("export_box") == "annotator" else "bbox"
     crosser = {
         (r["clip_id"], r["pedestrian"]): r["crosser"]
         for r in ds.dataset(str(root / "tables" / "pedestrians"), format="parquet")
         .to_table(columns=["clip_id", "pedestrian", "crosser"])
         .to_pylist()
     }
+    edges = [f"{box}_x_min", f"{box}_y_min", f"{box}_x_max", f"{box}_y_max"]
     table = ds.dataset(str(root / "tables" / "annotations"), format="parquet").to_table(
-        columns=["clip_id", "pedestrian", "frame", "crossing", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max"]
+        columns=["clip_id", "pedestrian", "frame", "crossing", *edges]
     )
     cols = {n: table.column(n).to_numpy(zero_copy_only=False) for n in table.column_names}
     tracks = defaultdict(list)
@@ -115,7 +119,7 @@ def synth_windows(root: Path) -> tuple[np.ndarray, np.ndarray, tuple[int, int]]:
             idx = idx[: first + 1] if first is not None else []
         if len(idx) < MIN_TRACK:
             continue
-        arr = np.stack([cols[c][idx] for c in ("bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max")], axis=1)
+        arr = np.stack([cols[c][idx] for c in edges], axis=1)
         for w in windows(arr.astype(np.float64)):
             xs.append(w)
             ys.append(1 if crosser[key] else 0)

@@ -441,17 +441,18 @@ pub fn preview(
     emit(out, &text)
 }
 
-/// `pedsynth export FORMAT DIR --out OUT`: a finished dataset in a format other tools read.
+/// `pedsynth export FORMAT DIR --out OUT [--box tight|annotator]`: a finished dataset in a format other tools
+/// read (`--box` chooses the 2D box over the spec's `annotations.export_box`).
 pub fn export(
     dir: &Path,
     format: crate::dataset::export::Format,
     to: &Path,
-    link: crate::dataset::export::LinkMode,
+    how: (crate::dataset::export::LinkMode, Option<crate::spec::types::ExportBox>),
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Error> {
     let mut warnings = Vec::new();
-    let text = crate::dataset::export::export(dir, format, to, link, &mut |w| warnings.push(w))?;
+    let text = crate::dataset::export::export(dir, format, to, how, &mut |w| warnings.push(w))?;
     for w in warnings {
         writeln!(err, "{w}").map_err(Error::output)?;
     }

@@ -49,6 +49,8 @@ pub struct AnnotationRow {
     pub pedestrian: u32,
     /// Tight 2D box `[x_min, y_min, x_max, y_max]`, pixels.
     pub bbox_px: [f32; 4],
+    /// The annotator box ([`super::annotator`]), pixels.
+    pub annotator_bbox_px: [f32; 4],
     /// Crossing label C.
     pub crossing: bool,
     /// Behaviour state.
@@ -546,6 +548,13 @@ pub fn annotate(
                 frame: frame as u32,
                 pedestrian: id as u32,
                 bbox_px: bbox.map(|x| x as f32),
+                annotator_bbox_px: super::annotator::annotator_box(
+                    bbox,
+                    &annotations.annotator_box,
+                    (script.seed, id as u32, frame as u32),
+                    (camera.width_px, camera.height_px),
+                )
+                .map(|x| x as f32),
                 crossing,
                 state: f.state,
                 distance_m: distance as f32,

@@ -11,6 +11,7 @@
 //! frame to a sink (the writer) as soon as it is produced; the sink does the IO, this module none.
 
 pub mod annotate;
+pub mod annotator;
 pub mod body;
 pub mod camera;
 pub mod cyclist;

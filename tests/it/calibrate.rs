@@ -132,6 +132,43 @@ fn jaad_and_pie_exports_read_back_as_their_own_tables() {
             assert!((own.cues[q] - back.cues[q]).abs() < 0.02, "{format}: cue {q}");
         }
     }
+    // `--box annotator` exports the annotator box: on whole pixels, around the tight box's centre, at least the
+    // narrowest drawn aspect (0.3 by default) wide, within the noise.
+    let out = tmp.path().join("jaad-annotator");
+    let (code, _, stderr) = pedsynth(&[
+        "export".as_ref(),
+        "jaad".as_ref(),
+        ds.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--box".as_ref(),
+        "annotator".as_ref(),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let drawn = calibrate::read_real(&out, Format::Jaad, &[]).expect("reads the export");
+    let mut boxes = 0;
+    for (v, w) in drawn.iter().zip(&ours) {
+        for (t, u) in v.tracks.iter().zip(&w.tracks) {
+            for (a, b) in t.boxes.iter().zip(&u.boxes) {
+                let edges = [a.x_min_px, a.y_min_px, a.x_max_px, a.y_max_px];
+                assert!(edges.iter().all(|e| e.fract() == 0.0), "whole pixels: {a:?}");
+                let (cx_a, cx_b) = (a.x_min_px + a.x_max_px, b.x_min_px + b.x_max_px);
+                assert!((cx_a - cx_b).abs() / 2.0 < 3.0, "centred: {a:?} against {b:?}");
+                let (w_a, h_a) = (a.x_max_px - a.x_min_px, a.y_max_px - a.y_min_px);
+                let inside = a.x_min_px > 0.0 && a.x_max_px < 1279.0;
+                assert!(
+                    !inside || w_a >= 0.3 * h_a - 3.0,
+                    "at least the narrowest aspect: {a:?}"
+                );
+                assert!(
+                    h_a >= b.y_max_px - b.y_min_px - 3.0,
+                    "not shorter than the silhouette: {a:?} {b:?}"
+                );
+                boxes += 1;
+            }
+        }
+    }
+    assert!(boxes > 1000, "{boxes} boxes compared");
 }
 
 #[test]

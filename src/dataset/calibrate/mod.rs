@@ -88,6 +88,9 @@ pub struct Fit {
     /// `crossing.scenario.walker_ahead_m`: the 10th and 90th percentiles of non-crossers' distance when first
     /// annotated, tracks of the benchmark's minimum length only.
     pub walker_ahead_m: (f64, f64),
+    /// `annotations.annotator_box.min_aspect`: the 10th and 90th percentiles of the windows' box aspect
+    /// (width / height), both classes.
+    pub min_aspect: (f64, f64),
 }
 
 /// A calibration: what was read, measured and fitted.
@@ -174,6 +177,12 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         }
     }
     let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
+    let aspect = measure::Spread::of(
+        measure::windows(videos, &options.pab)
+            .iter()
+            .map(|w| w.quantities[2])
+            .collect(),
+    );
     let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
     let lo = round(seen.p10.clamp(0.5, 30.0), 1);
     let fit = Fit {
@@ -193,6 +202,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         walker_ahead_m: (
             round(walkers_at.p10.clamp(1.0, 200.0), 1),
             round(walkers_at.p90.clamp(1.0, 200.0), 1),
+        ),
+        min_aspect: (
+            round(aspect.p10.clamp(0.0, 2.0), 2),
+            round(aspect.p90.clamp(0.0, 2.0), 2),
         ),
     };
     Ok(Calibration {
@@ -260,6 +273,11 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
         out,
         "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p90)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p10, p90)",
         f.crosser_ego_within_m.0, f.crosser_ego_within_m.1, f.walker_ahead_m.0, f.walker_ahead_m.1
+    );
+    let _ = writeln!(
+        out,
+        "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows (p10, p90)",
+        f.min_aspect.0, f.min_aspect.1
     );
     out
 }

@@ -10,13 +10,15 @@ use arrow_array::Array;
 use crate::dataset::read::tables;
 use crate::dataset::write::{Layout, Manifest};
 use crate::error::{Error, code};
+use crate::spec::types::ExportBox;
 use crate::spec::{LoadOptions, Spec};
 
 /// One annotated pedestrian-frame.
 #[derive(Clone, Debug)]
 pub struct AnnotatedFrame {
     pub frame: u32,
-    /// `[x_min, y_min, x_max, y_max]`, pixels.
+    /// `[x_min, y_min, x_max, y_max]`, pixels: the tight box, or the annotator box where the spec's
+    /// `annotations.export_box` says so.
     pub bbox_px: [f32; 4],
     /// Crossing label C.
     pub crossing: bool,
@@ -248,9 +250,9 @@ impl Dataset {
 }
 
 impl Dataset {
-    /// A clip's tables.
+    /// A clip's tables, with the 2D box `annotations.export_box` chooses as `bbox_px`.
     pub fn load(&self, info: &ClipInfo) -> Result<Clip, Error> {
-        read_clip(&self.layout, info.clone())
+        read_clip(&self.layout, info.clone(), self.spec.annotations.export_box)
     }
 }
 
@@ -293,7 +295,16 @@ fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
     clip.ok_or_else(|| refuse(format!("{}: no row", file.display())))
 }
 
-fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
+fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<Clip, Error> {
+    let boxes = match export_box {
+        ExportBox::Tight => ["bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max"],
+        ExportBox::Annotator => [
+            "annotator_x_min",
+            "annotator_y_min",
+            "annotator_x_max",
+            "annotator_y_max",
+        ],
+    };
     let file = |t: &str| layout.table(t, &info.clip_id);
     let mut clip = Clip {
         info: info.clone(),
@@ -369,10 +380,10 @@ fn read_clip(layout: &Layout, info: ClipInfo) -> Result<Clip, Error> {
     let cols = [
         "frame",
         "pedestrian",
-        "bbox_x_min",
-        "bbox_y_min",
-        "bbox_x_max",
-        "bbox_y_max",
+        boxes[0],
+        boxes[1],
+        boxes[2],
+        boxes[3],
         "crossing",
         "state",
         "occlusion",

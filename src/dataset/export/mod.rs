@@ -197,10 +197,14 @@ pub fn export(
     dir: &Path,
     format: Format,
     out: &Path,
-    link: LinkMode,
+    (link, export_box): (LinkMode, Option<crate::spec::types::ExportBox>),
     warn: &mut dyn FnMut(String),
 ) -> Result<String, Error> {
-    let ds = dataset::Dataset::open(dir)?;
+    let mut ds = dataset::Dataset::open(dir)?;
+    // `--box` overrides the spec's `annotations.export_box`.
+    if let Some(b) = export_box {
+        ds.spec.annotations.export_box = b;
+    }
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     Ok(match format {
         Format::Pie => {

@@ -4,6 +4,8 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+use super::Range;
+
 /// Annotation rules.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -17,6 +19,11 @@ pub struct Annotations {
     /// A pedestrian is `look`ing at the ego when its gaze (the head's forward direction) is within this angle
     /// of the direction from its eyes to the camera, degrees.
     pub look_cone_deg: f64,
+    /// The `annotator_*` box beside the tight one: drawn as a person draws it.
+    pub annotator_box: AnnotatorBox,
+    /// The box the exports (`pie`, `jaad`, `pab-poses`, `pab-poses-jaad`, `seed-csv`, `openscenario`) and
+    /// `pedsynth calibrate --compare` read: `tight` (the silhouette's, the default) or `annotator`.
+    pub export_box: ExportBox,
 }
 
 impl Default for Annotations {
@@ -26,6 +33,49 @@ impl Default for Annotations {
             crossing_label_smoothing_frames: 5,
             pose_format: PoseFormat::Coco17,
             look_cone_deg: 30.0,
+            annotator_box: AnnotatorBox::default(),
+            export_box: ExportBox::Tight,
+        }
+    }
+}
+
+/// Which 2D box a consumer of the tables reads.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ExportBox {
+    /// The tight box of the projected body (`bbox_*`).
+    #[default]
+    Tight,
+    /// The annotator box (`annotator_*`).
+    Annotator,
+}
+
+/// How the annotator box is drawn from the tight box: hand-drawn boxes in JAAD and PIE are looser than a
+/// silhouette (wider than a walking person's legs and arms), sit on whole pixels and move a little from frame to
+/// frame. Per pedestrian, a margin and a narrowest aspect are drawn from the ranges; per frame, each edge gets
+/// Gaussian noise; the box keeps the tight box's centre and stays in the image.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct AnnotatorBox {
+    /// Margin added around the silhouette, as a fraction of the tight box's height, `[min, max]` (drawn per
+    /// pedestrian; half above, half below, and the same width on each side).
+    pub margin_frac: Range,
+    /// The narrowest box, width / height, `[min, max]` (drawn per pedestrian): a narrower silhouette gets a
+    /// box this wide.
+    pub min_aspect: Range,
+    /// Standard deviation of the per-frame noise on each edge, pixels.
+    pub noise_px: f64,
+    /// Edges on whole pixels, as annotation tools write them.
+    pub whole_pixels: bool,
+}
+
+impl Default for AnnotatorBox {
+    fn default() -> Self {
+        AnnotatorBox {
+            margin_frac: Range(0.0, 0.06),
+            min_aspect: Range(0.3, 0.45),
+            noise_px: 0.5,
+            whole_pixels: true,
         }
     }
 }

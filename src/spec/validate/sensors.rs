@@ -251,5 +251,27 @@ impl Validator<'_> {
             90.0,
             "the half-angle of the cone around the gaze in which the camera counts as looked at, degrees",
         );
+        let b = &a.annotator_box;
+        self.range(
+            "annotations.annotator_box.margin_frac",
+            b.margin_frac,
+            0.0,
+            1.0,
+            "a margin as a fraction of the box height",
+        );
+        self.range(
+            "annotations.annotator_box.min_aspect",
+            b.min_aspect,
+            0.0,
+            2.0,
+            "a width / height ratio",
+        );
+        self.num(
+            "annotations.annotator_box.noise_px",
+            b.noise_px,
+            0.0,
+            100.0,
+            "a noise in pixels",
+        );
     }
 }

@@ -115,6 +115,10 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
         .column("bbox_y_min", false, f32c(|r| r.bbox_px[1]))
         .column("bbox_x_max", false, f32c(|r| r.bbox_px[2]))
         .column("bbox_y_max", false, f32c(|r| r.bbox_px[3]))
+        .column("annotator_x_min", false, f32c(|r| r.annotator_bbox_px[0]))
+        .column("annotator_y_min", false, f32c(|r| r.annotator_bbox_px[1]))
+        .column("annotator_x_max", false, f32c(|r| r.annotator_bbox_px[2]))
+        .column("annotator_y_max", false, f32c(|r| r.annotator_bbox_px[3]))
         .column(
             "crossing",
             false,
