@@ -545,6 +545,7 @@ fn main() -> ExitCode {
             let slurm = pedsynth::cli::cluster::SlurmOptions {
                 input: input.display().to_string(),
                 overrides: options.overrides.clone(),
+                profile: options.profile.as_ref().map(|p| p.display().to_string()),
                 out: dir.display().to_string(),
                 array,
                 cpus,

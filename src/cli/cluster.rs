@@ -16,6 +16,8 @@ pub struct SlurmOptions {
     pub input: String,
     /// `--set` overrides, passed on to every task.
     pub overrides: Vec<String>,
+    /// `--profile`, passed on to every task.
+    pub profile: Option<String>,
     /// The dataset directory (on storage every node sees).
     pub out: String,
     /// Array tasks.
@@ -105,7 +107,16 @@ pub fn slurm_script(
         .fold(0.0, f64::max);
     let time = o.time.clone().unwrap_or_else(|| time_limit(longest_cpu_s, o.cpus));
     let job = format!("pedsynth-{}", job_name(&plan.header().dataset, 40));
-    let sets: String = o.overrides.iter().map(|s| format!(" --set {}", sh_quote(s))).collect();
+    let profile: String = o
+        .profile
+        .iter()
+        .map(|p| format!(" --profile {}", sh_quote(p)))
+        .collect();
+    let sets: String = profile
+        + &o.overrides
+            .iter()
+            .map(|s| format!(" --set {}", sh_quote(s)))
+            .collect::<String>();
     let mut sbatch = format!("--cpus-per-task={} --time={}", o.cpus, sh_quote(&time));
     if let Some(mem) = &o.mem {
         sbatch += &format!(" --mem={}", sh_quote(mem));

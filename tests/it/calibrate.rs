@@ -267,7 +267,7 @@ fn a_profile_lies_over_the_spec_under_set_and_names_its_file_in_problems() {
     let rgb = &spec.sensors.rgb;
     // The named rig fills what neither the spec's `sensors.rgb` nor the profile sets; the profile's own fov wins.
     assert_eq!((rgb.width_px, rgb.height_px, rgb.fov_deg), (1920, 1080, 80.0));
-    assert_eq!((rgb.mount.up_m, rgb.mount.pitch_deg, spec.dataset.fps), (1.36, 7.6, 25));
+    assert_eq!((rgb.mount.up_m, rgb.mount.pitch_deg, spec.dataset.fps), (1.38, 7.3, 25));
     let spec = load(&["dataset.fps=10", "sensors.rgb.mount.pitch_deg=0"])
         .unwrap_or_else(|e| panic!("{e}"))
         .spec;

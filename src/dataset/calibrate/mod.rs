@@ -75,6 +75,8 @@ pub struct Fit {
     pub fov_deg: f64,
     /// `sensors.rgb.mount.up_m`: the horizon fit's slope × the pedestrians' mean height.
     pub up_m: f64,
+    /// The pedestrians' mean height assumed, metres.
+    pub person_height_m: f64,
     /// `sensors.rgb.mount.pitch_deg`: the pitch that puts the horizon where the fit has it (positive looks up).
     pub pitch_deg: f64,
     /// `dataset.fps`: the most common frame rate.
@@ -82,15 +84,22 @@ pub struct Fit {
     /// `crossing.timeline.in_view_before_crossing_s`: the 10th and 90th percentiles of how long crossers are
     /// annotated before they cross (within the spec's limits, 0.5–30 s).
     pub in_view_before_crossing_s: (f64, f64),
-    /// `crossing.scenario.crosser_ego_within_m`: the 10th and 90th percentiles of crossers' distance from the
-    /// camera at their crossing point (from the box height, the fitted camera and the mean height).
+    /// `crossing.scenario.crosser_ego_within_m`: the 10th and 50th percentiles of crossers' distance from the
+    /// camera at their crossing point (from the box height, the fitted camera and the mean height). The drawn
+    /// distance is the farthest the ego may be when a crosser steps out, and simulated crossers step out at or
+    /// inside it (they wait for their gap and the ego's yield): hence the nearer half of the real distances.
     pub crosser_ego_within_m: (f64, f64),
-    /// `crossing.scenario.walker_ahead_m`: the 10th and 90th percentiles of non-crossers' distance when first
-    /// annotated, tracks of the benchmark's minimum length only.
+    /// `crossing.scenario.walker_ahead_m`: the 50th and 90th percentiles of non-crossers' distance when first
+    /// annotated, tracks of the benchmark's minimum length only (walkers are placed at the clip's start, and the
+    /// ego drives towards them during the clip: the farther half keeps them ahead, as real bystanders are).
     pub walker_ahead_m: (f64, f64),
     /// `annotations.annotator_box.min_aspect`: the 10th and 90th percentiles of the windows' box aspect
     /// (width / height), both classes.
     pub min_aspect: (f64, f64),
+    /// `crossing.layers.behaviour_mix.mix`'s `sudden` share: crossers walking in the last frame of their windows
+    /// (a sudden crosser walks into the road without stopping at the curb); `normal` and `jaywalk` share the
+    /// rest 2 : 1 as the paper's mix does. `None` where the real data has no standing/walking labels.
+    pub sudden_share: Option<f64>,
 }
 
 /// A calibration: what was read, measured and fitted.
@@ -190,6 +199,7 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         height_px,
         fov_deg: options.fov_deg,
         up_m: round((horizon.slope * options.person_height_m).clamp(0.5, 3.0), 2),
+        person_height_m: options.person_height_m,
         pitch_deg: round(pitch_deg.clamp(-30.0, 30.0), 1),
         fps: most_common(videos.iter().map(|v| v.fps.round() as u32))
             .unwrap_or(30)
@@ -197,16 +207,17 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         in_view_before_crossing_s: (lo, round(seen.p90.clamp(lo, 30.0), 1)),
         crosser_ego_within_m: (
             round(crossers_at.p10.clamp(1.0, 100.0), 1),
-            round(crossers_at.p90.clamp(1.0, 100.0), 1),
+            round(crossers_at.p50.clamp(1.0, 100.0), 1),
         ),
         walker_ahead_m: (
-            round(walkers_at.p10.clamp(1.0, 200.0), 1),
+            round(walkers_at.p50.clamp(1.0, 200.0), 1),
             round(walkers_at.p90.clamp(1.0, 200.0), 1),
         ),
         min_aspect: (
             round(aspect.p10.clamp(0.0, 2.0), 2),
             round(aspect.p90.clamp(0.0, 2.0), 2),
         ),
+        sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
     };
     Ok(Calibration {
         splits: options.splits.clone(),
@@ -255,10 +266,7 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     let _ = writeln!(
         out,
         "    mount:\n      up_m: {}  # the fit's slope x a {:.2} m mean pedestrian\n      pitch_deg: {}  # puts the horizon {:.3} of the height from the top",
-        f.up_m,
-        f.up_m / h.slope.max(1e-6),
-        f.pitch_deg,
-        h.horizon
+        f.up_m, f.person_height_m, f.pitch_deg, h.horizon
     );
     let _ = writeln!(
         out,
@@ -271,9 +279,18 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p90)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p10, p90)",
+        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p50)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p50, p90)",
         f.crosser_ego_within_m.0, f.crosser_ego_within_m.1, f.walker_ahead_m.0, f.walker_ahead_m.1
     );
+    if let Some(sudden) = f.sudden_share {
+        let normal = (((1.0 - sudden) * 2.0 / 3.0) * 100.0).round() / 100.0;
+        let jaywalk = ((1.0 - sudden - normal) * 100.0).round() / 100.0;
+        let _ = writeln!(
+            out,
+            "  layers:\n    behaviour_mix:\n      mix: {{normal: {normal}, sudden: {sudden}, jaywalk: {jaywalk}}}  # {:.0} % of real crossers walk 1-2 s before crossing",
+            100.0 * sudden
+        );
+    }
     let _ = writeln!(
         out,
         "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows (p10, p90)",

@@ -130,9 +130,11 @@ fn timeline_allows(p: &Ped, lead_s: f64) -> bool {
     // (often behind a queue that hides the curb), and the crossing happens in front of it.
     let on_walk = percept.walk == Some(WalkSignal::Walk);
     // Where the scenario asks for it, the crosser waits until the ego is near (it eases off for the waiting
-    // pedestrian), as real crossers go in front of a car that slows for them.
-    let ego_near = p.traits.step_out_ego_within_m.is_none_or(|d| percept.ego_dist_m <= d);
-    !percept.ego_ahead || (p.seen_long_enough(lead_s) && p.followers_seen && ego_near) || cut_short || on_walk
+    // pedestrian), as real crossers go in front of a car that slows for them (`Ped::ego_near_enough`).
+    !percept.ego_ahead
+        || (p.seen_long_enough(lead_s) && p.followers_seen && p.ego_near_enough())
+        || cut_short
+        || on_walk
 }
 
 /// Whether the ego is so close ahead, and moving, that stepping out now would put the crosser under its wheels.

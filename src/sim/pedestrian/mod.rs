@@ -237,6 +237,10 @@ pub(crate) struct StepCtx<'a> {
     pub next_frame: u32,
 }
 
+/// A crosser timing its walk to the ego (`Ped::holds_for_ego`) sets off this much earlier than the bare estimate,
+/// seconds (the ego slows as it comes).
+const HOLD_SLACK_S: f64 = 1.0;
+
 impl Ped {
     /// Sets a pedestrian up from its script; draws its per-pedestrian constants from its own stream, and its
     /// gesture draws from `gesture_rng` (a stream of its own, so gestures shift no other draw).
@@ -385,6 +389,29 @@ impl Ped {
         self.traits
             .in_view_before_crossing_s
             .is_none_or(|t| self.in_view_s + lead_s >= t)
+    }
+
+    /// Whether the ego is near enough for it to step out, where its scenario asks for that
+    /// (`crossing.scenario.crosser_ego_within_m`; always otherwise, and once the ego has passed).
+    pub(crate) fn ego_near_enough(&self) -> bool {
+        self.traits
+            .step_out_ego_within_m
+            .is_none_or(|d| !self.percept.ego_ahead || self.percept.ego_dist_m <= d)
+    }
+
+    /// Whether a crosser that waits for the ego to come near (its scenario) stands where it is for now, rather
+    /// than walk on to its curb: it times its walk so that it arrives as the ego comes within its distance, as
+    /// real crossers walk up and into the road in front of a car that has slowed for them.
+    pub(crate) fn holds_for_ego(&self, speed_mps: f64) -> bool {
+        let (Some(d), Some(line)) = (self.traits.step_out_ego_within_m, self.traits.line) else {
+            return false;
+        };
+        if self.attempt.over() || self.attempt.at_curb() || !self.percept.ego_ahead {
+            return false;
+        }
+        let walk_s = line.curb_point().distance(self.body.pos) / speed_mps.max(0.3);
+        let ego_s = (self.percept.ego_dist_m - d) / self.percept.ego_speed_mps.max(0.5);
+        ego_s > walk_s + HOLD_SLACK_S
     }
 
     /// Whether its signalised crosswalk shows "don't walk" (or flashes) and it is not one to cross against the

@@ -122,6 +122,7 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
                     p.own_speed_mps(m)
                 }
             }
+            _ if p.holds_for_ego(p.own_speed_mps(m)) => 0.0,
             _ => p.own_speed_mps(m),
         };
         let mut v = ai_velocity(p, ctx, speed);
@@ -190,7 +191,7 @@ pub(crate) fn move_ped(p: &mut Ped, ctx: &StepCtx, others: &[DVec2], self_index:
     // The patience clock runs while waiting at the curb for a gap: once the crosser's timeline would let it go
     // (seen long enough, or the ego has passed), not while it waits for the approaching ego, nor while it waits
     // for "walk" at a signalised crosswalk (waiting for the signal is no gap to lose patience over).
-    let trying = (!p.percept.ego_ahead || p.seen_long_enough(0.0)) && !p.waits_for_walk();
+    let trying = (!p.percept.ego_ahead || (p.seen_long_enough(0.0) && p.ego_near_enough())) && !p.waits_for_walk();
     if let Attempt::Undecided {
         at_curb: true,
         waited_s,

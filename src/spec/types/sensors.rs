@@ -95,10 +95,10 @@ impl CameraProfile {
     /// Sources:
     /// - `carla`: the defaults of this spec language (the paper's camera).
     /// - `jaad`: 1920×1080 from JAAD's annotations (every video, `videos.parquet` in ../shared/real). The mount is
-    ///   fitted with `pedsynth calibrate` to JAAD train + val's unoccluded boxes: their bottoms lie on
-    ///   `bottom = 0.618 + 0.80 × height` (fractions of the image height), a horizon 0.118 of the height below
-    ///   the centre (pitched up 7.6° at 90°) and a camera 0.80 × 1.70 m (an adult's mean height) = 1.36 m above
-    ///   the road. JAAD's authors do not publish the cameras' fields of view; 90° is assumed.
+    ///   `pedsynth calibrate --splits train,val` on JAAD's train and val annotations: their 162,999 unoccluded
+    ///   boxes lie on `bottom = 0.614 + 0.815 × height` (fractions of the image height), a horizon 0.114 of the
+    ///   height below the centre (pitched up 7.3° at 90°) and a camera 0.815 × 1.70 m (a mean pedestrian's
+    ///   height) = 1.38 m above the road. JAAD's authors publish no field of view; 90° is assumed.
     /// - `pie`: PIE's `calibration_data.json` (github.com/aras62/PIE): 1920×1080, `fx` 1004.8 px, i.e.
     ///   2·atan(960 / 1004.8) = 87.4° horizontally, and `cam_height_mm` 1270. Its `cam_pitch_deg` (−10) comes
     ///   without a convention and is not used: the pitch is 0, level with the road.
@@ -115,8 +115,8 @@ impl CameraProfile {
                 ("width_px", "1920"),
                 ("height_px", "1080"),
                 ("fov_deg", "90"),
-                ("mount.up_m", "1.36"),
-                ("mount.pitch_deg", "7.6"),
+                ("mount.up_m", "1.38"),
+                ("mount.pitch_deg", "7.3"),
             ],
             CameraProfile::Pie => &[
                 ("width_px", "1920"),
