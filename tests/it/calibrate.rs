@@ -14,7 +14,6 @@
 use crate::common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use pedsynth::dataset::calibrate::{self, CalibrateOptions, Format, measure};
 use pedsynth::spec::{LoadOptions, load_file};
@@ -27,17 +26,7 @@ fn jaad_tables() -> PathBuf {
     root().join("../shared/real/jaad_trainval")
 }
 
-fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout).into_owned(),
-        String::from_utf8_lossy(&output.stderr).into_owned(),
-    )
-}
+use crate::common::pedsynth;
 
 #[test]
 #[ignore = "reads JAAD's annotations in ../shared/real"]

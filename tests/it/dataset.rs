@@ -1009,18 +1009,7 @@ fn tables_are_byte_identical_across_jobs_plan_files_and_resumption() {
     assert_same_files(&one, &from_plan, "after a refused run");
 }
 
-/// Runs the pedsynth binary; returns the exit code, stdout and stderr.
-fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_pedsynth"))
-        .args(args)
-        .output()
-        .expect("run pedsynth");
-    (
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout).into_owned(),
-        String::from_utf8_lossy(&output.stderr).into_owned(),
-    )
-}
+use crate::common::pedsynth;
 
 #[test]
 fn generate_refuses_directories_it_must_not_write_into() {

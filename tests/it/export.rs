@@ -13,7 +13,6 @@ use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use pedsynth::dataset::export::dataset::AnnotatedFrame;
 use pedsynth::dataset::export::pab::pose36;
@@ -22,17 +21,7 @@ fn spec(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("specs").join(name)
 }
 
-fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
-        .args(args)
-        .output()
-        .expect("runs");
-    (
-        output.status.code(),
-        String::from_utf8_lossy(&output.stdout).into_owned(),
-        String::from_utf8_lossy(&output.stderr).into_owned(),
-    )
-}
+use crate::common::pedsynth;
 
 fn export(format: &str, dataset: &Path, out: &Path) -> (Option<i32>, String, String) {
     pedsynth(&[

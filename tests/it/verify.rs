@@ -6,23 +6,12 @@
 use crate::common;
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn spec(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("specs").join(name)
 }
 
-fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_pedsynth"))
-        .args(args)
-        .output()
-        .expect("run pedsynth");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use crate::common::pedsynth;
 
 fn verify(dir: &Path) -> (Option<i32>, String, String) {
     pedsynth(&["verify".as_ref(), dir.as_os_str()])

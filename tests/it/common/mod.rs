@@ -345,3 +345,16 @@ pub fn plan_spec(
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{e}"));
     (towns, plan)
 }
+
+/// Runs the pedsynth binary; returns the exit code, stdout and stderr.
+pub fn pedsynth(args: &[&std::ffi::OsStr]) -> (Option<i32>, String, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_pedsynth"))
+        .args(args)
+        .output()
+        .expect("run pedsynth");
+    (
+        output.status.code(),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+    )
+}
