@@ -158,6 +158,33 @@ fn jaad_and_pie_exports_read_back_as_their_own_tables() {
         }
     }
     assert!(boxes > 1000, "{boxes} boxes compared");
+    // The spec's `annotations.export_box: annotator` chooses the same boxes without `--box`.
+    let ds2 = tmp.path().join("ds-annotator");
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.push("annotations.export_box=annotator");
+    let (code, _, stderr) = common::generate(&spec, &overrides, &ds2, None);
+    assert_eq!(code, 0, "{stderr}");
+    let out2 = tmp.path().join("jaad-annotator-spec");
+    let (code, _, stderr) = pedsynth(&[
+        "export".as_ref(),
+        "jaad".as_ref(),
+        ds2.as_os_str(),
+        "--out".as_ref(),
+        out2.as_os_str(),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let by_spec = calibrate::read_real(&out2, Format::Jaad, &[]).expect("reads the export");
+    let boxes_of = |videos: &[calibrate::real::RealVideo]| -> Vec<Vec<calibrate::real::RealBox>> {
+        videos
+            .iter()
+            .flat_map(|v| v.tracks.iter().map(|t| t.boxes.clone()))
+            .collect()
+    };
+    assert_eq!(
+        boxes_of(&by_spec),
+        boxes_of(&drawn),
+        "the spec key and --box annotator export the same boxes"
+    );
 }
 
 #[test]

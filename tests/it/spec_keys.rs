@@ -47,6 +47,7 @@ struct Walker {
 
 enum Verdict {
     Used,
+    Exported,
     NotImplemented,
     Validation,
     Ignored,
@@ -243,6 +244,10 @@ const VALIDATION_KEYS: &[&str] = &[
     "crossing.layers.crosser_allocation.max_crosser_ratio",
 ];
 
+/// Keys whose only effect is on what the exporters read (not the plan or the tables): the walk checks that
+/// their values load, and tests/it/calibrate.rs that they change an export.
+const EXPORT_KEYS: &[&str] = &["annotations.export_box"];
+
 /// Settings applied to both sides of a comparison, so that a key's effect can show (an event the key shapes must
 /// happen in the walk's few clips, or another key must make the perturbation valid).
 fn context(path: &str) -> Vec<(&'static str, Json)> {
@@ -367,6 +372,7 @@ fn candidates(path: &str, value: &Json, parent: &Json) -> Vec<Json> {
                 "default_split" => &["train", "val", "test"],
                 "body" => &["adult", "child", "adult_with_child"],
                 "pose_format" => &["coco17", "openpose18"],
+                "export_box" => &["tight", "annotator"],
                 "compression" => &["zstd", "snappy", "none"],
                 "rgb_encoding" => &["png", "jpeg", "h264"],
                 "depth_encoding" => &["mm_u16", "carla_rgb24"],
@@ -504,11 +510,23 @@ fn every_key_changes_the_plan_or_the_tables_or_is_reported_as_not_implemented() 
                 Ok(()) => Verdict::NotImplemented,
                 Err(e) => Verdict::Invalid(e),
             }
+        } else if EXPORT_KEYS.contains(&path.as_str()) {
+            let mut spec = walker.base.clone();
+            let loads = values.iter().any(|v| {
+                *pointer(&mut spec, target) = v.clone();
+                walker.load(&spec).is_ok()
+            });
+            if loads {
+                Verdict::Exported
+            } else {
+                Verdict::Invalid("no candidate value loads".to_owned())
+            }
         } else {
             walker.judge(target, &values, &context(path))
         };
         let name = match verdict {
             Verdict::Used => "used",
+            Verdict::Exported => "used by the exporters",
             Verdict::NotImplemented => "not implemented (reported)",
             Verdict::Validation => "validation",
             Verdict::Ignored => {
