@@ -52,7 +52,6 @@ fn main() {
                 std::process::exit(2);
             }
         };
-        let rig = Rig::from_spec(&plan.spec.sensors);
         // (pedestrians, allocated, allocated labelled, allocated on a driving lane, baseline, baseline labelled,
         // allocated never annotated, pedestrians never annotated, unlabelled allocated crossers that never had
         // C = 1, ... that had C = 1 only behind the camera, ... only in front of it but not annotated, allocated in
@@ -63,6 +62,7 @@ fn main() {
             .par_iter()
             .map(|clip| {
                 let net = &towns[&clip.town].network;
+                let rig = Rig::for_clip(&plan.spec.sensors, clip.seed);
                 let trace = sim::simulate(clip, &plan.sim, net);
                 let ann = sensors::observe(clip, &trace, &plan.spec, &rig, net).annotations;
                 let mut c = [0usize; 13];

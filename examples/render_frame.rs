@@ -41,13 +41,13 @@ fn main() {
         }
     };
     std::fs::create_dir_all(&out).expect("output directory");
-    let rig = Rig::from_spec(&plan.spec.sensors);
     for clip in plan
         .clips
         .iter()
         .filter(|c| only.as_ref().is_none_or(|id| *id == c.clip_id))
     {
         let net = &towns[&clip.town].network;
+        let rig = Rig::for_clip(&plan.spec.sensors, clip.seed);
         let trace = sim::simulate(clip, &plan.sim, net);
         let ann = sensors::observe(clip, &trace, &plan.spec, &rig, net).annotations;
         let frame = fixed.unwrap_or_else(|| {

@@ -40,7 +40,7 @@ pub fn busy_quickstart_clip(overrides: &[String]) -> BusyClip {
     let script = plan.clips[0].clone();
     let net = towns[&script.town].network.clone();
     let trace = sim::simulate(&script, &plan.sim, &net);
-    let rig = Rig::from_spec(&plan.spec.sensors);
+    let rig = Rig::for_clip(&plan.spec.sensors, script.seed);
     let ann = sensors::observe(&script, &trace, &plan.spec, &rig, &net).annotations;
     let mut counts = vec![0u32; trace.frame_count as usize];
     for r in &ann.rows {

@@ -249,7 +249,7 @@ impl<'a> Sim<'a> {
             trace,
             zones,
             contacts: Contacts::new(nv, np),
-            view: view::ViewProxy::new(params),
+            view: view::ViewProxy::new(params, script.seed),
             probes: Vec::with_capacity(8),
             positions: Vec::with_capacity(np),
             people: Vec::with_capacity(np),

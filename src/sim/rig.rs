@@ -8,6 +8,9 @@
 
 use glam::{DAffine3, DMat3, DVec2, DVec3};
 
+use rand::RngExt;
+
+use crate::plan::seeds::clip_rng;
 use crate::spec::types::{Mount, Rgb, Sensors};
 
 /// The sensors on the ego vehicle, placed and configured from the spec.
@@ -25,6 +28,15 @@ impl Rig {
         Rig {
             camera: Camera::from_spec(&sensors.rgb),
             lidar_vehicle_from_sensor: vehicle_from_mount(&sensors.lidar.mount),
+        }
+    }
+
+    /// The rig of a spec's sensors on the clip seeded `clip_seed`: the camera's mount with the clip's offsets
+    /// (`sensors.rgb.mount_spread`, [`clip_mount`]); the LiDAR's roof mount does not vary.
+    pub fn for_clip(sensors: &Sensors, clip_seed: u64) -> Rig {
+        Rig {
+            camera: Camera::for_clip(&sensors.rgb, clip_seed),
+            ..Rig::from_spec(sensors)
         }
     }
 
@@ -53,6 +65,22 @@ const OPTICAL_FROM_SENSOR: DMat3 = DMat3::from_cols(
     DVec3::new(-1.0, 0.0, 0.0), // sensor y (left) → optical −x
     DVec3::new(0.0, -1.0, 0.0), // sensor z (up) → optical −y
 );
+
+/// The camera mount of the clip seeded `clip_seed`: `rgb.mount` with its height and pitch offset by draws from
+/// `rgb.mount_spread`'s ranges (the clip's `"camera mount"` stream). With the default spread (`[0, 0]`) it is
+/// `rgb.mount` exactly.
+pub fn clip_mount(rgb: &Rgb, clip_seed: u64) -> Mount {
+    let spread = &rgb.mount_spread;
+    let mut mount = rgb.mount.clone();
+    if *spread == Default::default() {
+        return mount;
+    }
+    let mut rng = clip_rng(clip_seed, "camera mount");
+    let mut draw = |r: crate::spec::types::Range| r.min() + (r.max() - r.min()) * rng.random::<f64>();
+    mount.up_m += draw(spread.up_m);
+    mount.pitch_deg += draw(spread.pitch_deg);
+    mount
+}
 
 /// The pose of a mount in the vehicle frame. Pitch is about the vehicle's y axis with negative values looking
 /// down (CARLA's convention), yaw about z (positive turns left), roll about x.
@@ -106,6 +134,14 @@ impl Camera {
             height_px: rgb.height_px,
             focal_px,
             vehicle_from_sensor: vehicle_from_mount(&rgb.mount),
+        }
+    }
+
+    /// The RGB camera of a spec on the clip seeded `clip_seed` (its mount: [`clip_mount`]).
+    pub fn for_clip(rgb: &Rgb, clip_seed: u64) -> Self {
+        Camera {
+            vehicle_from_sensor: vehicle_from_mount(&clip_mount(rgb, clip_seed)),
+            ..Camera::from_spec(rgb)
         }
     }
 
@@ -192,5 +228,36 @@ mod tests {
             (pose.right - DVec3::X).length() < 1e-9 || pose.right.x > 0.99,
             "north-facing: right is east"
         );
+    }
+
+    #[test]
+    fn clip_mounts_vary_within_the_spread_and_are_the_spec_mount_without_it() {
+        let mut rgb = Rgb::default();
+        for seed in [0, 1, u64::MAX] {
+            assert_eq!(clip_mount(&rgb, seed), rgb.mount, "no spread: the spec's mount exactly");
+            assert_eq!(Camera::for_clip(&rgb, seed), Camera::from_spec(&rgb));
+        }
+        rgb.mount_spread.up_m = crate::spec::types::Range(-0.3, 0.2);
+        rgb.mount_spread.pitch_deg = crate::spec::types::Range(-5.0, 5.0);
+        let mounts: Vec<Mount> = (0..200).map(|seed| clip_mount(&rgb, seed)).collect();
+        for m in &mounts {
+            assert!(
+                (1.1..=1.6).contains(&m.up_m) && (-13.0..=-3.0).contains(&m.pitch_deg),
+                "{m:?}"
+            );
+            let untouched = (m.forward_m, m.left_m, m.yaw_deg, m.roll_deg);
+            assert_eq!(untouched, (0.8, 0.3, 0.0, 0.0));
+        }
+        let spread = |f: fn(&Mount) -> f64| {
+            let xs: Vec<f64> = mounts.iter().map(f).collect();
+            xs.iter().cloned().fold(f64::MIN, f64::max) - xs.iter().cloned().fold(f64::MAX, f64::min)
+        };
+        assert!(
+            spread(|m| m.up_m) > 0.4 && spread(|m| m.pitch_deg) > 8.0,
+            "draws cover the ranges"
+        );
+        assert_eq!(clip_mount(&rgb, 7), clip_mount(&rgb, 7), "a pure function of the seed");
+        let rig = Rig::for_clip(&Sensors::default(), 7);
+        assert_eq!(rig, Rig::from_spec(&Sensors::default()));
     }
 }

@@ -34,10 +34,10 @@ pub(crate) struct ViewProxy {
 }
 
 impl ViewProxy {
-    /// The proxy of a plan's camera and gate.
-    pub(crate) fn new(params: &SimParams) -> ViewProxy {
+    /// The proxy of a plan's camera (on the clip seeded `clip_seed`: its mount) and gate.
+    pub(crate) fn new(params: &SimParams, clip_seed: u64) -> ViewProxy {
         ViewProxy {
-            camera: Camera::from_spec(&params.camera),
+            camera: Camera::for_clip(&params.camera, clip_seed),
             gate: params.visibility.clone(),
         }
     }

@@ -3,11 +3,14 @@
 //!
 //! - JAAD train's boxes as the Parquet table: the camera fit equals an independent numpy least-squares fit
 //!   (0.6114 + 0.8184 × height over 140,352 unoccluded boxes, R² 0.675, computed once by hand and written
-//!   here), and the cue table equals tools/transfer_eval.py's, which follows JAAD's loader;
+//!   here), so does the spread of per-video fits (155 videos, horizon sd 0.0536, slope sd 0.1012, the same
+//!   way), and the cue table equals tools/transfer_eval.py's, which follows JAAD's loader;
 //! - JAAD's and PIE's XML: a dataset exported with `pedsynth export jaad|pie` reads back to the same windows
 //!   and quantities as its own tables, and JAAD's real example video reads;
 //! - bad real input (no directory, wrong layout, an empty split, too short tracks) is exit 2 with a message;
 //! - a profile lies over the spec, under `--set`, and its problems point into the profile file;
+//! - per-clip camera mounts (`sensors.rgb.mount_spread`) are what the pose table records and what the
+//!   keypoints are projected through;
 //! - every clip of PedSynth++ lies within `clip_duration_s`, and within the declared lengthening when a spec
 //!   allows one.
 
@@ -42,6 +45,12 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         "{h:?}"
     );
     assert!((h.r2 - 0.675).abs() < 0.002, "{h:?}");
+    let spread = c.real.camera_spread.expect("per-video fits");
+    assert_eq!(spread.videos, 155);
+    assert!(
+        (spread.horizon_sd - 0.0536).abs() < 5e-4 && (spread.slope_sd - 0.1012).abs() < 5e-4,
+        "{spread:?}"
+    );
     // The cue table of tools/transfer_eval.py on JAAD train (its reading cuts non-crossers' last two frames as
     // JAAD's loader does; this reading keeps them, hence the tolerance).
     for (q, expected) in [
@@ -75,6 +84,9 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
     .unwrap_or_else(|e| panic!("{e}"))
     .spec;
     assert_eq!((spec.sensors.rgb.width_px, spec.sensors.rgb.mount.up_m), (1920, f.up_m));
+    // √3 × (0.1012 × 1.70 m) and √3 × (0.0536 × 1080 / 960 rad × cos² 7.1°).
+    assert_eq!(f.mount_spread, (0.3, 5.9));
+    assert_eq!(spec.sensors.rgb.mount_spread.pitch_deg.max(), 5.9);
     assert_eq!(
         spec.crossing.scenario.crosser_ego_within_m.min(),
         f.crosser_ego_within_m.0
@@ -342,5 +354,102 @@ fn every_clip_keeps_clip_duration_unless_a_lengthening_is_declared() {
                 "the declared lengthening is used where timelines need it ({longest} s)"
             );
         }
+    }
+}
+
+#[test]
+fn per_clip_mounts_reach_the_pose_table_and_the_labels() {
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::{Float64Type, UInt32Type};
+    use glam::{DQuat, DVec3};
+    use pedsynth::dataset::write::tables;
+    use pedsynth::sim::rig::{Rig, clip_mount};
+
+    let (towns, plan) = common::plan_spec(
+        "specs/quickstart.yaml",
+        &[
+            "sensors.rgb.mount_spread.up_m=[-0.3, 0.3]",
+            "sensors.rgb.mount_spread.pitch_deg=[-5, 5]",
+        ],
+    );
+    let rgb = &plan.spec.sensors.rgb;
+    let mut mounts = Vec::new();
+    let mut keypoints = 0;
+    for script in plan.clips.iter().take(3) {
+        let mount = clip_mount(rgb, script.seed);
+        mounts.push((mount.up_m, mount.pitch_deg));
+        let rig = Rig::for_clip(&plan.spec.sensors, script.seed);
+        let net = &towns[&script.town].network;
+        let trace = pedsynth::sim::simulate(script, &plan.sim, net);
+        let ann = pedsynth::sensors::observe(script, &trace, &plan.spec, &rig, net).annotations;
+        // The pose table holds the clip's camera: its height above the ego and its pitch.
+        let poses = tables::sensor_poses_batch(script, &trace, &rig, &plan.spec.sensors);
+        let col = |name: &str| {
+            poses
+                .column_by_name(name)
+                .unwrap()
+                .as_primitive::<Float64Type>()
+                .clone()
+        };
+        let (z, qw, qx, qy, qz) = (col("z_m"), col("qw"), col("qx"), col("qy"), col("qz"));
+        let (x, y) = (col("x_m"), col("y_m"));
+        let frames = poses
+            .column_by_name("frame")
+            .unwrap()
+            .as_primitive::<UInt32Type>()
+            .clone();
+        let sensor = poses.column_by_name("sensor").unwrap().as_string::<i32>().clone();
+        let mut camera_of = std::collections::BTreeMap::new();
+        for i in 0..poses.num_rows() {
+            if sensor.value(i) != "camera" {
+                continue;
+            }
+            let f = frames.value(i) as usize;
+            assert!(
+                (z.value(i) - trace.ego[f].pos.z - mount.up_m).abs() < 1e-9,
+                "camera height"
+            );
+            let q = DQuat::from_xyzw(qx.value(i), qy.value(i), qz.value(i), qw.value(i));
+            let forward = q * DVec3::X;
+            assert!(
+                (forward.z.asin().to_degrees() - mount.pitch_deg).abs() < 1e-6,
+                "camera pitch"
+            );
+            camera_of.insert(f as u32, (DVec3::new(x.value(i), y.value(i), z.value(i)), q));
+        }
+        // Every visible keypoint is its 3D joint seen through the table's camera pose.
+        let cam = &rig.camera;
+        for row in &ann.rows {
+            let (centre, q) = camera_of[&row.frame];
+            for j in 0..17 {
+                if row.keypoints[3 * j + 2] < 1.0 {
+                    continue;
+                }
+                let world = DVec3::new(
+                    f64::from(row.keypoints_3d[3 * j]),
+                    f64::from(row.keypoints_3d[3 * j + 1]),
+                    f64::from(row.keypoints_3d[3 * j + 2]),
+                );
+                let s = q.inverse() * (world - centre); // sensor axes: x forward, y left, z up
+                let u = f64::from(cam.width_px) / 2.0 - cam.focal_px * s.y / s.x;
+                let v = f64::from(cam.height_px) / 2.0 - cam.focal_px * s.z / s.x;
+                let (ku, kv) = (f64::from(row.keypoints[3 * j]), f64::from(row.keypoints[3 * j + 1]));
+                assert!(
+                    (u - ku).abs() < 0.05 && (v - kv).abs() < 0.05,
+                    "{} frame {} joint {j}: ({ku}, {kv}) against ({u}, {v})",
+                    script.clip_id,
+                    row.frame
+                );
+                keypoints += 1;
+            }
+        }
+    }
+    assert!(keypoints > 1000, "{keypoints} keypoints checked");
+    assert!(
+        mounts.windows(2).all(|w| w[0] != w[1]),
+        "clips get their own mounts: {mounts:?}"
+    );
+    for (up, pitch) in &mounts {
+        assert!((1.1..=1.7).contains(up) && (-13.0..=-3.0).contains(pitch), "{mounts:?}");
     }
 }

@@ -86,13 +86,13 @@ impl Walker {
         let plan_text =
             serde_json::to_string(&(&plan.clips, &plan.dataset, plan.target_crossing_ratio, card)).expect("json");
         let tables = with_tables.then(|| {
-            let rig = Rig::from_spec(&plan.spec.sensors);
             let meta = FileMeta {
                 spec_hash: "fixed".to_owned(),
             };
             let mut hasher = blake3::Hasher::new();
             for script in &plan.clips {
                 let net = &towns[&script.town].network;
+                let rig = Rig::for_clip(&plan.spec.sensors, script.seed);
                 let trace = sim::simulate(script, &plan.sim, net);
                 let obs = sensors::observe(script, &trace, &plan.spec, &rig, net);
                 let ann = &obs.annotations;

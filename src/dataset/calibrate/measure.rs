@@ -140,6 +140,9 @@ pub struct HorizonFit {
     pub r2: f64,
     /// Boxes fitted.
     pub boxes: usize,
+    /// Standard deviation of the fitted boxes' heights, fraction of the image height (boxes all alike in size
+    /// fix no line).
+    pub height_sd: f64,
 }
 
 /// Fits [`HorizonFit`]; `None` with fewer than 10 boxes.
@@ -173,6 +176,42 @@ pub fn horizon_fit(videos: &[RealVideo]) -> Option<HorizonFit> {
         slope,
         r2: if var_y > 0.0 { explained / var_y } else { 0.0 },
         boxes: n as usize,
+        height_sd: (var_x / n).sqrt(),
+    })
+}
+
+/// How the camera differs from video to video: the standard deviations of [`HorizonFit`]s made per video
+/// (videos with 100 or more fitted boxes whose heights spread by a standard deviation of 3 % of the image
+/// height or more and whose line explains at least half of the bottoms' variance: boxes all alike in size fix no
+/// line).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CameraSpread {
+    /// Videos fitted.
+    pub videos: usize,
+    /// Standard deviation of the horizon, fraction of the image height.
+    pub horizon_sd: f64,
+    /// Standard deviation of the slope (camera height over the pedestrians' mean height).
+    pub slope_sd: f64,
+}
+
+/// Fits [`CameraSpread`]; `None` with fewer than 3 videos that can be fitted.
+pub fn camera_spread(videos: &[RealVideo]) -> Option<CameraSpread> {
+    let fits: Vec<HorizonFit> = videos
+        .iter()
+        .filter_map(|v| horizon_fit(std::slice::from_ref(v)))
+        .filter(|f| f.boxes >= 100 && f.height_sd >= 0.03 && f.r2 >= 0.5)
+        .collect();
+    if fits.len() < 3 {
+        return None;
+    }
+    let sd = |xs: Vec<f64>| {
+        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+        (xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (xs.len() - 1) as f64).sqrt()
+    };
+    Some(CameraSpread {
+        videos: fits.len(),
+        horizon_sd: sd(fits.iter().map(|f| f.horizon).collect()),
+        slope_sd: sd(fits.iter().map(|f| f.slope).collect()),
     })
 }
 
@@ -230,6 +269,8 @@ pub struct Measurements {
     pub crossers: usize,
     /// The horizon fit, where there were enough boxes.
     pub horizon: Option<HorizonFit>,
+    /// How the horizon and scale differ between videos, where enough videos can be fitted.
+    pub camera_spread: Option<CameraSpread>,
     /// Crossing windows.
     pub crossing: ClassSummary,
     /// Not-crossing windows.
@@ -310,6 +351,7 @@ pub fn measure(videos: &[RealVideo], pab: &PabOptions) -> Measurements {
         tracks: videos.iter().map(|v| v.tracks.len()).sum(),
         crossers: videos.iter().flat_map(|v| &v.tracks).filter(|t| t.crosser).count(),
         horizon: horizon_fit(videos),
+        camera_spread: camera_spread(videos),
         crossing: summary(&crossing),
         not_crossing: summary(&not_crossing),
         cues,
@@ -350,14 +392,14 @@ mod tests {
         assert!((auc(&s).unwrap() - 5.0 / 6.0).abs() < 1e-12);
     }
 
-    #[test]
-    fn horizon_fit_recovers_a_line() {
-        let boxes: Vec<RealBox> = (1..50)
+    /// A video of one track whose boxes lie on `bottom = horizon + slope × height` (fractions of 1000 px).
+    fn line_video(horizon: f64, slope: f64, boxes: u32) -> RealVideo {
+        let boxes: Vec<RealBox> = (1..=boxes)
             .map(|i| {
-                let h = 10.0 + 4.0 * f64::from(i);
-                let bottom = 600.0 + 0.8 * h;
+                let h = 10.0 + 4.0 * f64::from(i % 60);
+                let bottom = 1000.0 * horizon + slope * h;
                 RealBox {
-                    frame: i as u32,
+                    frame: i,
                     x_min_px: 0.0,
                     y_min_px: bottom - h,
                     x_max_px: h / 3.0,
@@ -368,7 +410,7 @@ mod tests {
                 }
             })
             .collect();
-        let video = RealVideo {
+        RealVideo {
             name: "v".into(),
             split: "train".into(),
             width_px: 1920.0,
@@ -381,8 +423,29 @@ mod tests {
                 boxes,
             }],
             ego_actions: BTreeMap::new(),
-        };
-        let fit = horizon_fit(&[video]).unwrap();
+        }
+    }
+
+    #[test]
+    fn horizon_fit_recovers_a_line() {
+        let fit = horizon_fit(&[line_video(0.6, 0.8, 49)]).unwrap();
         assert!((fit.horizon - 0.6).abs() < 1e-9 && (fit.slope - 0.8).abs() < 1e-9 && fit.r2 > 0.999);
+    }
+
+    #[test]
+    fn camera_spread_is_the_deviation_of_per_video_lines() {
+        let videos = [
+            line_video(0.55, 0.7, 120),
+            line_video(0.60, 0.8, 120),
+            line_video(0.65, 0.9, 120),
+            line_video(0.9, 0.1, 50), // too few boxes to count
+        ];
+        let c = camera_spread(&videos).unwrap();
+        assert_eq!(c.videos, 3);
+        assert!(
+            (c.horizon_sd - 0.05).abs() < 1e-9 && (c.slope_sd - 0.1).abs() < 1e-9,
+            "{c:?}"
+        );
+        assert_eq!(camera_spread(&videos[..2]), None, "two videos are too few");
     }
 }

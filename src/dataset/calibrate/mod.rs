@@ -79,6 +79,10 @@ pub struct Fit {
     pub person_height_m: f64,
     /// `sensors.rgb.mount.pitch_deg`: the pitch that puts the horizon where the fit has it (positive looks up).
     pub pitch_deg: f64,
+    /// `sensors.rgb.mount_spread`: half-widths of the per-clip offsets of the mount's height (metres) and pitch
+    /// (degrees), `√3 ×` the per-video standard deviations ([`measure::CameraSpread`]; a uniform draw of that
+    /// half-width has that deviation); 0 where too few videos can be fitted alone.
+    pub mount_spread: (f64, f64),
     /// `dataset.fps`: the most common frame rate.
     pub fps: u32,
     /// `crossing.timeline.in_view_before_crossing_s`: the 10th and 90th percentiles of how long crossers are
@@ -166,6 +170,14 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     let pitch_deg = ((horizon.horizon - 0.5) * f64::from(height_px) / focal_px)
         .atan()
         .to_degrees();
+    // d pitch / d horizon: the horizon row is H/2 + f tan(pitch).
+    let mount_spread = real.camera_spread.map_or((0.0, 0.0), |c| {
+        let cos2 = pitch_deg.to_radians().cos().powi(2);
+        (
+            3f64.sqrt() * c.slope_sd * options.person_height_m,
+            3f64.sqrt() * (c.horizon_sd * f64::from(height_px) / focal_px * cos2).to_degrees(),
+        )
+    });
     let seen = real.seen_before_crossing_s;
     let distance = |b: &RealBox| measure::distance_m(focal_px, options.person_height_m, b.y_max_px - b.y_min_px);
     let mut at_crossing = Vec::new();
@@ -201,6 +213,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         up_m: round((horizon.slope * options.person_height_m).clamp(0.5, 3.0), 2),
         person_height_m: options.person_height_m,
         pitch_deg: round(pitch_deg.clamp(-30.0, 30.0), 1),
+        mount_spread: (
+            round(mount_spread.0.clamp(0.0, 1.0), 2),
+            round(mount_spread.1.clamp(0.0, 15.0), 1),
+        ),
         fps: most_common(videos.iter().map(|v| v.fps.round() as u32))
             .unwrap_or(30)
             .max(1),
@@ -235,6 +251,7 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
         slope: 0.0,
         r2: 0.0,
         boxes: 0,
+        height_sd: 0.0,
     });
     let splits = if c.splits.is_empty() {
         "all".to_owned()
@@ -268,6 +285,14 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
         "    mount:\n      up_m: {}  # the fit's slope x a {:.2} m mean pedestrian\n      pitch_deg: {}  # puts the horizon {:.3} of the height from the top",
         f.up_m, f.person_height_m, f.pitch_deg, h.horizon
     );
+    if let Some(c) = m.camera_spread.filter(|_| f.mount_spread != (0.0, 0.0)) {
+        let (up, pitch) = f.mount_spread;
+        let _ = writeln!(
+            out,
+            "    mount_spread:  # per clip: {} videos fitted alone, horizon sd {:.3}, slope sd {:.3}\n      up_m: [{}, {}]\n      pitch_deg: [{}, {}]",
+            c.videos, c.horizon_sd, c.slope_sd, -up, up, -pitch, pitch
+        );
+    }
     let _ = writeln!(
         out,
         "crossing:\n  timeline:\n    in_view_before_crossing_s: [{}, {}]  # crossers annotated before crossing: p10 {:.1} s, median {:.1} s, p90 {:.1} s",

@@ -122,6 +122,8 @@ pub struct ClipInfo {
     pub split: String,
     pub fps: u32,
     pub frame_count: u32,
+    /// The clip's seed (what its per-clip camera mount is drawn from: `sim::rig::Camera::for_clip`).
+    pub seed: u64,
     /// The clip's weather parameters (CARLA's units: degrees and percentages).
     pub sun_altitude_deg: f64,
     pub sun_azimuth_deg: f64,
@@ -268,11 +270,11 @@ fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
         "wetness_pct",
         "wind_intensity_pct",
     ];
-    let mut cols = vec!["town", "weather", "split", "fps", "frame_count"];
+    let mut cols = vec!["town", "weather", "split", "fps", "frame_count", "seed"];
     cols.extend(WEATHER);
     for b in tables::read(&file, &cols)? {
         let (town, weather, split) = (b.strings("town")?, b.strings("weather")?, b.strings("split")?);
-        let (fps, frames) = (b.u32s("fps")?, b.u32s("frame_count")?);
+        let (fps, frames, seed) = (b.u32s("fps")?, b.u32s("frame_count")?, b.u64s("seed")?);
         let w: Vec<_> = WEATHER.iter().map(|c| b.f64s(c)).collect::<Result<_, _>>()?;
         if b.rows() > 0 {
             clip = Some(ClipInfo {
@@ -282,6 +284,7 @@ fn read_info(layout: &Layout, clip_id: &str) -> Result<ClipInfo, Error> {
                 split: split[0].to_owned(),
                 fps: fps.value(0),
                 frame_count: frames.value(0),
+                seed: seed.value(0),
                 sun_altitude_deg: w[0].value(0),
                 sun_azimuth_deg: w[1].value(0),
                 cloudiness_pct: w[2].value(0),

@@ -586,7 +586,6 @@ pub struct PieReport {
 /// Writes the PIE layout of `ds` into `out`.
 pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(String)) -> Result<PieReport, Error> {
     let videos = assign_videos(&ds.clips)?;
-    let camera = Camera::from_spec(&ds.spec.sensors.rgb);
     let towns = super::towns(ds, warn);
     for (_, sets) in SETS {
         for set in sets {
@@ -606,6 +605,7 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, warn: &mut dyn FnMut(Str
     for (info, v) in ds.clips.iter().zip(&videos) {
         let clip = &ds.load(info)?;
         let net = towns.get(&clip.town).map(|t| &t.network);
+        let camera = Camera::for_clip(&ds.spec.sensors.rgb, clip.info.seed);
         let (peds, vehicles) = write_video(out, clip, v, &camera, net)?;
         report.pedestrian_tracks += peds;
         report.vehicle_tracks += vehicles;

@@ -122,7 +122,6 @@ pub fn generate(
     let selected_count = (0..plan.len()).filter(|&i| selected(i)).count();
     let todo_count = (0..plan.len()).filter(|&i| todo(i)).count();
     let header = plan.header();
-    let rig = Rig::from_spec(&header.spec.sensors);
     let progress = if options.progress_json {
         Progress::json(todo_count)
     } else {
@@ -142,6 +141,7 @@ pub fn generate(
                     .script(i, towns)
                     .map_err(|p| Error::new(code::PLAN_INFEASIBLE, format!("the plan changed while generating: {p}")))
                     .and_then(|script| {
+                        let rig = Rig::for_clip(&header.spec.sensors, script.seed);
                         let counts = run_clip(header, &script, &towns[&script.town], &rig, &writer)?;
                         progress.clip_done(&script.clip_id, counts.frames);
                         Ok(counts)

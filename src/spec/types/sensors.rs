@@ -147,6 +147,31 @@ pub struct Rgb {
     pub fov_deg: f64,
     /// Mount at the driver's eye.
     pub mount: Mount,
+    /// How the mount differs from clip to clip, as real datasets are filmed from many cars: offsets drawn per
+    /// clip from its seed and added to `mount`. Off (`[0, 0]`) by default.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub mount_spread: MountSpread,
+}
+
+/// Per-clip offsets of the camera mount, each drawn uniformly from its range `[min, max]` with the clip's seed
+/// (`sim::rig::clip_mount`). JAAD's videos come from several cars and cameras: fitted per video, their horizons
+/// and camera heights scatter (`pedsynth calibrate` fits these ranges to a real dataset's spread).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct MountSpread {
+    /// Offset of the mount's height, metres `[min, max]`.
+    pub up_m: super::Range,
+    /// Offset of the mount's pitch, degrees `[min, max]` (negative looks down).
+    pub pitch_deg: super::Range,
+}
+
+impl Default for MountSpread {
+    fn default() -> Self {
+        MountSpread {
+            up_m: super::Range(0.0, 0.0),
+            pitch_deg: super::Range(0.0, 0.0),
+        }
+    }
 }
 
 impl Default for Rgb {
@@ -158,6 +183,7 @@ impl Default for Rgb {
             height_px: 720,
             fov_deg: 90.0,
             mount: Mount::default(),
+            mount_spread: MountSpread::default(),
         }
     }
 }

@@ -94,6 +94,33 @@ impl Validator<'_> {
             "a horizontal field of view in degrees",
         );
         self.mount("sensors.rgb.mount", &s.rgb.mount);
+        let spread = &s.rgb.mount_spread;
+        self.range(
+            "sensors.rgb.mount_spread.up_m",
+            spread.up_m,
+            -5.0,
+            5.0,
+            "a height offset in metres",
+        );
+        if spread.up_m.min() > -5.0 && s.rgb.mount.up_m + spread.up_m.min() < 0.1 {
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!(
+                    "`sensors.rgb.mount_spread.up_m` lowers the camera to {} m, below 0.1 m above the road",
+                    fmt_num(s.rgb.mount.up_m + spread.up_m.min())
+                ),
+            )
+            .at(self.span("sensors.rgb.mount_spread.up_m[0]"), "lowest offset")
+            .help("keep `mount.up_m` + `mount_spread.up_m[0]` at 0.1 m or more");
+            self.problems.push(problem);
+        }
+        self.range(
+            "sensors.rgb.mount_spread.pitch_deg",
+            spread.pitch_deg,
+            -45.0,
+            45.0,
+            "a pitch offset in degrees",
+        );
         let l = &s.lidar;
         self.num(
             "sensors.lidar.channels",
