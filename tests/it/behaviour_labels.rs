@@ -192,6 +192,7 @@ fn generate(out: &Path, extra: &[&str]) {
 }
 
 #[test]
+#[ignore = "slow (14 s in a debug build: two PedSynth++ datasets of 48 clips): cargo test -- --include-ignored"]
 fn behaviour_labels_agree_with_the_pose_the_camera_the_speed_and_the_state() {
     let scratch = common::Scratch::new("behaviour-labels");
     let (with, without) = (scratch.path().join("with"), scratch.path().join("without"));
