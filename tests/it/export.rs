@@ -52,10 +52,11 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
             ("pab-poses-jaad", "jaad"),
             ("seed-csv", "seed"),
             ("openscenario", "xosc"),
+            ("coco", "coco"),
         ] {
             let (code, stdout, stderr) = export(format, &ds, &out.join(layout));
             assert_eq!(code, Some(0), "{stderr}");
-            if ["pie", "jaad", "seed-csv"].contains(&format) {
+            if ["pie", "jaad", "seed-csv", "coco"].contains(&format) {
                 assert!(
                     stdout.contains("images absent: the dataset has no RGB stream"),
                     "{stdout}"
@@ -73,6 +74,7 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         "jaad/split_ids/default/val.txt",
         "xosc/towns/town01_like.xodr",
         "xosc/town01_like-clear_noon-0000.xosc",
+        "coco/annotations/train.json",
     ] {
         assert!(files.contains_key(file), "{file}: {:?}", files.keys());
     }
@@ -99,6 +101,32 @@ fn exports_are_reproducible_and_refuse_unfinished_or_altered_datasets() {
         "no duplicate (video_id, frame_id, pedestrian_id)"
     );
     assert!(rows.iter().all(|r| r.split(',').count() == width));
+    // COCO (tests/interop_coco.py runs pycocotools on it in CI): an image per frame, an annotation per annotated
+    // pedestrian-frame and cyclist-frame, no masks without an instance stream.
+    let coco: serde_json::Value = serde_json::from_slice(&files["coco/annotations/train.json"]).expect("json");
+    let frames: u32 = view.clips.iter().map(|c| c.frame_count).sum();
+    assert_eq!(coco["images"].as_array().expect("images").len(), frames as usize);
+    let cyclists: usize = view
+        .clips
+        .iter()
+        .map(|info| view.load(info).expect("loads"))
+        .map(|c| c.cyclists.iter().filter(|f| f.annotated).count())
+        .sum();
+    assert!(cyclists > 0, "the spec's cyclists are annotated somewhere");
+    let anns = coco["annotations"].as_array().expect("annotations");
+    assert_eq!(anns.len(), annotated + cyclists);
+    assert_eq!(anns.iter().filter(|a| a["category_id"] == 2).count(), cyclists);
+    assert!(
+        anns.iter()
+            .all(|a| a.get("segmentation").is_none() && a["iscrowd"] == 0)
+    );
+    let names: Vec<&str> = coco["categories"]
+        .as_array()
+        .expect("categories")
+        .iter()
+        .map(|c| c["name"].as_str().expect("name"))
+        .collect();
+    assert_eq!(names, ["pedestrian", "cyclist"]);
     // OpenSCENARIO: every entity's polyline, evaluated at every frame, is where the tables put it.
     for info in &view.clips {
         let clip = view.load(info).expect("loads");

@@ -101,7 +101,7 @@ pub struct VehicleFrame {
 }
 
 /// A cyclist in one frame: its pose, and its box of rider and bicycle where in view of the camera.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct CyclistFrame {
     pub frame: u32,
     pub cyclist: u32,
@@ -111,6 +111,10 @@ pub struct CyclistFrame {
     pub yaw_rad: f64,
     /// `[x1, y1, x2, y2]`, pixels.
     pub bbox: Option<[f64; 4]>,
+    /// In view and passing the pedestrians' visibility gate (the table's `annotated`).
+    pub annotated: bool,
+    /// The rider's keypoints as written (`u, v, flag` triplets); empty when not in view.
+    pub keypoints: Vec<f32>,
 }
 
 /// A clip's row of the `clips` table.
@@ -468,12 +472,30 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
     let cyclists = file("cyclists");
     if cyclists.is_file() {
         let cols = [
-            "frame", "cyclist", "in_view", "x_m", "y_m", "z_m", "yaw_rad", "x1", "y1", "x2", "y2",
+            "frame",
+            "cyclist",
+            "in_view",
+            "x_m",
+            "y_m",
+            "z_m",
+            "yaw_rad",
+            "x1",
+            "y1",
+            "x2",
+            "y2",
+            "annotated",
+            "keypoints",
         ];
         for b in tables::read(&cyclists, &cols)? {
             let (frame, cyclist, in_view) = (b.u32s("frame")?, b.u32s("cyclist")?, b.bools("in_view")?);
-            let v: Vec<_> = cols[3..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            let v: Vec<_> = cols[3..11].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            let (annotated, (kp, width)) = (b.bools("annotated")?, b.f32_lists("keypoints")?);
             for i in 0..b.rows() {
+                let keypoints = if in_view.value(i) {
+                    kp[i * width..(i + 1) * width].to_vec()
+                } else {
+                    Vec::new()
+                };
                 clip.cyclists.push(CyclistFrame {
                     frame: frame.value(i),
                     cyclist: cyclist.value(i),
@@ -484,6 +506,8 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                     bbox: in_view
                         .value(i)
                         .then(|| std::array::from_fn(|k| f64::from(v[4 + k].value(i)))),
+                    annotated: annotated.value(i),
+                    keypoints,
                 });
             }
         }

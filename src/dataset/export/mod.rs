@@ -6,11 +6,14 @@
 //! - [`pab`] — PedestrianActionBenchmark's pose pickles for the PIE or the JAAD export.
 //! - [`openscenario`] — one ASAM OpenSCENARIO 1.2 file per clip replaying its traces, with the towns as
 //!   OpenDRIVE beside them.
+//! - [`coco`] — COCO's detection, keypoint and instance-segmentation JSON per split, images linked
+//!   (pycocotools loads it).
 //! - [`seed_csv`] — the seed system's CSV layout (labels, 3D boxes, ego poses; per clip, weather, dataset).
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
 //! renamed, so an interrupted export leaves complete files only and re-running it finishes the job.
 
+pub mod coco;
 pub mod dataset;
 pub mod jaad;
 pub mod openscenario;
@@ -39,6 +42,8 @@ pub enum Format {
     SeedCsv,
     /// ASAM OpenSCENARIO 1.2: <clip_id>.xosc per clip replaying its traces, towns/<town>.xodr beside them.
     Openscenario,
+    /// COCO (pycocotools): annotations/<split>.json (boxes, keypoints, instance masks as RLE), images/.
+    Coco,
 }
 
 /// How images get into an export.
@@ -256,6 +261,20 @@ pub fn export(
                 r.vertices,
                 r.frames,
                 r.towns
+            )
+        }
+        Format::Coco => {
+            let r = coco::export(&ds, out, link)?;
+            format!(
+                "{}: COCO layout of {} clips: {} annotation files (annotations/<split>.json), {} images, {} \
+                 annotations, {} with a mask\n{}\n",
+                out.display(),
+                ds.clips.len(),
+                r.files,
+                r.images,
+                r.annotations,
+                r.masks,
+                r.images_note
             )
         }
         Format::PabPoses | Format::PabPosesJaad => {

@@ -146,6 +146,25 @@ const SKELETON: [(usize, usize); 16] = [
     (14, 16),
 ];
 
+/// A 16-bit grey PNG (the instance stream) as row-major values: width, height, values.
+pub(crate) fn read_u16_png(path: &Path) -> Result<(usize, usize, Vec<u16>), Error> {
+    let (w, h, bytes, colour, depth) = decode_png(path)?;
+    if colour != png::ColorType::Grayscale || depth != png::BitDepth::Sixteen {
+        return Err(Error::new(
+            code::DATASET_INVALID,
+            format!("{}: {colour:?} {depth:?}, not 16-bit grey", path.display()),
+        ));
+    }
+    Ok((
+        w,
+        h,
+        bytes
+            .chunks_exact(2)
+            .map(|b| u16::from_be_bytes([b[0], b[1]]))
+            .collect(),
+    ))
+}
+
 fn decode_png(path: &Path) -> Result<(usize, usize, Vec<u8>, png::ColorType, png::BitDepth), Error> {
     let file = std::fs::File::open(path).map_err(|e| Error::read(path, e))?;
     let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
