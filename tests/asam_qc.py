@@ -10,9 +10,11 @@ checks whatever the configuration lists), then the result file (.xqar) is read b
 qc_baselib. A file passes when the bundle reports zero issues and every checker completed; a checker may be
 skipped only because the rule does not apply to the file's declared standard version (that is how the bundles
 scope rules), and those are listed; for OpenDRIVE a copy declared 1.8 runs the 1.8-only rule, and every
-checker of the bundle must have completed on the file or its copy. Exits 1 on the first failing file, printing its issues.
+checker of the bundle must have completed on the file or its copy. Exits 1 on the first failing file (in the order
+given), printing its issues. Files are checked in parallel, one checker process per CPU.
 """
 
+import concurrent.futures
 import os
 import subprocess
 import sys
@@ -72,6 +74,7 @@ def main() -> None:
     kind, files = sys.argv[1], [a for a in sys.argv[2:] if a != "--quiet"]
     checks = 0
     with tempfile.TemporaryDirectory() as work:
+        jobs = []
         for path in files:
             copies = [path]
             if kind == "xodr":
@@ -83,19 +86,23 @@ def main() -> None:
                 with open(copy, "w") as f:
                     f.write(text.replace('revMinor="7"', 'revMinor="8"', 1))
                 copies.append(copy)
-            completed, all_ids = set(), set()
-            for p in copies:
-                problems, done, ids = check(kind, p, work)
-                if problems:
-                    print("\n".join(problems[:40]))
-                    sys.exit(f"{p}: {len(problems)} problems reported by ASAM's checker")
-                completed |= done
-                all_ids |= ids
-            if completed != all_ids:
-                sys.exit(f"{path}: checks that never ran: {sorted(all_ids - completed)}")
-            if VERBOSE:
-                print(f"{path}: all {len(all_ids)} checks of the bundle ran, zero issues")
-            checks = len(all_ids)
+            jobs.append((path, copies))
+        with concurrent.futures.ThreadPoolExecutor(max_workers=os.cpu_count() or 1) as pool:
+            results = {p: pool.submit(check, kind, p, work) for _, copies in jobs for p in copies}
+            for path, copies in jobs:
+                completed, all_ids = set(), set()
+                for p in copies:
+                    problems, done, ids = results[p].result()
+                    if problems:
+                        print("\n".join(problems[:40]))
+                        sys.exit(f"{p}: {len(problems)} problems reported by ASAM's checker")
+                    completed |= done
+                    all_ids |= ids
+                if completed != all_ids:
+                    sys.exit(f"{path}: checks that never ran: {sorted(all_ids - completed)}")
+                if VERBOSE:
+                    print(f"{path}: all {len(all_ids)} checks of the bundle ran, zero issues")
+                checks = len(all_ids)
     print(f"asam_qc: {len(files)} {kind} files, all {checks} checks of {BUNDLES[kind][0]} ran on each, zero issues")
 
 
