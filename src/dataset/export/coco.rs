@@ -18,27 +18,7 @@ use serde::Serialize;
 use super::dataset::{Clip, Dataset};
 use super::{LinkMode, RgbFiles, link_file, write_file};
 use crate::error::{Error, code};
-
-/// COCO's 17 person keypoints, in COCO's order.
-pub const KEYPOINT_NAMES: [&str; 17] = [
-    "nose",
-    "left_eye",
-    "right_eye",
-    "left_ear",
-    "right_ear",
-    "left_shoulder",
-    "right_shoulder",
-    "left_elbow",
-    "right_elbow",
-    "left_wrist",
-    "right_wrist",
-    "left_hip",
-    "right_hip",
-    "left_knee",
-    "right_knee",
-    "left_ankle",
-    "right_ankle",
-];
+use crate::sensors::body::{COCO17, OPENPOSE18_FROM_COCO17};
 
 /// COCO's person skeleton (1-based keypoint indices, as in `person_keypoints_*.json`).
 pub const SKELETON: [[u8; 2]; 19] = [
@@ -62,9 +42,6 @@ pub const SKELETON: [[u8; 2]; 19] = [
     [4, 6],
     [5, 7],
 ];
-
-/// For each COCO joint, its index in OpenPose-18 order (`annotations.pose_format: openpose18`).
-const COCO_FROM_OPENPOSE: [usize; 17] = [0, 14, 15, 16, 17, 5, 2, 6, 3, 7, 4, 11, 8, 12, 9, 13, 10];
 
 /// Category ids.
 pub const PEDESTRIAN: u32 = 1;
@@ -311,7 +288,7 @@ fn category(id: u32, name: &'static str) -> Category {
         id,
         name,
         supercategory: "person",
-        keypoints: KEYPOINT_NAMES,
+        keypoints: COCO17,
         skeleton: SKELETON,
     }
 }
@@ -397,8 +374,13 @@ fn coco_keypoints(ours: &[f32]) -> (Vec<f32>, u32) {
     let joints = ours.len() / 3;
     let mut out = Vec::with_capacity(51);
     let mut labelled = 0;
-    for (k, &openpose) in COCO_FROM_OPENPOSE.iter().enumerate() {
-        let j = if joints == 18 { openpose } else { k };
+    for k in 0..17 {
+        // OpenPose-18 (`annotations.pose_format: openpose18`) holds COCO joint k where its table says so.
+        let j = if joints == 18 {
+            OPENPOSE18_FROM_COCO17.iter().position(|&c| c == Some(k)).unwrap_or(k)
+        } else {
+            k
+        };
         match ours.get(3 * j..3 * j + 3) {
             Some(&[u, v, flag]) if flag >= 1.0 => {
                 out.extend([u, v, flag]);
