@@ -241,6 +241,18 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// One self-contained HTML page of a dataset's distributions (plots and labelled samples per weather, no
+    /// script, nothing loaded from elsewhere), with a second dataset beside it (--compare).
+    Report {
+        /// Dataset directory.
+        dir: PathBuf,
+        /// A second generated dataset to show beside the first.
+        #[arg(long, value_name = "DATASET")]
+        compare: Option<PathBuf>,
+        /// Output HTML file.
+        #[arg(long, value_name = "FILE.html")]
+        out: PathBuf,
+    },
     /// Check a dataset: manifest, completeness, every table's hash, metadata, schema, row counts and joins, and
     /// every sensor file's size and SHA-256; exit 0 when clean, 2 with the list of problems.
     Verify {
@@ -504,6 +516,7 @@ fn main() -> ExitCode {
                 &mut out,
             )
         }
+        Command::Report { dir, compare, out: to } => cli::report(&dir, compare.as_deref(), &to, &mut out),
         Command::Export {
             format,
             dir,

@@ -441,6 +441,12 @@ pub fn preview(
     emit(out, &text)
 }
 
+/// `pedsynth report DIR [--compare OTHER] --out FILE.html`: the dataset's distributions as one HTML page.
+pub fn report(dir: &Path, compare: Option<&Path>, to: &Path, out: &mut dyn Write) -> Result<(), Error> {
+    let text = crate::dataset::report::report(dir, compare, to)?;
+    emit(out, &text)
+}
+
 /// `pedsynth export FORMAT DIR --out OUT [--box tight|annotator]`: a finished dataset in a format other tools
 /// read (`--box` chooses the 2D box over the spec's `annotations.export_box`).
 pub fn export(

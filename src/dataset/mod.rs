@@ -8,6 +8,7 @@
 //! - [`verify`] — `pedsynth verify`: completeness, hashes, schemas, joins, sensor files.
 //! - [`export`] — a written dataset in other tools' layouts (PIE, JAAD, PedestrianActionBenchmark, the seed
 //!   system's CSV, OpenSCENARIO).
+//! - [`report`] — `pedsynth report`: a dataset's distributions (and another's beside them) as one HTML page.
 //! - [`calibrate`] — `pedsynth calibrate`: real annotations measured, a profile fitted, real against generated.
 //! - [`inputs`] — what a dataset is made from, read from disk: a spec's towns, the compiled plan, a plan file
 //!   checked against its spec.
@@ -17,5 +18,6 @@ pub mod export;
 pub mod generate;
 pub mod inputs;
 pub mod read;
+pub mod report;
 pub mod verify;
 pub mod write;

@@ -23,6 +23,7 @@ mod lidar;
 mod plan_file;
 mod planner;
 mod realise;
+mod report;
 mod shard;
 mod signals;
 mod sim_determinism;

@@ -146,6 +146,55 @@ const SKELETON: [(usize, usize); 16] = [
     (14, 16),
 ];
 
+/// A labelled thumbnail of one RGB frame of `clip` (the frame with the most annotated pedestrians, the earliest
+/// of those), at the preview's half resolution, as PNG bytes; `None` when the clip has no PNG RGB frames.
+pub fn thumbnail_png(dir: &Path, clip: &str) -> Result<Option<Vec<u8>>, Error> {
+    let layout = Layout::new(dir);
+    let labels = labels(&layout, clip)?;
+    let frames = frame_count(&layout, clip)?;
+    let best = (0..frames)
+        .max_by_key(|f| (labels.get(f).map_or(0, Vec::len), std::cmp::Reverse(*f)))
+        .unwrap_or(0);
+    if !layout.sensor_frame("rgb", clip, best, "png").is_file() {
+        return Ok(None);
+    }
+    let options = PreviewOptions {
+        clip: clip.to_owned(),
+        stream: Stream::Rgb,
+        out: PathBuf::new(),
+    };
+    let mut c = frame_canvas(&layout, &options, best, &[], None)?;
+    draw_labels(&mut c, labels.get(&best).map_or(&[], Vec::as_slice));
+    c.text(6, 6, &format!("{clip} frame {best}"), [255, 255, 255]);
+    // At most 400 px wide: the mean of each k × k block.
+    let k = c.w.div_ceil(400).max(1);
+    let (w, h) = (c.w / k, c.h / k);
+    let mut px = vec![0u8; w * h * 3];
+    for y in 0..h {
+        for x in 0..w {
+            for ch in 0..3 {
+                let mut sum = 0u32;
+                for dy in 0..k {
+                    for dx in 0..k {
+                        sum += u32::from(c.px[((y * k + dy) * c.w + x * k + dx) * 3 + ch]);
+                    }
+                }
+                px[(y * w + x) * 3 + ch] = (sum / (k * k) as u32) as u8;
+            }
+        }
+    }
+    png_bytes(
+        w,
+        h,
+        png::ColorType::Rgb,
+        png::BitDepth::Eight,
+        &px,
+        png::Filter::Adaptive,
+        None,
+    )
+    .map(Some)
+}
+
 /// A 16-bit grey PNG (the instance stream) as row-major values: width, height, values.
 pub(crate) fn read_u16_png(path: &Path) -> Result<(usize, usize, Vec<u16>), Error> {
     let (w, h, bytes, colour, depth) = decode_png(path)?;
