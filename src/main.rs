@@ -283,6 +283,10 @@ enum Command {
         /// dataset spec's `annotations.export_box`.
         #[arg(long = "box", value_enum)]
         export_box: Option<BoxArg>,
+        /// nuScenes: keyframes (samples, with boxes) per second of a clip; a keyframe every round(fps / HZ)
+        /// frames from frame 0.
+        #[arg(long, value_name = "HZ", default_value_t = 2.0, value_parser = positive_hz)]
+        keyframe_hz: f64,
     },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
@@ -291,6 +295,14 @@ enum Command {
         #[command(subcommand)]
         command: TownCommand,
     },
+}
+
+/// A rate above 0 Hz.
+fn positive_hz(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("`{s}` is not a rate above 0 Hz (nuScenes' own is 2)")),
+    }
 }
 
 /// Streams `preview` can show.
@@ -524,6 +536,7 @@ fn main() -> ExitCode {
             link,
             copy,
             export_box,
+            keyframe_hz,
         } => {
             let link = if copy {
                 pedsynth::dataset::export::LinkMode::Copy
@@ -534,7 +547,12 @@ fn main() -> ExitCode {
                 BoxArg::Tight => pedsynth::spec::types::ExportBox::Tight,
                 BoxArg::Annotator => pedsynth::spec::types::ExportBox::Annotator,
             });
-            cli::export(&dir, format, &to, (link, export_box), &mut out, &mut err)
+            let options = pedsynth::dataset::export::Options {
+                link,
+                export_box,
+                keyframe_hz,
+            };
+            cli::export(&dir, format, &to, &options, &mut out, &mut err)
         }
         Command::Merge {
             input,

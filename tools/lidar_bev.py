@@ -2,7 +2,7 @@
 """Reads a pedsynth dataset's LiDAR with pyarrow and numpy only, as DATASET.md's example does, and checks it
 independently of pedsynth's own reader: every point is registered into the world with the `sensor_poses` table
 (quaternion → matrix by hand, CARLA's y-right flipped), and every point tagged Pedestrian (12) of an annotated
-pedestrian must lie in that pedestrian's 3D box from the `annotations` table grown by 5 cm. Optionally writes the
+pedestrian must lie in that pedestrian's 3D box from the `annotations` table (1 mm for float rounding). Optionally writes the
 bird's-eye view of a frame pair coloured by tag as a PPM image.
 
 Usage: tools/lidar_bev.py DATASET [--image FILE.ppm]
@@ -68,7 +68,7 @@ def main():
             c, s = np.cos(ann["yaw_rad"][b]), np.sin(ann["yaw_rad"][b])
             d = world[i] - [ann["box3d_x_m"][b], ann["box3d_y_m"][b], ann["box3d_z_m"][b]]
             local = np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1], d[2]])
-            half = np.array([ann["box3d_length_m"][b], ann["box3d_width_m"][b], ann["box3d_height_m"][b]]) / 2 + 0.05
+            half = np.array([ann["box3d_length_m"][b], ann["box3d_width_m"][b], ann["box3d_height_m"][b]]) / 2 + 0.001
             checked += 1
             if (np.abs(local) > half).any():
                 outside += 1

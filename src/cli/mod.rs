@@ -453,7 +453,7 @@ pub fn export(
     dir: &Path,
     format: crate::dataset::export::Format,
     to: &Path,
-    how: (crate::dataset::export::LinkMode, Option<crate::spec::types::ExportBox>),
+    how: &crate::dataset::export::Options,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<(), Error> {

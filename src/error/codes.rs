@@ -90,6 +90,8 @@ pub mod code {
     pub const REAL_INVALID: &str = "pedsynth::calibrate::real_invalid";
     /// Options of `stats --protocol` that the protocol does not define.
     pub const PROTOCOL_OPTIONS: &str = "pedsynth::dataset::protocol_options";
+    /// Options of `export` that its format cannot use (a keyframe rate of 0 Hz, a clip the dataset does not have).
+    pub const EXPORT_OPTIONS: &str = "pedsynth::dataset::export_options";
     /// A file or directory that cannot be read.
     pub const IO_READ: &str = "pedsynth::io::read";
     /// A file or directory that cannot be written (disk full, permissions, read-only file system).
@@ -232,6 +234,10 @@ pub const CODES: &[CodeInfo] = &[
     input(
         code::PROTOCOL_OPTIONS,
         "`stats --protocol` options that the benchmark's sampling does not define (a track shorter than its windows)",
+    ),
+    input(
+        code::EXPORT_OPTIONS,
+        "`export` options that its format cannot use (a keyframe rate of 0 Hz, a clip the dataset does not have)",
     ),
     environment(code::IO_READ, "a file or directory cannot be read"),
     environment(

@@ -118,17 +118,20 @@ pub struct BodyPose {
 }
 
 impl BodyPose {
-    /// The 3D box around the silhouette, aligned with the body's yaw: its centre in the world and its extents
-    /// (length along the yaw, width, height), metres.
+    /// The 3D box around the rendered body (its capsules' meshes, which reach
+    /// [`CAPSULE_MESH_SCALE`](crate::sensors::scene::CAPSULE_MESH_SCALE) radii from their axes: every camera
+    /// pixel and LiDAR point of the body lies in it), aligned with the body's yaw: its centre in the world and
+    /// its extents (length along the yaw, width, height), metres.
     pub fn box3d(&self) -> (DVec3, DVec3) {
         let to_body = DMat3::from_rotation_z(-self.yaw_rad);
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        let scale = f64::from(crate::sensors::scene::CAPSULE_MESH_SCALE);
         for c in &self.capsules {
             for p in [c.a, c.b] {
                 let q = to_body * (p - self.ground);
-                lo = lo.min(q - DVec3::splat(c.radius_m));
-                hi = hi.max(q + DVec3::splat(c.radius_m));
+                lo = lo.min(q - DVec3::splat(c.radius_m * scale));
+                hi = hi.max(q + DVec3::splat(c.radius_m * scale));
             }
         }
         (

@@ -655,6 +655,12 @@ impl RoadNetwork {
         render::render_png(self, px_per_m, max_side_px)
     }
 
+    /// The surface mask of nuScenes' map: a grey PNG of `size_px` (width, height) at `m_per_px` whose bottom-left
+    /// corner is `origin` (north up), 255 where a lane of any type covers a pixel's centre, 0 elsewhere.
+    pub fn surface_mask_png(&self, origin: DVec2, m_per_px: f64, size_px: (usize, usize)) -> Vec<u8> {
+        render::surface_mask_png(self, origin, m_per_px, size_px)
+    }
+
     /// Centre-line points of a lane in the direction of travel (reference direction if undirected).
     pub fn lane_centre_line(&self, lane: u32) -> Vec<DVec2> {
         routes::lane_centre_line(self, lane)

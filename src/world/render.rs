@@ -36,14 +36,17 @@ const ORDER: [LaneType; 8] = [
 struct Canvas {
     w: usize,
     h: usize,
+    /// 3 (RGB) or 1 (grey: a colour's first channel).
+    channels: usize,
     px: Vec<u8>,
     xs: Vec<f64>,
 }
 
 impl Canvas {
     fn blend(&mut self, x: usize, y: usize, c: [u8; 3], alpha: f64) {
-        let i = (y * self.w + x) * 3;
-        for (dst, &src) in self.px[i..i + 3].iter_mut().zip(c.iter()) {
+        let n = self.channels;
+        let i = (y * self.w + x) * n;
+        for (dst, &src) in self.px[i..i + n].iter_mut().zip(c.iter()) {
             let old = *dst as f64;
             *dst = (old + (src as f64 - old) * alpha).round() as u8;
         }
@@ -154,6 +157,7 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
     let mut cv = Canvas {
         w,
         h,
+        channels: 3,
         px: Vec::with_capacity(w * h * 3),
         xs: Vec::new(),
     };
@@ -263,10 +267,14 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
     cv.rect(x0 + bar_px - 2, y0 - 2, x0 + bar_px, y0 + 12, [0, 0, 0]);
     cv.text(x0, y0 - 13, s, &label, [0, 0, 0]);
 
+    encode(&cv, png::ColorType::Rgb)
+}
+
+fn encode(cv: &Canvas, colour: png::ColorType) -> Vec<u8> {
     let mut out = Vec::new();
     {
-        let mut enc = png::Encoder::new(&mut out, w as u32, h as u32);
-        enc.set_color(png::ColorType::Rgb);
+        let mut enc = png::Encoder::new(&mut out, cv.w as u32, cv.h as u32);
+        enc.set_color(colour);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_compression(png::Compression::Fast);
         let mut wr = enc
@@ -277,4 +285,25 @@ pub(crate) fn render_png(net: &RoadNetwork, px_per_m: f64, max_side_px: u32) -> 
         wr.finish().expect("in-memory PNG finish cannot fail");
     }
     out
+}
+
+/// A grey PNG of `size_px` (width, height) whose pixel (i, j) covers the square of side `m_per_px` with its
+/// lower-left corner at `origin + (i, h − 1 − j) · m_per_px` (north up): 255 where a lane of any type (driving
+/// surface, sidewalk, median, …) covers the pixel's centre, 0 elsewhere — nuScenes' "semantic prior" map mask.
+pub(crate) fn surface_mask_png(net: &RoadNetwork, origin: DVec2, m_per_px: f64, size_px: (usize, usize)) -> Vec<u8> {
+    let (w, h) = size_px;
+    let mut cv = Canvas {
+        w,
+        h,
+        channels: 1,
+        px: vec![0; w * h],
+        xs: Vec::new(),
+    };
+    let to_px = |p: DVec2| DVec2::new((p.x - origin.x) / m_per_px, h as f64 - (p.y - origin.y) / m_per_px);
+    for lane in &net.lanes {
+        for p in &net.pieces[lane.pieces.start as usize..lane.pieces.end as usize] {
+            cv.fill(&p.corners.map(to_px), [255; 3], 1.0);
+        }
+    }
+    encode(&cv, png::ColorType::Grayscale)
 }

@@ -326,3 +326,227 @@ fn check_replay(clip: &pedsynth::dataset::export::dataset::Clip, xosc: &str) {
     let sun = doc.descendants().find(|n| n.has_tag_name("Sun")).unwrap();
     assert!((num(sun, "elevation") - clip.sun_altitude_deg.to_radians()).abs() < 1e-3);
 }
+
+/// nuScenes (tests/interop_nuscenes.py runs nuscenes-devkit on it in CI): a LiDAR-only dataset with cyclists
+/// exports to the same bytes twice; keyframes every 15 frames at 30 FPS; every annotated pedestrian of a
+/// keyframe has one box; tokens are unique and every `prev`/`next`/`first`/`last` token points at a record of
+/// its table; each `LIDAR_TOP` sample_data's ego pose and calibration compose to the `sensor_poses` row of its
+/// frame; a dataset without cameras or LiDAR is refused with exit 2, and so is `--keyframe-hz 0`.
+#[test]
+fn nuscenes_export_links_its_records_and_composes_the_sensor_poses() {
+    use serde_json::Value;
+    let tmp = common::Scratch::new("export-nuscenes");
+    let ds = tmp.path().join("ds");
+    let mut overrides = common::NO_CAMERAS.to_vec();
+    overrides.extend([
+        "traffic.cyclists.per_clip=[2, 2]",
+        "dataset.clips.count=1",
+        "dataset.clip_duration_s=[3, 3]",
+    ]);
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &overrides, &ds, None);
+    assert_eq!(code, 0, "{stderr}");
+    let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
+    for out in [&a, &b] {
+        let (code, stdout, stderr) = export("nuscenes", &ds, out);
+        assert_eq!(code, Some(0), "{stderr}");
+        assert!(stdout.contains("no CAM_FRONT"), "{stdout}");
+    }
+    let files = common::all_files(&a);
+    assert!(files == common::all_files(&b), "two exports of one dataset differ");
+    let table = |name: &str| -> Vec<Value> {
+        let bytes = &files[&format!("v1.0-pedsynth/{name}.json")];
+        serde_json::from_slice::<Value>(bytes)
+            .expect("json")
+            .as_array()
+            .expect("array")
+            .clone()
+    };
+    let tables: BTreeMap<&str, Vec<Value>> = [
+        "category",
+        "attribute",
+        "visibility",
+        "sensor",
+        "calibrated_sensor",
+        "ego_pose",
+        "log",
+        "scene",
+        "sample",
+        "sample_data",
+        "instance",
+        "sample_annotation",
+        "map",
+    ]
+    .into_iter()
+    .map(|t| (t, table(t)))
+    .collect();
+    let tokens: BTreeMap<&str, std::collections::BTreeSet<String>> = tables
+        .iter()
+        .map(|(t, rows)| {
+            (
+                *t,
+                rows.iter()
+                    .map(|r| r["token"].as_str().expect("token").to_owned())
+                    .collect(),
+            )
+        })
+        .collect();
+    for (t, rows) in &tables {
+        assert_eq!(tokens[t].len(), rows.len(), "{t}: tokens are unique");
+    }
+    let points_at = |table: &str, value: &Value| {
+        let v = value.as_str().expect("a token");
+        assert!(v.is_empty() || tokens[table].contains(v), "{v} is not a {table} token");
+    };
+    for r in &tables["sample"] {
+        points_at("sample", &r["prev"]);
+        points_at("sample", &r["next"]);
+        points_at("scene", &r["scene_token"]);
+    }
+    for r in &tables["sample_data"] {
+        points_at("sample_data", &r["prev"]);
+        points_at("sample_data", &r["next"]);
+        points_at("sample", &r["sample_token"]);
+        points_at("ego_pose", &r["ego_pose_token"]);
+        points_at("calibrated_sensor", &r["calibrated_sensor_token"]);
+        let file = r["filename"].as_str().expect("filename");
+        assert!(files.contains_key(file), "{file} is written");
+    }
+    for r in &tables["sample_annotation"] {
+        points_at("sample_annotation", &r["prev"]);
+        points_at("sample_annotation", &r["next"]);
+        points_at("sample", &r["sample_token"]);
+        points_at("instance", &r["instance_token"]);
+    }
+    for r in &tables["instance"] {
+        points_at("sample_annotation", &r["first_annotation_token"]);
+        points_at("sample_annotation", &r["last_annotation_token"]);
+        points_at("category", &r["category_token"]);
+    }
+    // Keyframes: frames 0, 15, ..., 75 of the 90-frame clip.
+    let view = pedsynth::dataset::export::dataset::Dataset::open(&ds).expect("opens");
+    let clip = view.load(&view.clips[0]).expect("loads");
+    assert_eq!(clip.frame_count, 90);
+    let samples = &tables["sample"];
+    assert_eq!(samples.len(), 6);
+    let stamps: Vec<u64> = samples.iter().map(|s| s["timestamp"].as_u64().expect("µs")).collect();
+    assert_eq!(stamps, [0, 500_000, 1_000_000, 1_500_000, 2_000_000, 2_500_000]);
+    // Each keyframe's pedestrians are the annotations table's; cyclists are there too.
+    let sample_frame: BTreeMap<&str, u32> = samples
+        .iter()
+        .map(|s| {
+            (
+                s["token"].as_str().expect("token"),
+                (s["timestamp"].as_u64().expect("µs") * 30 / 1_000_000) as u32,
+            )
+        })
+        .collect();
+    let instance: BTreeMap<&str, &Value> = tables["instance"]
+        .iter()
+        .map(|i| (i["token"].as_str().expect("t"), i))
+        .collect();
+    let mut boxed: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    let mut cyclist_boxes = 0;
+    for r in &tables["sample_annotation"] {
+        let inst = instance[r["instance_token"].as_str().expect("t")];
+        match inst["kind"].as_str() {
+            Some("pedestrian") => boxed
+                .entry(sample_frame[r["sample_token"].as_str().expect("t")])
+                .or_default()
+                .push(inst["id"].as_u64().expect("id") as u32),
+            Some("cyclist") => cyclist_boxes += 1,
+            _ => {}
+        }
+    }
+    for f in (0..90).step_by(15) {
+        let mut want: Vec<u32> = clip
+            .pedestrians
+            .values()
+            .filter(|p| p.frames.iter().any(|a| a.frame == f))
+            .map(|p| p.id)
+            .collect();
+        let mut got = boxed.remove(&f).unwrap_or_default();
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, want, "pedestrian boxes at keyframe {f}");
+    }
+    assert!(cyclist_boxes > 0, "the cyclists within 100 m have boxes");
+    // Ego pose ∘ calibration = the LiDAR's pose in sensor_poses (in the world: global + the map's origin).
+    let origin = &tables["map"][0]["world_origin_m"];
+    let origin = glam::DVec3::new(origin[0].as_f64().expect("x"), origin[1].as_f64().expect("y"), 0.0);
+    let pose_of = |v: &Value| {
+        let t = &v["translation"];
+        let q = &v["rotation"];
+        let f = |x: &Value| x.as_f64().expect("number");
+        glam::DAffine3::from_rotation_translation(
+            glam::DQuat::from_xyzw(f(&q[1]), f(&q[2]), f(&q[3]), f(&q[0])),
+            glam::DVec3::new(f(&t[0]), f(&t[1]), f(&t[2])),
+        )
+    };
+    let ego: BTreeMap<&str, &Value> = tables["ego_pose"]
+        .iter()
+        .map(|e| (e["token"].as_str().expect("t"), e))
+        .collect();
+    let calibrated = &tables["calibrated_sensor"];
+    assert_eq!(calibrated.len(), 1, "one LiDAR on one clip");
+    let lidar_poses = read_sensor_poses(&ds, &clip.clip_id, "lidar");
+    let mut compared = 0;
+    for r in &tables["sample_data"] {
+        let frame = (r["timestamp"].as_u64().expect("µs") * 30).div_ceil(1_000_000) as u32;
+        let global_from_sensor = pose_of(ego[r["ego_pose_token"].as_str().expect("t")]) * pose_of(&calibrated[0]);
+        let want = lidar_poses[&frame];
+        let got_t = global_from_sensor.translation + origin;
+        assert!(
+            (got_t - want.translation).length() < 1e-6,
+            "frame {frame}: {got_t} vs {}",
+            want.translation
+        );
+        assert!(
+            (global_from_sensor.matrix3 - want.matrix3)
+                .abs()
+                .to_cols_array()
+                .iter()
+                .all(|&d| d < 1e-9),
+            "frame {frame}: rotations differ"
+        );
+        compared += 1;
+    }
+    assert_eq!(compared, 6 + 5, "keyframes and the tick before each but the first");
+
+    // No cameras and no LiDAR: refused.
+    let bare = tmp.path().join("bare");
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.extend(["dataset.clips.count=1", "dataset.clip_duration_s=[1, 1]"]);
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &overrides, &bare, None);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, _, stderr) = export("nuscenes", &bare, &tmp.path().join("c"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("CAM_FRONT or LIDAR_TOP"), "{stderr}");
+    let (code, _, stderr) = pedsynth(&[
+        "export".as_ref(),
+        "nuscenes".as_ref(),
+        ds.as_os_str(),
+        "--out".as_ref(),
+        tmp.path().join("d").as_os_str(),
+        "--keyframe-hz".as_ref(),
+        "0".as_ref(),
+    ]);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("not a rate above 0 Hz"), "{stderr}");
+}
+
+/// A sensor's `world_from_sensor` by frame, from the `sensor_poses` table.
+fn read_sensor_poses(ds: &Path, clip: &str, sensor: &str) -> BTreeMap<u32, glam::DAffine3> {
+    let file = ds.join(format!("tables/sensor_poses/{clip}.parquet"));
+    let cols = ["frame", "sensor", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"];
+    let mut out = BTreeMap::new();
+    for b in pedsynth::dataset::read::tables::read(&file, &cols).expect("reads") {
+        let (f, s) = (b.u32s("frame").expect("frame"), b.strings("sensor").expect("sensor"));
+        let v: Vec<_> = cols[2..].iter().map(|c| b.f64s(c).expect("f64")).collect();
+        for i in (0..b.rows()).filter(|&i| s[i] == sensor) {
+            let q = glam::DQuat::from_xyzw(v[4].value(i), v[5].value(i), v[6].value(i), v[3].value(i));
+            let t = glam::DVec3::new(v[0].value(i), v[1].value(i), v[2].value(i));
+            out.insert(f.value(i), glam::DAffine3::from_rotation_translation(q.normalize(), t));
+        }
+    }
+    out
+}

@@ -90,7 +90,7 @@ pub struct EgoFrame {
 }
 
 /// One traffic vehicle in one frame.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct VehicleFrame {
     pub frame: u32,
     pub vehicle: u32,
@@ -98,6 +98,10 @@ pub struct VehicleFrame {
     pub y_m: f64,
     pub z_m: f64,
     pub yaw_rad: f64,
+    /// Speed along the heading, m/s.
+    pub speed_mps: f64,
+    /// `car`, `ambulance`, `fire_truck` or `police`.
+    pub kind: String,
 }
 
 /// A cyclist in one frame: its pose, and its box of rider and bicycle where in view of the camera.
@@ -109,8 +113,12 @@ pub struct CyclistFrame {
     pub y_m: f64,
     pub z_m: f64,
     pub yaw_rad: f64,
+    /// Speed along the heading, m/s.
+    pub speed_mps: f64,
     /// `[x1, y1, x2, y2]`, pixels.
     pub bbox: Option<[f64; 4]>,
+    /// Share of the rider's sample points hidden from the camera; `None` when not in view.
+    pub occlusion: Option<f32>,
     /// In view and passing the pedestrians' visibility gate (the table's `annotated`).
     pub annotated: bool,
     /// The rider's keypoints as written (`u, v, flag` triplets); empty when not in view.
@@ -453,11 +461,11 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
     for p in clip.pedestrians.values_mut() {
         p.frames.sort_by_key(|f| f.frame);
     }
-    let cols = ["frame", "vehicle", "x_m", "y_m", "z_m", "yaw_rad"];
+    let cols = ["frame", "vehicle", "x_m", "y_m", "z_m", "yaw_rad", "speed_mps", "kind"];
     for b in tables::read(&file("vehicles"), &cols)? {
-        let (frame, vehicle) = (b.u32s("frame")?, b.u32s("vehicle")?);
-        let v: Vec<_> = cols[2..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
-        for i in 0..b.rows() {
+        let (frame, vehicle, kind) = (b.u32s("frame")?, b.u32s("vehicle")?, b.strings("kind")?);
+        let v: Vec<_> = cols[2..7].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+        for (i, kind) in kind.iter().enumerate() {
             clip.vehicles.push(VehicleFrame {
                 frame: frame.value(i),
                 vehicle: vehicle.value(i),
@@ -465,6 +473,8 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                 y_m: f64::from(v[1].value(i)),
                 z_m: f64::from(v[2].value(i)),
                 yaw_rad: f64::from(v[3].value(i)),
+                speed_mps: f64::from(v[4].value(i)),
+                kind: (*kind).to_owned(),
             });
         }
     }
@@ -483,12 +493,14 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
             "y1",
             "x2",
             "y2",
+            "speed_mps",
+            "occlusion",
             "annotated",
             "keypoints",
         ];
         for b in tables::read(&cyclists, &cols)? {
             let (frame, cyclist, in_view) = (b.u32s("frame")?, b.u32s("cyclist")?, b.bools("in_view")?);
-            let v: Vec<_> = cols[3..11].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            let v: Vec<_> = cols[3..13].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
             let (annotated, (kp, width)) = (b.bools("annotated")?, b.f32_lists("keypoints")?);
             for i in 0..b.rows() {
                 let keypoints = if in_view.value(i) {
@@ -503,9 +515,11 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                     y_m: f64::from(v[1].value(i)),
                     z_m: f64::from(v[2].value(i)),
                     yaw_rad: f64::from(v[3].value(i)),
+                    speed_mps: f64::from(v[8].value(i)),
                     bbox: in_view
                         .value(i)
                         .then(|| std::array::from_fn(|k| f64::from(v[4 + k].value(i)))),
+                    occlusion: (in_view.value(i) && !v[9].is_null(i)).then(|| v[9].value(i)),
                     annotated: annotated.value(i),
                     keypoints,
                 });

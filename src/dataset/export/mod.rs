@@ -8,6 +8,8 @@
 //!   OpenDRIVE beside them.
 //! - [`coco`] — COCO's detection, keypoint and instance-segmentation JSON per split, images linked
 //!   (pycocotools loads it).
+//! - [`nuscenes`] — nuScenes' JSON tables, CAM_FRONT images, LIDAR_TOP `.pcd.bin` sweeps and map masks
+//!   (`nuscenes-devkit` loads it).
 //! - [`seed_csv`] — the seed system's CSV layout (labels, 3D boxes, ego poses; per clip, weather, dataset).
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
@@ -16,6 +18,7 @@
 pub mod coco;
 pub mod dataset;
 pub mod jaad;
+pub mod nuscenes;
 pub mod openscenario;
 pub mod pab;
 pub mod pie;
@@ -44,6 +47,29 @@ pub enum Format {
     Openscenario,
     /// COCO (pycocotools): annotations/<split>.json (boxes, keypoints, instance masks as RLE), images/.
     Coco,
+    /// nuScenes (nuscenes-devkit): v1.0-pedsynth/*.json, samples/ and sweeps/ (CAM_FRONT, LIDAR_TOP), maps/.
+    Nuscenes,
+}
+
+/// How an export runs: the options of `pedsynth export`.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// How images get into the export.
+    pub link: LinkMode,
+    /// Overrides the spec's `annotations.export_box`.
+    pub export_box: Option<crate::spec::types::ExportBox>,
+    /// nuScenes' keyframe rate, Hz.
+    pub keyframe_hz: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            link: LinkMode::Hard,
+            export_box: None,
+            keyframe_hz: 2.0,
+        }
+    }
 }
 
 /// How images get into an export.
@@ -202,9 +228,10 @@ pub fn export(
     dir: &Path,
     format: Format,
     out: &Path,
-    (link, export_box): (LinkMode, Option<crate::spec::types::ExportBox>),
+    options: &Options,
     warn: &mut dyn FnMut(String),
 ) -> Result<String, Error> {
+    let (link, export_box) = (options.link, options.export_box);
     let mut ds = dataset::Dataset::open(dir)?;
     // `--box` overrides the spec's `annotations.export_box`.
     if let Some(b) = export_box {
@@ -274,6 +301,26 @@ pub fn export(
                 r.images,
                 r.annotations,
                 r.masks,
+                r.images_note
+            )
+        }
+        Format::Nuscenes => {
+            let r = nuscenes::export(&ds, out, link, options.keyframe_hz)?;
+            format!(
+                "{}: nuScenes layout ({}) of {} clips: {} scenes, {} samples (a keyframe every {} frames), {} \
+                 sample_data ({} images, {} LiDAR sweeps), {} instances, {} box annotations, {} maps\n{}\n",
+                out.display(),
+                nuscenes::VERSION,
+                ds.clips.len(),
+                r.scenes,
+                r.samples,
+                r.keyframe_step,
+                r.sample_data,
+                r.images,
+                r.lidar_files,
+                r.instances,
+                r.annotations,
+                r.maps,
                 r.images_note
             )
         }

@@ -375,7 +375,7 @@ fn write_video(
         let vid = clip.vehicles[i].vehicle;
         let mut boxes = String::new();
         while i < clip.vehicles.len() && clip.vehicles[i].vehicle == vid {
-            let vf = clip.vehicles[i];
+            let vf = &clip.vehicles[i];
             i += 1;
             let Some(cam) = cameras.get(vf.frame as usize) else {
                 continue;
