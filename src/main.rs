@@ -246,9 +246,16 @@ enum Command {
     Report {
         /// Dataset directory.
         dir: PathBuf,
-        /// A second generated dataset to show beside the first.
-        #[arg(long, value_name = "DATASET")]
+        /// A second generated dataset, or real annotations (JAAD's or PIE's XML, or the table layout `calibrate`
+        /// reads), to show beside the first.
+        #[arg(long, value_name = "DATASET|REAL")]
         compare: Option<PathBuf>,
+        /// The layout of real annotations given to --compare (default: detected from the files).
+        #[arg(long, value_enum, requires = "compare")]
+        real_format: Option<RealFormat>,
+        /// The splits of real annotations to show (default: all the annotations have).
+        #[arg(long, value_delimiter = ',', requires = "compare")]
+        real_splits: Vec<String>,
         /// Output HTML file.
         #[arg(long, value_name = "FILE.html")]
         out: PathBuf,
@@ -270,7 +277,7 @@ enum Command {
         format: pedsynth::dataset::export::Format,
         /// Dataset directory (written by `pedsynth generate`, every clip done).
         dir: PathBuf,
-        /// Output directory (re-running resumes: complete files are kept).
+        /// Output directory (re-running resumes: complete files are kept); for `rerun`, the `.rrd` file.
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
         /// How images get there from the dataset's sensors/.
@@ -287,6 +294,9 @@ enum Command {
         /// frames from frame 0.
         #[arg(long, value_name = "HZ", default_value_t = 2.0, value_parser = positive_hz)]
         keyframe_hz: f64,
+        /// Rerun: the clip to record (`--out` is then the `.rrd` file).
+        #[arg(long, value_name = "ID")]
+        clip: Option<String>,
     },
     /// Print the spec language's JSON Schema (draft-07).
     Schema,
@@ -528,7 +538,21 @@ fn main() -> ExitCode {
                 &mut out,
             )
         }
-        Command::Report { dir, compare, out: to } => cli::report(&dir, compare.as_deref(), &to, &mut out),
+        Command::Report {
+            dir,
+            compare,
+            real_format,
+            real_splits,
+            out: to,
+        } => {
+            use pedsynth::dataset::calibrate::Format;
+            let real_format = real_format.map(|f| match f {
+                RealFormat::Jaad => Format::Jaad,
+                RealFormat::Pie => Format::Pie,
+                RealFormat::Table => Format::Table,
+            });
+            cli::report(&dir, compare.as_deref(), (real_format, &real_splits), &to, &mut out)
+        }
         Command::Export {
             format,
             dir,
@@ -537,6 +561,7 @@ fn main() -> ExitCode {
             copy,
             export_box,
             keyframe_hz,
+            clip,
         } => {
             let link = if copy {
                 pedsynth::dataset::export::LinkMode::Copy
@@ -551,6 +576,7 @@ fn main() -> ExitCode {
                 link,
                 export_box,
                 keyframe_hz,
+                clip,
             };
             cli::export(&dir, format, &to, &options, &mut out, &mut err)
         }

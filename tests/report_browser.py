@@ -1,6 +1,8 @@
 """CI (issue 45): `pedsynth report` in a real browser — headless Chromium (Debian's `chromium`), unmodified.
 
-Usage: python3 tests/report_browser.py DATASET [--compare OTHER] --pedsynth PATH [--keep DIR]
+Usage: python3 tests/report_browser.py DATASET [--compare OTHER [--real-splits S]] --pedsynth PATH [--keep DIR]
+
+OTHER is a second generated dataset or real annotations (`--real-splits` chooses their splits).
 
 Writes the report of DATASET (beside OTHER), then with Chromium:
 - loads it with console logging on: any console message fails (the page has no script, so a message can only
@@ -70,6 +72,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
     ap.add_argument("--compare")
+    ap.add_argument("--real-splits")
     ap.add_argument("--pedsynth", required=True)
     ap.add_argument("--keep", type=pathlib.Path)
     args = ap.parse_args()
@@ -80,6 +83,8 @@ def main():
         cmd = [args.pedsynth, "report", args.dataset, "--out", str(page)]
         if args.compare:
             cmd += ["--compare", args.compare]
+        if args.real_splits:
+            cmd += ["--real-splits", args.real_splits]
         subprocess.run(cmd, check=True)
         url = page.resolve().as_uri()
         common = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",

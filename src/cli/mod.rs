@@ -442,7 +442,29 @@ pub fn preview(
 }
 
 /// `pedsynth report DIR [--compare OTHER] --out FILE.html`: the dataset's distributions as one HTML page.
-pub fn report(dir: &Path, compare: Option<&Path>, to: &Path, out: &mut dyn Write) -> Result<(), Error> {
+/// `pedsynth report DIR [--compare DATASET|REAL] --out FILE.html`: `--compare` names a generated dataset (it has a
+/// manifest) or real annotations, whose layout is `real.0` or detected.
+pub fn report(
+    dir: &Path,
+    compare: Option<&Path>,
+    real: (Option<crate::dataset::calibrate::Format>, &[String]),
+    to: &Path,
+    out: &mut dyn Write,
+) -> Result<(), Error> {
+    use crate::dataset::report::{Compare, detect_real_format};
+    let compare = compare.map(|other| {
+        if other.join("manifest.json").is_file() {
+            Compare::Dataset(other)
+        } else if let Some(format) = real.0.or_else(|| detect_real_format(other)) {
+            Compare::Real {
+                dir: other,
+                format,
+                splits: real.1,
+            }
+        } else {
+            Compare::Dataset(other)
+        }
+    });
     let text = crate::dataset::report::report(dir, compare, to)?;
     emit(out, &text)
 }

@@ -117,16 +117,20 @@ pub struct BodyPose {
     pub gaze: DVec3,
 }
 
+/// A capsule's mesh (`sensors::scene`) puts its vertices this many radii from its axis (so that the polygon's
+/// silhouette matches the capsule's on average): what the cameras and the LiDAR see reaches this far, and the
+/// 3D boxes ([`BodyPose::box3d`]) do too.
+pub const CAPSULE_MESH_SCALE: f32 = 1.04;
+
 impl BodyPose {
-    /// The 3D box around the rendered body (its capsules' meshes, which reach
-    /// [`CAPSULE_MESH_SCALE`](crate::sensors::scene::CAPSULE_MESH_SCALE) radii from their axes: every camera
-    /// pixel and LiDAR point of the body lies in it), aligned with the body's yaw: its centre in the world and
+    /// The 3D box around the rendered body (its capsules' meshes, which reach [`CAPSULE_MESH_SCALE`] radii from
+    /// their axes: every camera pixel and LiDAR point of the body lies in it), aligned with the body's yaw: its centre in the world and
     /// its extents (length along the yaw, width, height), metres.
     pub fn box3d(&self) -> (DVec3, DVec3) {
         let to_body = DMat3::from_rotation_z(-self.yaw_rad);
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        let scale = f64::from(crate::sensors::scene::CAPSULE_MESH_SCALE);
+        let scale = f64::from(CAPSULE_MESH_SCALE);
         for c in &self.capsules {
             for p in [c.a, c.b] {
                 let q = to_body * (p - self.ground);

@@ -488,7 +488,7 @@ fn contrast(img: &CameraImages, range: std::ops::Range<f32>) -> f64 {
         .rgb
         .chunks_exact(3)
         .zip(&img.depth_m)
-        .filter(|(_, d)| range.contains(d))
+        .filter(|&(_, &d)| range.contains(&d))
         .map(|(p, _)| f64::from(luminance(p)))
         .collect();
     let m = l.iter().sum::<f64>() / l.len() as f64;

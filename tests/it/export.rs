@@ -532,6 +532,23 @@ fn nuscenes_export_links_its_records_and_composes_the_sensor_poses() {
     ]);
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("not a rate above 0 Hz"), "{stderr}");
+    // Rerun records one clip: without --clip, or with one the dataset does not have, exit 2 naming its clips
+    // (with or without the `rerun` feature; tests/interop_rerun.py reads a recording in CI).
+    for clip in [None, Some("no_such_clip")] {
+        let mut args: Vec<&std::ffi::OsStr> = vec![
+            "export".as_ref(),
+            "rerun".as_ref(),
+            ds.as_os_str(),
+            "--out".as_ref(),
+            "x.rrd".as_ref(),
+        ];
+        if let Some(c) = clip {
+            args.extend([std::ffi::OsStr::new("--clip"), std::ffi::OsStr::new(c)]);
+        }
+        let (code, _, stderr) = pedsynth(&args);
+        assert_eq!(code, Some(2), "{stderr}");
+        assert!(stderr.contains(&view.clips[0].clip_id), "{stderr}");
+    }
 }
 
 /// A sensor's `world_from_sensor` by frame, from the `sensor_poses` table.

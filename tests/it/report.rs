@@ -111,3 +111,52 @@ fn a_report_is_one_offline_page_with_every_plot_and_a_sample_per_weather() {
     assert!(stderr.contains("not generated yet"), "{stderr}");
     assert!(!tmp.path().join("y.html").exists());
 }
+
+/// `--compare` with real annotations (JAAD's train split, ../shared/real): the real data's boxes, crossing
+/// ratio, time in view before crossing and benchmark windows beside the dataset's, the simulation-only plots
+/// marked absent for it, and the crossing ratio in the table the one `calibrate`'s reader gives.
+#[test]
+#[ignore = "reads JAAD's annotations in ../shared/real"]
+fn a_report_compares_a_dataset_with_real_annotations() {
+    let tmp = common::Scratch::new("report-real");
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+    let ds = tmp.path().join("ds");
+    let (code, _, stderr) = common::generate(&spec, &common::NO_SENSORS, &ds, None);
+    assert_eq!(code, 0, "{stderr}");
+    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/real/jaad_trainval");
+    let out = tmp.path().join("report.html");
+    let (code, stdout, stderr) = common::pedsynth(&[
+        "report".as_ref(),
+        ds.as_os_str(),
+        "--compare".as_ref(),
+        real.as_os_str(),
+        "--real-splits".as_ref(),
+        "train".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("against real: jaad_trainval"), "{stdout}");
+    let html = std::fs::read_to_string(&out).expect("report");
+    // Every plot has the real series in its legend; four plots say the real data do not have them.
+    let legends = html.matches("real: jaad_trainval</text>").count()
+        + html.matches("real: jaad_trainval achieved</text>").count();
+    assert_eq!(legends, TITLES.len(), "a legend entry per plot");
+    assert_eq!(html.matches("real: jaad_trainval: not in real annotations").count(), 4);
+    // The table's achieved crossing ratio of the real data is calibrate's reader's crossers / tracks.
+    let videos = pedsynth::dataset::calibrate::read_real(
+        &real,
+        pedsynth::dataset::calibrate::Format::Table,
+        &["train".to_owned()],
+    )
+    .expect("reads");
+    let tracks: Vec<_> = videos.iter().flat_map(|v| &v.tracks).collect();
+    let crossers = tracks.iter().filter(|t| t.crosser).count();
+    let want = format!("<td>{:.3}</td></tr>", crossers as f64 / tracks.len() as f64);
+    let row = html
+        .lines()
+        .find(|l| l.starts_with("<tr><th>crossing ratio (achieved)"))
+        .expect("the row");
+    assert!(row.ends_with(&want), "{row} vs {want}");
+    assert!(!html.contains(tmp.path().to_str().expect("utf-8")));
+}

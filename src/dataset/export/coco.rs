@@ -370,7 +370,7 @@ impl FrameAnnotations {
 
 /// Our keypoints (COCO-17 or OpenPose-18 `u, v, flag`) as COCO's 51 values and `num_keypoints`: joints not
 /// in the image are `0, 0, 0`.
-fn coco_keypoints(ours: &[f32]) -> (Vec<f32>, u32) {
+pub(crate) fn coco_keypoints(ours: &[f32]) -> (Vec<f32>, u32) {
     let joints = ours.len() / 3;
     let mut out = Vec::with_capacity(51);
     let mut labelled = 0;

@@ -263,7 +263,43 @@ impl Dataset {
     }
 }
 
+/// Rotation taking a camera's optical axes (x right, y down, z forward) to its sensor axes (x forward, y left,
+/// z up).
+pub const SENSOR_FROM_OPTICAL: glam::DMat3 = glam::DMat3::from_cols(
+    glam::DVec3::new(0.0, -1.0, 0.0), // optical x (right) → sensor −y
+    glam::DVec3::new(0.0, 0.0, -1.0), // optical y (down) → sensor −z
+    glam::DVec3::new(1.0, 0.0, 0.0),  // optical z (forward) → sensor x
+);
+
 impl Dataset {
+    /// Each sensor's pose on the ego (`ego_from_sensor`, sensor axes x forward, y left, z up), by sensor name
+    /// (`camera`, `lidar`), from the `sensor_poses` table at frame 0 and the ego's pose there (mounts are rigid:
+    /// the ego only moves and turns).
+    pub fn sensor_mounts(&self, clip: &Clip) -> Result<BTreeMap<String, glam::DAffine3>, Error> {
+        use glam::{DAffine3, DQuat, DVec3};
+        let e = clip
+            .ego
+            .first()
+            .ok_or_else(|| refuse(format!("clip `{}`: no frames", clip.clip_id)))?;
+        let ego_from_world = crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad).inverse();
+        let mut out = BTreeMap::new();
+        let cols = ["frame", "sensor", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"];
+        for b in tables::read(&self.layout.table("sensor_poses", &clip.clip_id), &cols)? {
+            let (f, s) = (b.u32s("frame")?, b.strings("sensor")?);
+            let c = [b.f64s("x_m")?, b.f64s("y_m")?, b.f64s("z_m")?];
+            let q = [b.f64s("qw")?, b.f64s("qx")?, b.f64s("qy")?, b.f64s("qz")?];
+            for i in (0..b.rows()).filter(|&i| f.value(i) == 0) {
+                let rot = DQuat::from_xyzw(q[1].value(i), q[2].value(i), q[3].value(i), q[0].value(i)).normalize();
+                let at = DVec3::new(c[0].value(i), c[1].value(i), c[2].value(i));
+                out.insert(
+                    s[i].to_owned(),
+                    ego_from_world * DAffine3::from_rotation_translation(rot, at),
+                );
+            }
+        }
+        Ok(out)
+    }
+
     /// A clip's tables, with the 2D box `annotations.export_box` chooses as `bbox_px`.
     pub fn load(&self, info: &ClipInfo) -> Result<Clip, Error> {
         read_clip(&self.layout, info.clone(), self.spec.annotations.export_box)

@@ -10,6 +10,7 @@
 //!   (pycocotools loads it).
 //! - [`nuscenes`] — nuScenes' JSON tables, CAM_FRONT images, LIDAR_TOP `.pcd.bin` sweeps and map masks
 //!   (`nuscenes-devkit` loads it).
+//! - `rerun` (the `rerun` cargo feature) — one clip as a Rerun recording (`.rrd`), with Rerun's own SDK.
 //! - [`seed_csv`] — the seed system's CSV layout (labels, 3D boxes, ego poses; per clip, weather, dataset).
 //!
 //! Exporters read the written dataset, never the simulator; every file is written under a temporary name and
@@ -22,6 +23,8 @@ pub mod nuscenes;
 pub mod openscenario;
 pub mod pab;
 pub mod pie;
+#[cfg(feature = "rerun")]
+pub mod rerun;
 pub mod seed_csv;
 
 use std::collections::BTreeMap;
@@ -49,6 +52,8 @@ pub enum Format {
     Coco,
     /// nuScenes (nuscenes-devkit): v1.0-pedsynth/*.json, samples/ and sweeps/ (CAM_FRONT, LIDAR_TOP), maps/.
     Nuscenes,
+    /// One clip (`--clip ID`) as a Rerun recording: `--out CLIP.rrd` (needs the `rerun` cargo feature).
+    Rerun,
 }
 
 /// How an export runs: the options of `pedsynth export`.
@@ -60,6 +65,8 @@ pub struct Options {
     pub export_box: Option<crate::spec::types::ExportBox>,
     /// nuScenes' keyframe rate, Hz.
     pub keyframe_hz: f64,
+    /// The clip to export (Rerun).
+    pub clip: Option<String>,
 }
 
 impl Default for Options {
@@ -68,6 +75,7 @@ impl Default for Options {
             link: LinkMode::Hard,
             export_box: None,
             keyframe_hz: 2.0,
+            clip: None,
         }
     }
 }
@@ -237,6 +245,9 @@ pub fn export(
     if let Some(b) = export_box {
         ds.spec.annotations.export_box = b;
     }
+    if format == Format::Rerun {
+        return export_rerun(&ds, options.clip.as_deref(), out);
+    }
     std::fs::create_dir_all(out).map_err(|e| Error::write(out, e))?;
     Ok(match format {
         Format::Pie => {
@@ -324,6 +335,7 @@ pub fn export(
                 r.images_note
             )
         }
+        Format::Rerun => unreachable!("handled above"),
         Format::PabPoses | Format::PabPosesJaad => {
             let r = pab::export(&ds, out, format == Format::PabPosesJaad)?;
             format!(
@@ -335,4 +347,57 @@ pub fn export(
             )
         }
     })
+}
+
+/// `export rerun`: the clip `--clip` names into the `.rrd` file `out`.
+fn export_rerun(ds: &dataset::Dataset, clip: Option<&str>, out: &Path) -> Result<String, Error> {
+    let names = || {
+        ds.clips
+            .iter()
+            .map(|c| c.clip_id.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let Some(clip) = clip else {
+        return Err(Error::new(
+            crate::error::code::EXPORT_OPTIONS,
+            format!(
+                "export rerun writes one clip: add --clip ID (the dataset's clips: {})",
+                names()
+            ),
+        ));
+    };
+    if !ds.clips.iter().any(|c| c.clip_id == clip) {
+        return Err(Error::new(
+            crate::error::code::EXPORT_OPTIONS,
+            format!(
+                "--clip {clip}: no such clip in {}; its clips are: {}",
+                ds.layout.root().display(),
+                names()
+            ),
+        ));
+    }
+    #[cfg(feature = "rerun")]
+    {
+        let r = rerun::export(ds, clip, out)?;
+        let rows: u64 = r.rows.values().sum();
+        Ok(format!(
+            "{}: Rerun recording of clip {clip}: {} frames, {} entities, {} rows (open it with `rerun {}`)\n",
+            out.display(),
+            r.frames,
+            r.rows.len(),
+            rows,
+            out.display()
+        ))
+    }
+    #[cfg(not(feature = "rerun"))]
+    {
+        let _ = (clip, out);
+        Err(Error::new(
+            crate::error::code::EXPORT_OPTIONS,
+            "this pedsynth was built without Rerun's SDK: build it with `cargo build --release --features rerun` \
+             (the `rerun` feature adds Rerun's ~480 crates to the build)"
+                .to_owned(),
+        ))
+    }
 }

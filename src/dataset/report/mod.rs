@@ -1,5 +1,8 @@
 //! `pedsynth report DATASET [--compare OTHER] --out report.html`: one self-contained HTML page that shows a
-//! finished dataset's distributions as plots, and another dataset's beside them.
+//! finished dataset's distributions as plots, and another's beside them: a second generated dataset, or real
+//! annotations (JAAD's or PIE's XML, or the table layout `calibrate` reads), whose boxes, crossing ratio, time
+//! in view before crossing and benchmark windows are drawn beside ours (the rest is simulation-only and shown
+//! as absent).
 //!
 //! - [`svg`] — the grouped bar charts, inline SVG.
 //!
@@ -35,12 +38,31 @@ pub const TITLES: [&str; 10] = [
     "Sensor and table sizes",
 ];
 
+/// The plots of quantities only a simulation has (states, archetypes, ground speeds, sensor sizes): real
+/// annotations are shown absent from them.
+const SIMULATION_ONLY: [bool; 10] = [false, true, true, true, false, false, false, false, false, true];
+
 /// The title of the per-weather samples.
 pub const SAMPLES_TITLE: &str = "Samples per weather";
+
+/// What to compare a dataset with.
+#[derive(Clone, Debug)]
+pub enum Compare<'a> {
+    /// A second generated dataset.
+    Dataset(&'a Path),
+    /// Real annotations in a layout `calibrate` reads, keeping the videos of `splits` (all if empty).
+    Real {
+        dir: &'a Path,
+        format: crate::dataset::calibrate::Format,
+        splits: &'a [String],
+    },
+}
 
 /// What the report reads from one dataset.
 struct Summary {
     name: String,
+    /// Real annotations (not a generated dataset).
+    real: bool,
     version: String,
     stats: stats::DatasetStats,
     pab: protocol::PabStats,
@@ -87,6 +109,7 @@ fn summarise(dir: &Path) -> Result<Summary, Error> {
     );
     let mut summary = Summary {
         name: ds.spec.dataset.name.clone(),
+        real: false,
         version: ds.manifest.pedsynth_version.clone(),
         stats,
         pab,
@@ -150,23 +173,131 @@ fn ratio(a: u64, b: u64) -> f64 {
     if b == 0 { 0.0 } else { a as f64 / b as f64 }
 }
 
+/// The real annotations' layout in `dir` as `calibrate` reads it: the table layout where `boxes.parquet` or
+/// `boxes.csv` is, PIE's XML where `annotations/` holds set folders, JAAD's XML where it holds `.xml` files.
+pub fn detect_real_format(dir: &Path) -> Option<crate::dataset::calibrate::Format> {
+    use crate::dataset::calibrate::Format;
+    if dir.join("boxes.parquet").is_file() || dir.join("boxes.csv").is_file() {
+        return Some(Format::Table);
+    }
+    let entries: Vec<_> = std::fs::read_dir(dir.join("annotations")).ok()?.flatten().collect();
+    if entries.iter().any(|e| e.path().is_dir()) {
+        Some(Format::Pie)
+    } else if entries.iter().any(|e| e.path().extension().is_some_and(|x| x == "xml")) {
+        Some(Format::Jaad)
+    } else {
+        None
+    }
+}
+
+/// The summary of real annotations: their videos' boxes, crossers, time in view before the crossing point and
+/// PedestrianActionBenchmark windows (no states, archetypes, speeds, sensors or samples: the plots show them
+/// empty for it).
+fn summarise_real(dir: &Path, format: crate::dataset::calibrate::Format, splits: &[String]) -> Result<Summary, Error> {
+    use crate::dataset::calibrate::{measure, read_real};
+    let videos = read_real(dir, format, splits)?;
+    let name = format!(
+        "real: {}",
+        dir.file_name()
+            .map_or_else(|| dir.display().to_string(), |n| n.to_string_lossy().into_owned())
+    );
+    let mut stats = stats::DatasetStats::default();
+    let mut summary = Summary {
+        name,
+        real: true,
+        version: "(real annotations)".to_owned(),
+        stats: stats::DatasetStats::default(),
+        pab: protocol::PabStats {
+            options: protocol::PabOptions::default(),
+            stride: 0,
+            splits: BTreeMap::new(),
+            all: protocol::SplitProtocol::default(),
+            target_crossing_ratio: None,
+        },
+        speeds_mps: Vec::new(),
+        seen_before_crossing_s: Vec::new(),
+        box_height: Vec::new(),
+        box_bottom: Vec::new(),
+        box_centre: Vec::new(),
+        sizes: BTreeMap::new(),
+        samples: Vec::new(),
+    };
+    let options = protocol::PabOptions::default();
+    let mut by_split: BTreeMap<String, Vec<crate::dataset::calibrate::real::RealVideo>> = BTreeMap::new();
+    for v in &videos {
+        let split = stats.splits.entry(v.split.clone()).or_default();
+        split.clips += 1;
+        let frames = v
+            .tracks
+            .iter()
+            .flat_map(|t| t.boxes.iter().map(|b| u64::from(b.frame) + 1))
+            .max()
+            .unwrap_or(0);
+        split.frames += frames;
+        stats.clips += 1;
+        stats.frames += frames;
+        for t in &v.tracks {
+            split.pedestrians += 1;
+            split.samples += t.boxes.len() as u64;
+            stats.pedestrians += 1;
+            stats.annotated_samples += t.boxes.len() as u64;
+            if t.crosser {
+                split.crossers += 1;
+                stats.crossing += 1;
+            }
+            if let (Some(first), Some(cross)) = (t.boxes.first(), t.crossing_frame)
+                && first.frame <= cross
+            {
+                summary
+                    .seen_before_crossing_s
+                    .push(f64::from(cross - first.frame) / v.fps.max(1.0));
+            }
+            for b in &t.boxes {
+                summary.box_height.push((b.y_max_px - b.y_min_px) / v.height_px);
+                summary.box_bottom.push(b.y_max_px / v.height_px);
+                summary.box_centre.push((b.x_min_px + b.x_max_px) / 2.0 / v.width_px);
+            }
+        }
+        by_split.entry(v.split.clone()).or_default().push(v.clone());
+    }
+    stats.achieved_crossing_ratio = ratio(stats.crossing, stats.pedestrians);
+    for (split, vs) in by_split {
+        let mut p = protocol::SplitProtocol::default();
+        for w in measure::windows(&vs, &options) {
+            if w.crosser {
+                p.crossing.windows += 1;
+            } else {
+                p.not_crossing.windows += 1;
+            }
+        }
+        summary.pab.splits.insert(split, p);
+    }
+    summary.stats = stats;
+    Ok(summary)
+}
+
 /// Writes the report of `dir` (with `compare` beside it) to `out`; returns the line to print.
-pub fn report(dir: &Path, compare: Option<&Path>, out: &Path) -> Result<String, Error> {
-    if let Some(other) = compare
+pub fn report(dir: &Path, compare: Option<Compare<'_>>, out: &Path) -> Result<String, Error> {
+    if let Some(Compare::Dataset(other)) = &compare
         && !other.join("manifest.json").is_file()
     {
         return Err(refuse(format!(
-            "{}: not a pedsynth dataset (no manifest.json); --compare takes a generated dataset",
+            "{}: not a pedsynth dataset (no manifest.json), nor real annotations `calibrate` reads (JAAD's or PIE's \
+             XML, or boxes.parquet/boxes.csv); name their layout with --real-format",
             other.display()
         )));
     }
     let mut summaries = vec![summarise(dir)?];
-    if let Some(other) = compare {
-        let mut s = summarise(other)?;
-        if s.name == summaries[0].name {
-            s.name = format!("{} (compared)", s.name);
+    match compare {
+        Some(Compare::Dataset(other)) => {
+            let mut s = summarise(other)?;
+            if s.name == summaries[0].name {
+                s.name = format!("{} (compared)", s.name);
+            }
+            summaries.push(s);
         }
-        summaries.push(s);
+        Some(Compare::Real { dir, format, splits }) => summaries.push(summarise_real(dir, format, splits)?),
+        None => {}
     }
     let html = page(&summaries);
     crate::util::files::write_atomically(out, html.as_bytes()).map_err(|e| Error::write(out, e))?;
@@ -386,7 +517,13 @@ fn page(summaries: &[Summary]) -> String {
         ("crossing ratio (achieved)", &|s| {
             format!("{:.3}", s.stats.achieved_crossing_ratio)
         }),
-        ("weathers", &|s| escape(&s.stats.weathers.join(", "))),
+        ("weathers", &|s| {
+            if s.real {
+                "n/a".to_owned()
+            } else {
+                escape(&s.stats.weathers.join(", "))
+            }
+        }),
     ];
     for (label, value) in rows {
         let _ = write!(h, "<tr><th>{label}</th>");
@@ -396,12 +533,25 @@ fn page(summaries: &[Summary]) -> String {
         h.push_str("</tr>\n");
     }
     h.push_str("</table>\n");
-    for (title, plot) in TITLES.iter().zip(&plots) {
-        let _ = writeln!(h, "<section><h2>{}</h2>{plot}</section>", escape(title));
+    for ((title, plot), simulation_only) in TITLES.iter().zip(&plots).zip(SIMULATION_ONLY) {
+        let absent: Vec<String> = summaries
+            .iter()
+            .filter(|s| s.real && simulation_only)
+            .map(|s| format!("<p>{}: not in real annotations</p>", escape(&s.name)))
+            .collect();
+        let _ = writeln!(
+            h,
+            "<section><h2>{}</h2>{plot}{}</section>",
+            escape(title),
+            absent.concat()
+        );
     }
     let _ = writeln!(h, "<h2>{SAMPLES_TITLE}</h2>");
     for s in summaries {
         let _ = writeln!(h, "<h3>{}</h3><div>", escape(&s.name));
+        if s.real {
+            h.push_str("<p>real annotations: no images</p>");
+        }
         for (weather, clip, png) in &s.samples {
             match png {
                 Some(bytes) => {

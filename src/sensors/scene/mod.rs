@@ -31,11 +31,6 @@ use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::util::mix::splitmix64;
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
 
-/// A capsule's mesh puts its vertices this many radii from its axis (so that the polygon's silhouette matches
-/// the capsule's on average): what the cameras and the LiDAR see reaches this far, and the 3D boxes
-/// (`BodyPose::box3d`) do too.
-pub const CAPSULE_MESH_SCALE: f32 = 1.04;
-
 pub use frame::*;
 pub use paint::*;
 pub use town::*;
@@ -307,7 +302,7 @@ impl Mesh {
     pub fn capsule(&mut self, c: &SceneCapsule, prim: u32) {
         const N: usize = 8;
         // Vertices sit slightly outside the surface so the polygon's silhouette matches the capsule's on average.
-        let r = c.radius_m * CAPSULE_MESH_SCALE;
+        let r = c.radius_m * crate::sensors::body::CAPSULE_MESH_SCALE;
         let d = c.b - c.a;
         let axis = if d.length_squared() > 1e-10 {
             d.normalize()

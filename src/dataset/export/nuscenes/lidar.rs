@@ -22,7 +22,7 @@ pub(super) fn ring(l: &crate::spec::types::Lidar, x: f32, y: f32, z: f32) -> f32
 
 /// The LiDAR points of `frames` of a clip, by frame: `[x, y, z, intensity]` in CARLA's sensor frame (x forward,
 /// y right, z up), in the order the dataset holds them. Reads the Parquet points or the seed's `.bin` files.
-pub(super) fn read_points(
+pub(crate) fn read_points(
     ds: &Dataset,
     clip: &str,
     frames: &BTreeSet<u32>,

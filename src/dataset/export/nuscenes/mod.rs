@@ -18,11 +18,12 @@ use std::path::Path;
 
 use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 
-use super::dataset::{Clip, Dataset};
+use super::dataset::{Clip, Dataset, SENSOR_FROM_OPTICAL};
 use super::{LinkMode, RgbFiles, link_file, write_file};
-use crate::dataset::read::tables as read_tables;
 use crate::error::{Error, code};
 use crate::sim::rig::world_from_vehicle;
+#[cfg(feature = "rerun")]
+pub(crate) use lidar::read_points as lidar_points_xyzi;
 use lidar::{read_points, ring};
 use tables::{CAM_FRONT, LIDAR_TOP, token};
 
@@ -89,14 +90,6 @@ fn quat(m: DMat3) -> [f64; 4] {
 fn xyz(v: DVec3) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
-
-/// Rotation taking the camera's optical axes (x right, y down, z forward: nuScenes' camera frame) to its
-/// sensor axes (x forward, y left, z up).
-const SENSOR_FROM_OPTICAL: DMat3 = DMat3::from_cols(
-    DVec3::new(0.0, -1.0, 0.0), // optical x (right) → sensor −y
-    DVec3::new(0.0, 0.0, -1.0), // optical y (down) → sensor −z
-    DVec3::new(1.0, 0.0, 0.0),  // optical z (forward) → sensor x
-);
 
 /// Frames between keyframes for a clip at `fps`.
 pub fn keyframe_step(fps: u32, keyframe_hz: f64) -> u32 {
@@ -384,7 +377,7 @@ impl ClipExport<'_> {
         });
         // The sample a sweep belongs to: the latest keyframe at or before it.
         let sample_of = |f: u32| sample_token(f - f % self.step);
-        let mounts = self.mounts()?;
+        let mounts = self.ds.sensor_mounts(self.clip)?;
         if with_camera {
             let ego_from_sensor = *mounts.get("camera").ok_or_else(|| self.no_pose("camera"))?;
             let ego_from_optical = ego_from_sensor.matrix3 * SENSOR_FROM_OPTICAL;
@@ -471,28 +464,6 @@ impl ClipExport<'_> {
             self.id(),
             timestamp_us(frame, self.clip.fps)
         )
-    }
-
-    /// Each sensor's pose on the ego (`ego_from_sensor`, axes x forward, y left, z up) from the `sensor_poses`
-    /// table at frame 0 (mounts are rigid: the ego only moves and turns).
-    fn mounts(&self) -> Result<BTreeMap<String, DAffine3>, Error> {
-        let ego_from_world = self.world_from_ego(0).inverse();
-        let mut out = BTreeMap::new();
-        let cols = ["frame", "sensor", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"];
-        for b in read_tables::read(&self.ds.layout.table("sensor_poses", self.id()), &cols)? {
-            let (f, s) = (b.u32s("frame")?, b.strings("sensor")?);
-            let c = [b.f64s("x_m")?, b.f64s("y_m")?, b.f64s("z_m")?];
-            let q = [b.f64s("qw")?, b.f64s("qx")?, b.f64s("qy")?, b.f64s("qz")?];
-            for i in (0..b.rows()).filter(|&i| f.value(i) == 0) {
-                let rot = DQuat::from_xyzw(q[1].value(i), q[2].value(i), q[3].value(i), q[0].value(i)).normalize();
-                let at = DVec3::new(c[0].value(i), c[1].value(i), c[2].value(i));
-                out.insert(
-                    s[i].to_owned(),
-                    ego_from_world * DAffine3::from_rotation_translation(rot, at),
-                );
-            }
-        }
-        Ok(out)
     }
 
     fn calibrated(
