@@ -5,7 +5,8 @@ Usage: python3 tests/interop_coco.py DATASET --pedsynth PATH/TO/pedsynth
 Exports DATASET as COCO into a temporary directory, then, for every split's annotation file:
 - pycocotools' COCO() loads it; every image file it names exists;
 - COCOeval of the ground truth scored as detections gives AP 1.0 for `bbox`, `segm` (when the dataset has
-  masks) and `keypoints`;
+  masks) and `keypoints`; faster-coco-eval's own COCO reader and evaluator (a second implementation) load the
+  file and give AP 1.0 too;
 - every decoded mask (pycocotools' annToMask) equals the instance image's pixels of that instance, and `area`
   is their count;
 - the annotations are, one for one, the `annotations` table's rows (and the annotated cyclists' rows): boxes,
@@ -28,6 +29,7 @@ from PIL import Image
 from pycocotools import mask as mask_utils
 from pycocotools.coco import COCO
 from pycocotools.cocoeval import COCOeval
+import faster_coco_eval
 
 
 def fail(msg):
@@ -52,6 +54,26 @@ def evaluate(gt, kind):
     with contextlib.redirect_stdout(io.StringIO()):
         dt = gt.loadRes(dets)
         ev = COCOeval(gt, dt, kind)
+        ev.evaluate()
+        ev.accumulate()
+        ev.summarize()
+    return ev.stats[0]
+
+
+def evaluate_faster(path, kind):
+    """faster-coco-eval's COCO reader and evaluator on the ground truth scored as detections."""
+    with contextlib.redirect_stdout(io.StringIO()):
+        gt = faster_coco_eval.COCO(str(path))
+        dets = []
+        for a in gt.dataset["annotations"]:
+            d = {"image_id": a["image_id"], "category_id": a["category_id"], "bbox": a["bbox"], "score": 1.0}
+            if kind == "segm":
+                d["segmentation"] = a["segmentation"]
+            if kind == "keypoints":
+                d["keypoints"] = a["keypoints"]
+            dets.append(d)
+        dt = gt.loadRes(dets)
+        ev = faster_coco_eval.COCOeval_faster(gt, dt, kind)
         ev.evaluate()
         ev.accumulate()
         ev.summarize()
@@ -91,6 +113,10 @@ def main():
                 ap_all = evaluate(gt, kind)
                 if abs(ap_all - 1.0) > 1e-9:
                     fail(f"{f.name}: COCOeval {kind} of the ground truth as detections gives AP {ap_all}, not 1")
+                ap_faster = evaluate_faster(f, kind)
+                if abs(ap_faster - 1.0) > 1e-9:
+                    fail(f"{f.name}: faster-coco-eval {kind} of the ground truth as detections gives AP "
+                         f"{ap_faster}, not 1")
             masks_checked = 0
             by_image = {}
             for a in anns:
@@ -135,7 +161,8 @@ def main():
                             fail(f"{f.name}: annotation {a['id']}: area {a['area']} vs {int(want_mask.sum())}")
                         masks_checked += 1
             print(f"interop_coco: {f.name}: pycocotools loads {len(images)} images, {len(anns)} annotations "
-                  f"({', '.join(sorted(set(cats.values())))}); COCOeval AP 1.0 for {', '.join(kinds)}; "
+                  f"({', '.join(sorted(set(cats.values())))}); COCOeval and faster-coco-eval AP 1.0 for "
+                  f"{', '.join(kinds)}; "
                   f"{masks_checked} decoded masks equal the instance pixels")
         missing = set(rows) - seen
         if missing:
