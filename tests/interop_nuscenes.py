@@ -16,7 +16,7 @@ Usage: interop_nuscenes.py DATASET --pedsynth BIN [--out DIR]
   `num_lidar_pts` is the devkit's count of points in the box.
 - The pedestrians' 3D keypoints (our `keypoints_3d`, world) projected with the exported ego pose, calibration
   and the devkit's `view_points` land on our 2D keypoints; each tight 2D box lies inside its 3D box's
-  projection.
+  projection (within a pixel), with a median IoU of at least 0.5 between the two.
 - Every annotated pedestrian of a keyframe has one box, with nuScenes' pedestrian attributes; `splits.json`
   lists the clips by split.
 """
@@ -95,6 +95,7 @@ def main():
     checked = {"boxes": 0, "points": 0, "keypoints": 0, "velocities": 0, "lidar_files": 0, "images": 0}
     worst_kp = 0.0
     speed_errors = []
+    ious = []
     for sample in nusc.sample:
         scene = nusc.get("scene", sample["scene_token"])
         clip = scene["name"]
@@ -198,6 +199,14 @@ def main():
             corners = view_points(box.corners(), K, normalize=True)[:2]
             x0, y0 = corners.min(axis=1)
             x1, y1 = corners.max(axis=1)
+            # The 3D box's projection clipped to the image, against the tight box (inside it, and close).
+            w, h = cam_sd["width"], cam_sd["height"]
+            cx0, cy0, cx1, cy1 = max(x0, 0), max(y0, 0), min(x1, w), min(y1, h)
+            ix = max(0.0, min(cx1, r.bbox_x_max) - max(cx0, r.bbox_x_min))
+            iy = max(0.0, min(cy1, r.bbox_y_max) - max(cy0, r.bbox_y_min))
+            inter = ix * iy
+            union = (cx1 - cx0) * (cy1 - cy0) + (r.bbox_x_max - r.bbox_x_min) * (r.bbox_y_max - r.bbox_y_min) - inter
+            ious.append(inter / union if union > 0 else 0.0)
             if (r.bbox_x_min < x0 - 1 or r.bbox_y_min < y0 - 1 or r.bbox_x_max > x1 + 1
                     or r.bbox_y_max > y1 + 1):
                 fail(f"{clip} frame {frame} pedestrian {ped}: tight box "
@@ -238,12 +247,16 @@ def main():
         fail(f"nothing checked: {checked}")
     # Box centres move as the body walks: their finite differences follow the tables' ground velocity.
     median_speed_error = float(np.median(speed_errors))
+    median_iou = float(np.median(ious))
+    if median_iou < 0.5:
+        fail(f"the 3D boxes' projections overlap the tight 2D boxes with a median IoU of {median_iou:.2f}")
     if median_speed_error > 0.3:
         fail(f"box_velocity is {median_speed_error:.2f} m/s from the tables' velocity (median)")
     print(f"interop_nuscenes: OK: {len(nusc.scene)} scenes, {len(nusc.sample)} samples, "
           f"{len(nusc.sample_data)} sample_data, {len(nusc.sample_annotation)} annotations; checked "
           f"{checked['boxes']} pedestrian boxes holding {checked['points']} of their LiDAR points, "
-          f"{checked['keypoints']} keypoints (worst {worst_kp:.4f} px), {checked['velocities']} velocities (pedestrians within a median {median_speed_error:.3f} m/s of the "
+          f"{checked['keypoints']} keypoints (worst {worst_kp:.4f} px), 3D box projections around the 2D boxes "
+          f"(median IoU {median_iou:.2f}, lowest {min(ious):.2f}), {checked['velocities']} velocities (pedestrians within a median {median_speed_error:.3f} m/s of the "
           f"tables'), "
           f"{checked['lidar_files']} LiDAR files; renders in {render_dir}")
 
