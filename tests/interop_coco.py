@@ -42,7 +42,8 @@ def table(root, name):
     return [r for f in files for r in pq.read_table(f).to_pylist()]
 
 
-def evaluate(gt, kind):
+def detections(gt, kind):
+    """The ground truth of `gt` as detections of `kind`, each scored 1."""
     dets = []
     for a in gt.dataset["annotations"]:
         d = {"image_id": a["image_id"], "category_id": a["category_id"], "bbox": a["bbox"], "score": 1.0}
@@ -51,9 +52,14 @@ def evaluate(gt, kind):
         if kind == "keypoints":
             d["keypoints"] = a["keypoints"]
         dets.append(d)
+    return dets
+
+
+def evaluate(gt, kind, evaluator=COCOeval):
+    """AP over IoU 0.50:0.95 of the ground truth scored as detections, by `evaluator`."""
     with contextlib.redirect_stdout(io.StringIO()):
-        dt = gt.loadRes(dets)
-        ev = COCOeval(gt, dt, kind)
+        dt = gt.loadRes(detections(gt, kind))
+        ev = evaluator(gt, dt, kind)
         ev.evaluate()
         ev.accumulate()
         ev.summarize()
@@ -61,23 +67,10 @@ def evaluate(gt, kind):
 
 
 def evaluate_faster(path, kind):
-    """faster-coco-eval's COCO reader and evaluator on the ground truth scored as detections."""
+    """faster-coco-eval's own COCO reader and evaluator on the file."""
     with contextlib.redirect_stdout(io.StringIO()):
         gt = faster_coco_eval.COCO(str(path))
-        dets = []
-        for a in gt.dataset["annotations"]:
-            d = {"image_id": a["image_id"], "category_id": a["category_id"], "bbox": a["bbox"], "score": 1.0}
-            if kind == "segm":
-                d["segmentation"] = a["segmentation"]
-            if kind == "keypoints":
-                d["keypoints"] = a["keypoints"]
-            dets.append(d)
-        dt = gt.loadRes(dets)
-        ev = faster_coco_eval.COCOeval_faster(gt, dt, kind)
-        ev.evaluate()
-        ev.accumulate()
-        ev.summarize()
-    return ev.stats[0]
+    return evaluate(gt, kind, faster_coco_eval.COCOeval_faster)
 
 
 def main():

@@ -39,6 +39,28 @@ fn invalid(msg: String) -> Error {
     Error::new(code::DATASET_INVALID, msg)
 }
 
+/// The points of one frame in the seed's `.bin` layout (little-endian float32 `x y z intensity` per point,
+/// CARLA's sensor frame); `None` when the file is absent.
+pub(crate) fn read_bin(path: &std::path::Path) -> Result<Option<Vec<[f32; 4]>>, Error> {
+    let Ok(bytes) = std::fs::read(path) else {
+        return Ok(None);
+    };
+    if bytes.len() % 16 != 0 {
+        return Err(invalid(format!(
+            "{}: {} bytes is not a whole number of 16-byte points",
+            path.display(),
+            bytes.len()
+        )));
+    }
+    let value = |c: &[u8]| f32::from_le_bytes([c[0], c[1], c[2], c[3]]);
+    Ok(Some(
+        bytes
+            .chunks_exact(16)
+            .map(|p| [value(&p[0..4]), value(&p[4..8]), value(&p[8..12]), value(&p[12..16])])
+            .collect(),
+    ))
+}
+
 impl LidarFrames {
     /// Reads the points of `frames` of a clip, its LiDAR poses and its boxes.
     pub fn read(layout: &Layout, clip: &str, frames: &BTreeSet<u32>) -> Result<LidarFrames, Error> {
@@ -57,20 +79,10 @@ impl LidarFrames {
             }
         } else {
             for &f in frames {
-                let path = layout.sensor_frame("lidar", clip, f, "bin");
-                let Ok(bytes) = std::fs::read(&path) else { continue };
-                if bytes.len() % 16 != 0 {
-                    return Err(invalid(format!(
-                        "{}: {} bytes is not a whole number of 16-byte points",
-                        path.display(),
-                        bytes.len()
-                    )));
-                }
-                let v: Vec<f32> = bytes
-                    .chunks_exact(4)
-                    .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                    .collect();
-                points.entry(f).or_default().extend(v.chunks_exact(4).map(|p| {
+                let Some(bin) = read_bin(&layout.sensor_frame("lidar", clip, f, "bin"))? else {
+                    continue;
+                };
+                points.entry(f).or_default().extend(bin.iter().map(|p| {
                     let g = (60.0 + 195.0 * p[3].clamp(0.0, 1.0)) as u8;
                     (p[0], p[1], [g, g, g])
                 }));

@@ -3,7 +3,6 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::refuse;
 use crate::dataset::export::dataset::Dataset;
 use crate::dataset::read::tables as read_tables;
 use crate::error::Error;
@@ -43,23 +42,10 @@ pub(crate) fn read_points(
         return Ok(points);
     }
     for &f in frames {
-        let path = ds.layout.sensor_frame("lidar", clip, f, "bin");
-        let Ok(bytes) = std::fs::read(&path) else { continue };
-        if bytes.len() % 16 != 0 {
-            return Err(refuse(format!(
-                "{}: {} bytes is not a whole number of 16-byte points",
-                path.display(),
-                bytes.len()
-            )));
+        if let Some(bin) = crate::dataset::read::lidar_view::read_bin(&ds.layout.sensor_frame("lidar", clip, f, "bin"))?
+        {
+            points.entry(f).or_default().extend(bin);
         }
-        let v: Vec<f32> = bytes
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-            .collect();
-        points
-            .entry(f)
-            .or_default()
-            .extend(v.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]));
     }
     Ok(points)
 }
