@@ -331,7 +331,8 @@ fn check_replay(clip: &pedsynth::dataset::export::dataset::Clip, xosc: &str) {
 /// exports to the same bytes twice; keyframes every 15 frames at 30 FPS; every annotated pedestrian of a
 /// keyframe has one box; tokens are unique and every `prev`/`next`/`first`/`last` token points at a record of
 /// its table; each `LIDAR_TOP` sample_data's ego pose and calibration compose to the `sensor_poses` row of its
-/// frame; a dataset without cameras or LiDAR is refused with exit 2, and so is `--keyframe-hz 0`.
+/// frame; an altered dataset, a dataset without cameras or LiDAR and `--keyframe-hz 0` are refused with exit 2,
+/// and so is `export rerun` of an altered dataset or without a clip the dataset has.
 #[test]
 fn nuscenes_export_links_its_records_and_composes_the_sensor_poses() {
     use serde_json::Value;
@@ -511,6 +512,31 @@ fn nuscenes_export_links_its_records_and_composes_the_sensor_poses() {
         compared += 1;
     }
     assert_eq!(compared, 6 + 5, "keyframes and the tick before each but the first");
+
+    // A table changed after generate: nuScenes and Rerun refuse it as the other exports do.
+    let table = ds.join(format!("tables/annotations/{}.parquet", clip.clip_id));
+    let original = std::fs::read(&table).expect("read");
+    let mut changed = original.clone();
+    let mid = changed.len() / 2;
+    changed[mid] ^= 1;
+    std::fs::write(&table, &changed).expect("write");
+    for format in ["nuscenes", "rerun"] {
+        let (code, _, stderr) = pedsynth(&[
+            "export".as_ref(),
+            format.as_ref(),
+            ds.as_os_str(),
+            "--out".as_ref(),
+            tmp.path().join("altered").as_os_str(),
+            "--clip".as_ref(),
+            clip.clip_id.as_ref(),
+        ]);
+        assert_eq!(code, Some(2), "{format}: {stderr}");
+        assert!(
+            stderr.contains("blake3 differs from the manifest"),
+            "{format}: {stderr}"
+        );
+    }
+    std::fs::write(&table, &original).expect("restore");
 
     // No cameras and no LiDAR: refused.
     let bare = tmp.path().join("bare");
