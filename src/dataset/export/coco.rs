@@ -16,7 +16,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::dataset::{Clip, Dataset};
-use super::{LinkMode, RgbFiles, link_file, write_file};
+use super::{LinkMode, link_file, write_file};
 use crate::error::{Error, code};
 use crate::sensors::body::{COCO17, OPENPOSE18_FROM_COCO17};
 
@@ -142,27 +142,9 @@ fn refuse(msg: String) -> Error {
 
 /// Writes the COCO layout of `ds` into `out`.
 pub fn export(ds: &Dataset, out: &Path, link: LinkMode) -> Result<CocoReport, Error> {
-    let (rgb, images_note) = super::images_note(ds, link);
-    if rgb == RgbFiles::Mp4 {
-        return Err(refuse(format!(
-            "{}: the RGB stream is H.264 video, and COCO links image files: generate the dataset with \
-             output.rgb_encoding: png (or jpeg), or decode sensors/rgb/<clip_id>.mp4 into \
-             sensors/rgb/<clip_id>/<frame:06>.png first",
-            ds.layout.root().display()
-        )));
-    }
-    let jpeg = ds
-        .manifest
-        .sensors
-        .get("rgb")
-        .is_some_and(|s| s.starts_with("rendered") && s.ends_with(".jpg"));
-    let ext = if jpeg { "jpg" } else { "png" };
-    let with_images = rgb == RgbFiles::Png || jpeg;
-    let images_note = if jpeg {
-        format!("images linked ({link}) from sensors/rgb (JPEG)")
-    } else {
-        images_note
-    };
+    let frames = super::image_frames(ds, link, "COCO")?;
+    let with_images = frames.is_some();
+    let (ext, images_note) = frames.unwrap_or_else(|| ("png", super::images_note(ds, link).1));
     let with_masks = ds
         .manifest
         .sensors

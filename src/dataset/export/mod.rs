@@ -178,6 +178,36 @@ pub(crate) fn images_note(ds: &dataset::Dataset, link: LinkMode) -> (RgbFiles, S
     }
 }
 
+/// The RGB frames an export that links image files can use: `Some((extension, note))` for PNG or JPEG frames
+/// (`note` says how they get there), `None` without an RGB stream. An H.264 stream is refused (exit 2) with what
+/// to do, naming the format (`what`).
+pub(crate) fn image_frames(
+    ds: &dataset::Dataset,
+    link: LinkMode,
+    what: &str,
+) -> Result<Option<(&'static str, String)>, Error> {
+    let (rgb, note) = images_note(ds, link);
+    let jpeg = ds
+        .manifest
+        .sensors
+        .get("rgb")
+        .is_some_and(|s| s.starts_with("rendered") && s.ends_with(".jpg"));
+    match rgb {
+        RgbFiles::Mp4 => Err(Error::new(
+            crate::error::code::DATASET_INVALID,
+            format!(
+                "{}: the RGB stream is H.264 video, and {what} links image files: generate the dataset with \
+                 output.rgb_encoding: png (or jpeg), or decode sensors/rgb/<clip_id>.mp4 into \
+                 sensors/rgb/<clip_id>/<frame:06>.png first",
+                ds.layout.root().display()
+            ),
+        )),
+        RgbFiles::Png => Ok(Some(("png", note))),
+        RgbFiles::None if jpeg => Ok(Some(("jpg", format!("images linked ({link}) from sensors/rgb (JPEG)")))),
+        RgbFiles::None => Ok(None),
+    }
+}
+
 /// Links a clip's H.264 video to `to`; returns whether it was there.
 pub(crate) fn link_video(
     ds: &dataset::Dataset,

@@ -118,9 +118,12 @@ impl Recorder<'_> {
         self.log_static("world", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())?;
         let mounts = ds.sensor_mounts(clip)?;
         let rendered = |s: &str| ds.manifest.sensors.get(s).is_some_and(|v| v.starts_with("rendered"));
-        let rgb_ext = ds.manifest.sensors.get("rgb").and_then(|s| {
-            (rendered("rgb") && !s.contains(".mp4")).then(|| if s.ends_with(".jpg") { "jpg" } else { "png" })
-        });
+        // PNG or JPEG frames go in as they are; an H.264 dataset's recording has no camera image (its depth,
+        // masks, boxes and LiDAR still do).
+        let rgb_ext = super::image_frames(ds, super::LinkMode::Hard, "Rerun")
+            .ok()
+            .flatten()
+            .map(|(ext, _)| ext);
         let depth_mm =
             rendered("depth") && ds.spec.output.depth_encoding == crate::spec::types::DepthEncoding::MillimetresU16;
         let (w, h) = (ds.spec.sensors.rgb.width_px, ds.spec.sensors.rgb.height_px);
@@ -160,6 +163,23 @@ impl Recorder<'_> {
             BTreeMap::new()
         };
         // Annotations by frame.
+        // The traffic by frame (ground point, yaw, label), grouped once.
+        let mut vehicles: BTreeMap<u32, Vec<(DVec3, f64, String)>> = BTreeMap::new();
+        for v in &clip.vehicles {
+            vehicles.entry(v.frame).or_default().push((
+                DVec3::new(v.x_m, v.y_m, v.z_m),
+                v.yaw_rad,
+                format!("{} {}", v.kind, v.vehicle),
+            ));
+        }
+        let mut cyclists: BTreeMap<u32, Vec<(DVec3, f64, String)>> = BTreeMap::new();
+        for c in &clip.cyclists {
+            cyclists.entry(c.frame).or_default().push((
+                DVec3::new(c.x_m, c.y_m, c.z_m),
+                c.yaw_rad,
+                format!("cyclist {}", c.cyclist),
+            ));
+        }
         let mut by_frame: BTreeMap<u32, Vec<(u32, &super::dataset::AnnotatedFrame)>> = BTreeMap::new();
         for p in clip.pedestrians.values() {
             for a in &p.frames {
@@ -209,7 +229,20 @@ impl Recorder<'_> {
             if !anns.is_empty() {
                 self.pedestrians(f, &anns)?;
             }
-            self.traffic(f)?;
+            let vehicles = vehicles.remove(&f).unwrap_or_default();
+            let size = (
+                crate::sim::VEHICLE_LENGTH_M,
+                crate::sim::VEHICLE_WIDTH_M,
+                crate::sim::VEHICLE_HEIGHT_M,
+            );
+            self.traffic("world/vehicles", &vehicles, size, rerun::Color::from_rgb(250, 210, 40))?;
+            let cyclists = cyclists.remove(&f).unwrap_or_default();
+            let size = (
+                crate::sim::BICYCLE_LENGTH_M,
+                crate::sim::BICYCLE_WIDTH_M,
+                crate::sim::BICYCLE_HEIGHT_M,
+            );
+            self.traffic("world/cyclists", &cyclists, size, rerun::Color::from_rgb(80, 160, 250))?;
             if let Some(pts) = points.remove(&f) {
                 let positions: Vec<[f32; 3]> = pts.iter().map(|p| [p.0[0], -p.0[1], p.0[2]]).collect();
                 let colours: Vec<rerun::Color> = pts
@@ -284,46 +317,27 @@ impl Recorder<'_> {
         self.log("world/pedestrians", &boxes3d)
     }
 
-    /// The traffic vehicles' and the cyclists' 3D boxes of frame `f`.
-    fn traffic(&mut self, f: u32) -> Result<(), Error> {
-        let clip = self.clip;
-        let vehicles: Vec<_> = clip.vehicles.iter().filter(|v| v.frame == f).collect();
-        if !vehicles.is_empty() {
-            let (l, w, h) = (
-                crate::sim::VEHICLE_LENGTH_M,
-                crate::sim::VEHICLE_WIDTH_M,
-                crate::sim::VEHICLE_HEIGHT_M,
-            );
-            let boxes = rerun::Boxes3D::from_centers_and_sizes(
-                vehicles
-                    .iter()
-                    .map(|v| (v.x_m as f32, v.y_m as f32, (v.z_m + 0.5 * h) as f32)),
-                vehicles.iter().map(|_| (l as f32, w as f32, h as f32)),
-            )
-            .with_quaternions(vehicles.iter().map(|v| yaw_quaternion(v.yaw_rad)))
-            .with_colors([rerun::Color::from_rgb(250, 210, 40)])
-            .with_labels(vehicles.iter().map(|v| format!("{} {}", v.kind, v.vehicle)));
-            self.log("world/vehicles", &boxes)?;
+    /// Boxes of one kind of traffic in one frame: ground points, yaws and labels, all of one size and colour.
+    fn traffic(
+        &mut self,
+        path: &str,
+        items: &[(DVec3, f64, String)],
+        (l, w, h): (f64, f64, f64),
+        colour: rerun::Color,
+    ) -> Result<(), Error> {
+        if items.is_empty() {
+            return Ok(());
         }
-        let cyclists: Vec<_> = clip.cyclists.iter().filter(|c| c.frame == f).collect();
-        if !cyclists.is_empty() {
-            let (l, w, h) = (
-                crate::sim::BICYCLE_LENGTH_M,
-                crate::sim::BICYCLE_WIDTH_M,
-                crate::sim::BICYCLE_HEIGHT_M,
-            );
-            let boxes = rerun::Boxes3D::from_centers_and_sizes(
-                cyclists
-                    .iter()
-                    .map(|c| (c.x_m as f32, c.y_m as f32, (c.z_m + 0.5 * h) as f32)),
-                cyclists.iter().map(|_| (l as f32, w as f32, h as f32)),
-            )
-            .with_quaternions(cyclists.iter().map(|c| yaw_quaternion(c.yaw_rad)))
-            .with_colors([rerun::Color::from_rgb(80, 160, 250)])
-            .with_labels(cyclists.iter().map(|c| format!("cyclist {}", c.cyclist)));
-            self.log("world/cyclists", &boxes)?;
-        }
-        Ok(())
+        let boxes = rerun::Boxes3D::from_centers_and_sizes(
+            items
+                .iter()
+                .map(|(g, _, _)| (g.x as f32, g.y as f32, (g.z + 0.5 * h) as f32)),
+            items.iter().map(|_| (l as f32, w as f32, h as f32)),
+        )
+        .with_quaternions(items.iter().map(|&(_, yaw, _)| yaw_quaternion(yaw)))
+        .with_colors([colour])
+        .with_labels(items.iter().map(|(_, _, label)| label.clone()));
+        self.log(path, &boxes)
     }
 }
 

@@ -77,6 +77,33 @@ struct Summary {
     samples: Vec<(String, String, Option<Vec<u8>>)>,
 }
 
+impl Summary {
+    /// Adds a box `[x_min, y_min, x_max, y_max]` (pixels) of an image `(width, height)` to the box plots.
+    fn add_box(&mut self, [x0, y0, x1, y1]: [f64; 4], (w, h): (f64, f64)) {
+        self.box_height.push((y1 - y0) / h);
+        self.box_bottom.push(y1 / h);
+        self.box_centre.push((x0 + x1) / 2.0 / w);
+    }
+
+    /// A summary with its figures and no samples yet.
+    fn empty(name: String, version: String, stats: stats::DatasetStats, pab: protocol::PabStats) -> Summary {
+        Summary {
+            name,
+            real: false,
+            version,
+            stats,
+            pab,
+            speeds_mps: Vec::new(),
+            seen_before_crossing_s: Vec::new(),
+            box_height: Vec::new(),
+            box_bottom: Vec::new(),
+            box_centre: Vec::new(),
+            sizes: BTreeMap::new(),
+            samples: Vec::new(),
+        }
+    }
+}
+
 fn refuse(msg: String) -> Error {
     Error::new(code::DATASET_INVALID, msg)
 }
@@ -107,20 +134,12 @@ fn summarise(dir: &Path) -> Result<Summary, Error> {
         f64::from(ds.spec.sensors.rgb.width_px),
         f64::from(ds.spec.sensors.rgb.height_px),
     );
-    let mut summary = Summary {
-        name: ds.spec.dataset.name.clone(),
-        real: false,
-        version: ds.manifest.pedsynth_version.clone(),
+    let mut summary = Summary::empty(
+        ds.spec.dataset.name.clone(),
+        ds.manifest.pedsynth_version.clone(),
         stats,
         pab,
-        speeds_mps: Vec::new(),
-        seen_before_crossing_s: Vec::new(),
-        box_height: Vec::new(),
-        box_bottom: Vec::new(),
-        box_centre: Vec::new(),
-        sizes: BTreeMap::new(),
-        samples: Vec::new(),
-    };
+    );
     let mut weathers = BTreeSet::new();
     for info in &ds.clips {
         let clip = ds.load(info)?;
@@ -136,10 +155,7 @@ fn summarise(dir: &Path) -> Result<Summary, Error> {
                 if f.speed_mps >= 0.3 {
                     summary.speeds_mps.push(f64::from(f.speed_mps));
                 }
-                let [x0, y0, x1, y1] = f.bbox_px.map(f64::from);
-                summary.box_height.push((y1 - y0) / h);
-                summary.box_bottom.push(y1 / h);
-                summary.box_centre.push((x0 + x1) / 2.0 / w);
+                summary.add_box(f.bbox_px.map(f64::from), (w, h));
             }
         }
         if weathers.insert(info.weather.clone()) {
@@ -202,26 +218,20 @@ fn summarise_real(dir: &Path, format: crate::dataset::calibrate::Format, splits:
             .map_or_else(|| dir.display().to_string(), |n| n.to_string_lossy().into_owned())
     );
     let mut stats = stats::DatasetStats::default();
-    let mut summary = Summary {
-        name,
-        real: true,
-        version: "(real annotations)".to_owned(),
-        stats: stats::DatasetStats::default(),
-        pab: protocol::PabStats {
-            options: protocol::PabOptions::default(),
-            stride: 0,
-            splits: BTreeMap::new(),
-            all: protocol::SplitProtocol::default(),
-            target_crossing_ratio: None,
-        },
-        speeds_mps: Vec::new(),
-        seen_before_crossing_s: Vec::new(),
-        box_height: Vec::new(),
-        box_bottom: Vec::new(),
-        box_centre: Vec::new(),
-        sizes: BTreeMap::new(),
-        samples: Vec::new(),
+    let pab = protocol::PabStats {
+        options: protocol::PabOptions::default(),
+        stride: 0,
+        splits: BTreeMap::new(),
+        all: protocol::SplitProtocol::default(),
+        target_crossing_ratio: None,
     };
+    let mut summary = Summary::empty(
+        name,
+        "(real annotations)".to_owned(),
+        stats::DatasetStats::default(),
+        pab,
+    );
+    summary.real = true;
     let options = protocol::PabOptions::default();
     let mut by_split: BTreeMap<String, Vec<crate::dataset::calibrate::real::RealVideo>> = BTreeMap::new();
     for v in &videos {
@@ -253,9 +263,10 @@ fn summarise_real(dir: &Path, format: crate::dataset::calibrate::Format, splits:
                     .push(f64::from(cross - first.frame) / v.fps.max(1.0));
             }
             for b in &t.boxes {
-                summary.box_height.push((b.y_max_px - b.y_min_px) / v.height_px);
-                summary.box_bottom.push(b.y_max_px / v.height_px);
-                summary.box_centre.push((b.x_min_px + b.x_max_px) / 2.0 / v.width_px);
+                summary.add_box(
+                    [b.x_min_px, b.y_min_px, b.x_max_px, b.y_max_px],
+                    (v.width_px, v.height_px),
+                );
             }
         }
         by_split.entry(v.split.clone()).or_default().push(v.clone());

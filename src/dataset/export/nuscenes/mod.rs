@@ -19,7 +19,7 @@ use std::path::Path;
 use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
 
 use super::dataset::{Clip, Dataset, SENSOR_FROM_OPTICAL};
-use super::{LinkMode, RgbFiles, link_file, write_file};
+use super::{LinkMode, link_file, write_file};
 use crate::error::{Error, code};
 use crate::sim::rig::world_from_vehicle;
 #[cfg(feature = "rerun")]
@@ -109,22 +109,9 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, keyframe_hz: f64) -> Res
             format!("--keyframe-hz {keyframe_hz}: a rate above 0 Hz, such as 2 (nuScenes' own)"),
         ));
     }
-    let (rgb, images_note) = super::images_note(ds, link);
-    if rgb == RgbFiles::Mp4 {
-        return Err(refuse(format!(
-            "{}: the RGB stream is H.264 video, and nuScenes links image files: generate the dataset with \
-             output.rgb_encoding: png (or jpeg), or decode sensors/rgb/<clip_id>.mp4 into \
-             sensors/rgb/<clip_id>/<frame:06>.png first",
-            ds.layout.root().display()
-        )));
-    }
+    let frames = super::image_frames(ds, link, "nuScenes")?;
+    let with_camera = frames.is_some();
     let rendered = |s: &str| ds.manifest.sensors.get(s).is_some_and(|v| v.starts_with("rendered"));
-    let jpeg = ds
-        .manifest
-        .sensors
-        .get("rgb")
-        .is_some_and(|s| rendered("rgb") && s.ends_with(".jpg"));
-    let with_camera = rgb == RgbFiles::Png || jpeg;
     let with_lidar = rendered("lidar");
     if !with_camera && !with_lidar {
         return Err(refuse(format!(
@@ -133,20 +120,17 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, keyframe_hz: f64) -> Res
             ds.layout.root().display()
         )));
     }
-    let ext = if jpeg { "jpg" } else { "png" };
     let mut notes = Vec::new();
-    if with_camera {
-        notes.push(format!(
-            "CAM_FRONT {}",
-            if jpeg {
-                images_note.replace("from sensors/rgb", "from sensors/rgb (JPEG)")
-            } else {
-                images_note
-            }
-        ));
-    } else {
-        notes.push("no CAM_FRONT (the dataset has no PNG or JPEG RGB stream)".to_owned());
-    }
+    let ext = match &frames {
+        Some((ext, note)) => {
+            notes.push(format!("CAM_FRONT {note}"));
+            *ext
+        }
+        None => {
+            notes.push("no CAM_FRONT (the dataset has no PNG or JPEG RGB stream)".to_owned());
+            "png"
+        }
+    };
     if !with_lidar {
         notes.push("no LIDAR_TOP (the dataset has no LiDAR)".to_owned());
     }
@@ -429,15 +413,17 @@ impl ClipExport<'_> {
                 write_file(&self.out.join(&filename), &bytes)?;
                 report.lidar_files += 1;
                 if key {
+                    // Each point into the world once, then counted against every box of the keyframe.
                     let world_from_lidar = self.world_from_ego(f) * ego_from_lidar;
+                    let world: Vec<DVec3> = pts
+                        .iter()
+                        .map(|p| {
+                            let local = DVec3::new(f64::from(p[0]), -f64::from(p[1]), f64::from(p[2]));
+                            world_from_lidar.transform_point3(local)
+                        })
+                        .collect();
                     for (b, bx) in boxes[&f].iter().enumerate() {
-                        let count = pts
-                            .iter()
-                            .filter(|p| {
-                                let local = DVec3::new(f64::from(p[0]), -f64::from(p[1]), f64::from(p[2]));
-                                bx.contains(world_from_lidar.transform_point3(local))
-                            })
-                            .count();
+                        let count = world.iter().filter(|&&w| bx.contains(w)).count();
                         lidar_counts.insert((f, b), count as u32);
                     }
                 }
