@@ -282,6 +282,9 @@ pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
 /// [`project_box`] of any set of capsules (a cyclist: its rider and its bicycle).
 pub fn project_capsules_box<'a>(capsules: impl IntoIterator<Item = &'a Capsule>, cam: &CameraPose) -> Option<[f64; 4]> {
     let c = &cam.camera;
+    if !c.lens.is_pinhole() {
+        return distorted_capsules_box(capsules, cam);
+    }
     let (cx, cy) = (f64::from(c.width_px) * 0.5, f64::from(c.height_px) * 0.5);
     let mut lo = DVec2::splat(f64::INFINITY);
     let mut hi = DVec2::splat(f64::NEG_INFINITY);
@@ -295,6 +298,46 @@ pub fn project_capsules_box<'a>(capsules: impl IntoIterator<Item = &'a Capsule>,
             let (v0, v1) = sphere_interval(p.y, p.z, cap.radius_m, c.focal_px, cy);
             lo = lo.min(DVec2::new(u0, v0));
             hi = hi.max(DVec2::new(u1, v1));
+        }
+    }
+    Some([lo.x, lo.y, hi.x, hi.y])
+}
+
+/// Spheres per capsule whose silhouettes bound its distorted image (the two ends and the points between).
+const DISTORTED_SPHERES: usize = 5;
+/// Points sampled on each sphere's silhouette.
+const SILHOUETTE_POINTS: usize = 32;
+
+/// [`project_capsules_box`] through a distorting lens: a straight capsule's image is no longer the hull of its
+/// end spheres' images, so the box bounds the distorted silhouettes (the circles where rays from the camera
+/// graze each sphere) of spheres along each capsule, [`SILHOUETTE_POINTS`] points each. The sampled outline
+/// lies within `R (1 − cos(π/32))` = 0.5 % of a sphere's image radius of the true one.
+fn distorted_capsules_box<'a>(capsules: impl IntoIterator<Item = &'a Capsule>, cam: &CameraPose) -> Option<[f64; 4]> {
+    let c = &cam.camera;
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for cap in capsules {
+        let (a, b) = (
+            cam.optical_from_world.transform_point3(cap.a),
+            cam.optical_from_world.transform_point3(cap.b),
+        );
+        if a.z - cap.radius_m <= 0.05 || b.z - cap.radius_m <= 0.05 {
+            return None;
+        }
+        for k in 0..DISTORTED_SPHERES {
+            let p = a.lerp(b, k as f64 / (DISTORTED_SPHERES - 1) as f64);
+            let (d2, r2) = (p.length_squared(), cap.radius_m * cap.radius_m);
+            // The grazing circle: centre p (1 − r²/|p|²), radius r √(|p|² − r²) / |p|, facing the camera.
+            let centre = p * (1.0 - r2 / d2);
+            let radius = cap.radius_m * ((d2 - r2) / d2).sqrt();
+            let (e1, e2) = (p / d2.sqrt()).any_orthonormal_pair();
+            for i in 0..SILHOUETTE_POINTS {
+                let (sin, cos) = (std::f64::consts::TAU * i as f64 / SILHOUETTE_POINTS as f64).sin_cos();
+                let q = centre + radius * (cos * e1 + sin * e2);
+                let px = c.pixel_of_normalised(q.x / q.z, q.y / q.z);
+                lo = lo.min(px);
+                hi = hi.max(px);
+            }
         }
     }
     Some([lo.x, lo.y, hi.x, hi.y])

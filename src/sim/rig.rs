@@ -12,6 +12,7 @@ use rand::RngExt;
 
 use crate::plan::seeds::clip_rng;
 use crate::spec::types::{Mount, Rgb, Sensors};
+use crate::util::lens::Lens;
 
 /// The sensors on the ego vehicle, placed and configured from the spec.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,6 +58,8 @@ pub struct Camera {
     pub focal_px: f64,
     /// Pose of the sensor in the vehicle frame.
     pub vehicle_from_sensor: DAffine3,
+    /// Lens distortion between the pinhole and the pixels ([`Lens::is_pinhole`] for none).
+    pub lens: Lens,
 }
 
 /// The rotation taking sensor axes (x forward, y left, z up) to optical axes (x right, y down, z forward).
@@ -134,6 +137,7 @@ impl Camera {
             height_px: rgb.height_px,
             focal_px,
             vehicle_from_sensor: vehicle_from_mount(&rgb.mount),
+            lens: Lens::new(rgb.distortion.coefficients()),
         }
     }
 
@@ -143,6 +147,20 @@ impl Camera {
             vehicle_from_sensor: vehicle_from_mount(&clip_mount(rgb, clip_seed)),
             ..Camera::from_spec(rgb)
         }
+    }
+
+    /// The pixel at which the camera sees the normalised image point `(x, y) = (X/Z, Y/Z)` of its optical frame:
+    /// through the lens, then the intrinsics (principal point at the image centre).
+    pub fn pixel_of_normalised(&self, x: f64, y: f64) -> DVec2 {
+        let (x, y) = if self.lens.is_pinhole() {
+            (x, y)
+        } else {
+            self.lens.distort(x, y)
+        };
+        DVec2::new(
+            self.focal_px * x + f64::from(self.width_px) * 0.5,
+            self.focal_px * y + f64::from(self.height_px) * 0.5,
+        )
     }
 
     /// The camera's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
@@ -174,13 +192,16 @@ impl CameraPose {
         let c = &self.camera;
         let depth = p.z;
         let inv = if depth.abs() > 1e-9 { 1.0 / depth } else { 1e9 };
-        Projection {
-            px: DVec2::new(
+        let px = if c.lens.is_pinhole() {
+            // (f·x)/z, in this order: the pinhole's pixels are bit for bit those of earlier versions.
+            DVec2::new(
                 c.focal_px * p.x * inv + f64::from(c.width_px) * 0.5,
                 c.focal_px * p.y * inv + f64::from(c.height_px) * 0.5,
-            ),
-            depth_m: depth,
-        }
+            )
+        } else {
+            c.pixel_of_normalised(p.x * inv, p.y * inv)
+        };
+        Projection { px, depth_m: depth }
     }
 
     /// Whether a pixel lies inside the image.

@@ -1,8 +1,9 @@
 //! Small helpers every room may use (the bottom layer, beside `error`): atomic file writes and capped reads,
-//! SplitMix64 for values that are pure functions of a seed, JSON sequences streamed from iterators, and XML
-//! escaping.
+//! SplitMix64 for values that are pure functions of a seed, JSON sequences streamed from iterators, XML
+//! escaping, and Brown–Conrady lens distortion.
 
 pub mod files;
+pub mod lens;
 pub mod mix;
 pub mod stream_json;
 pub(crate) mod xml;

@@ -547,6 +547,22 @@ fn nuscenes_export_links_its_records_and_composes_the_sensor_poses() {
     let (code, _, stderr) = export("nuscenes", &bare, &tmp.path().join("c"));
     assert_eq!(code, Some(2), "{stderr}");
     assert!(stderr.contains("CAM_FRONT or LIDAR_TOP"), "{stderr}");
+    // A distorting lens: nuScenes' pinhole cannot describe it, so the export refuses rather than mislead.
+    let lens = tmp.path().join("lens");
+    let mut overrides = common::NO_SENSORS.to_vec();
+    overrides.extend([
+        "dataset.clips.count=1",
+        "dataset.clip_duration_s=[1, 1]",
+        "sensors.rgb.enabled=true",
+        "sensors.rgb.width_px=160",
+        "sensors.rgb.height_px=90",
+        "sensors.rgb.distortion.k1=-0.1",
+    ]);
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &overrides, &lens, None);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, _, stderr) = export("nuscenes", &lens, &tmp.path().join("e"));
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("lens distortion"), "{stderr}");
     let (code, _, stderr) = pedsynth(&[
         "export".as_ref(),
         "nuscenes".as_ref(),

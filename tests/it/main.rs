@@ -19,6 +19,7 @@ mod export;
 mod fuzz_corpus;
 mod hashes;
 mod intention;
+mod lens;
 mod lidar;
 mod plan_file;
 mod planner;

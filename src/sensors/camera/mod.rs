@@ -12,6 +12,9 @@
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
 //! - [`dvs`] — the ESIM event simulator.
 //!
+//! A camera with lens distortion draws its frame on a pinhole canvas and resamples it through the lens
+//! ([`lens`]).
+//!
 //! A frame is drawn at `SS × SS` samples per pixel, in bands of rows, with the same
 //! [`CameraPose`](crate::sim::rig::CameraPose) (intrinsics and pose) that the annotations project
 //! with: every pixel's first sample, and all four where the first samples of the pixel and of its right,
@@ -24,6 +27,7 @@ pub mod band;
 pub mod dvs;
 pub mod group;
 pub mod lanes;
+mod lens;
 pub mod light;
 mod post;
 mod projection;
@@ -128,6 +132,8 @@ pub struct Renderer {
     /// the band is in cache: a whole-image pass misses the cache at every streak pixel).
     streaks: Vec<Streak>,
     streak_bins: Vec<Vec<u32>>,
+    /// A distorting camera's canvas and resampling (`None` for a pinhole: the frame is drawn in place).
+    warp: Option<Box<lens::LensWarp>>,
 }
 
 /// The (up to) `n` items nearest to `from` within `radius_m`, nearest first (ties by index), into `out`.
@@ -147,9 +153,12 @@ fn nearest<T>(items: &[T], pos: impl Fn(&T) -> Vec3, from: Vec3, radius_m: f32, 
 impl Renderer {
     /// A renderer for a camera, a clip's lighting and its texture seed.
     pub fn new(camera: &Camera, light: Lighting, seed: u64) -> Renderer {
+        let warp = lens::LensWarp::new(camera).map(Box::new);
+        // The stages draw with the pinhole of the canvas where the camera distorts.
+        let camera = warp.as_ref().map_or(*camera, |w| w.canvas_camera);
         let h = camera.height_px as usize;
         Renderer {
-            camera: *camera,
+            camera,
             light,
             noise: Noise::new(seed ^ 0x7e57_0000),
             tris: Vec::new(),
@@ -162,6 +171,7 @@ impl Renderer {
             lut: build_lut(),
             streaks: Vec::new(),
             streak_bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
+            warp,
         }
     }
 
@@ -179,13 +189,26 @@ impl Renderer {
         streak_seed: u64,
         out: &mut CameraImages,
     ) {
-        let (w, h) = (self.camera.width_px as usize, self.camera.height_px as usize);
-        out.width = w;
-        out.height = h;
-        out.rgb.resize(w * h * 3, 0);
-        out.depth_m.resize(w * h, 0.0);
-        out.semantic.resize(w * h, 0);
-        out.instance.resize(w * h, 0);
+        if let Some(mut warp) = self.warp.take() {
+            self.draw(scene, frame, pose, streak_seed, &mut warp.canvas);
+            size_images(out, pose.camera.width_px as usize, pose.camera.height_px as usize);
+            warp.apply(out);
+            self.warp = Some(warp);
+        } else {
+            self.draw(scene, frame, pose, streak_seed, out);
+        }
+    }
+
+    /// Draws one frame with the renderer's pinhole (the camera's, or a distorting camera's canvas) into `out`.
+    fn draw(
+        &mut self,
+        scene: &StaticScene,
+        frame: &FrameScene,
+        pose: &CameraPose,
+        streak_seed: u64,
+        out: &mut CameraImages,
+    ) {
+        size_images(out, self.camera.width_px as usize, self.camera.height_px as usize);
         let optical_from_scene = pose.optical_from_world * DAffine3::from_translation(scene.origin);
         self.draw_visibility(scene, frame, &optical_from_scene);
         let cam_rel = (pose.centre - scene.origin).as_vec3();
@@ -194,6 +217,16 @@ impl Renderer {
         self.place_streaks(streak_seed);
         self.resolve(scene, frame, pose, cam_rel, out);
     }
+}
+
+/// Sizes the images of `out` to `w × h` pixels.
+fn size_images(out: &mut CameraImages, w: usize, h: usize) {
+    out.width = w;
+    out.height = h;
+    out.rgb.resize(w * h * 3, 0);
+    out.depth_m.resize(w * h, 0.0);
+    out.semantic.resize(w * h, 0);
+    out.instance.resize(w * h, 0);
 }
 
 /// The luminance of an 8-bit sRGB pixel (the DVS's intensity, 0–255).

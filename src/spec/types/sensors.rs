@@ -151,6 +151,42 @@ pub struct Rgb {
     /// clip from its seed and added to `mount`. Off (`[0, 0]`) by default.
     #[serde(skip_serializing_if = "super::is_default")]
     pub mount_spread: MountSpread,
+    /// Lens distortion (Brown–Conrady, OpenCV's convention), applied to every camera stream and to the boxes
+    /// and keypoints. All zero (a pinhole) by default.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub distortion: Distortion,
+}
+
+/// Brown–Conrady lens distortion in OpenCV's convention (`cv2.projectPoints`, `cv2.undistort` with
+/// `D = [k1, k2, p1, p2, k3]`): a point at normalised image coordinates `(x, y) = (X/Z, Y/Z)`, `r² = x² + y²`,
+/// is seen at `x' = x·(1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2 x²)` and
+/// `y' = y·(1 + k1 r² + k2 r⁴ + k3 r⁶) + p1 (r² + 2 y²) + 2 p2 x y`, then at pixel `(f x' + w/2, f y' + h/2)`.
+/// Negative `k1` is barrel distortion (a dashcam's wide lens).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Distortion {
+    /// Radial coefficient of r².
+    pub k1: f64,
+    /// Radial coefficient of r⁴.
+    pub k2: f64,
+    /// Tangential coefficient p1.
+    pub p1: f64,
+    /// Tangential coefficient p2.
+    pub p2: f64,
+    /// Radial coefficient of r⁶.
+    pub k3: f64,
+}
+
+impl Distortion {
+    /// Whether every coefficient is zero: a pinhole.
+    pub fn is_zero(&self) -> bool {
+        *self == Distortion::default()
+    }
+
+    /// The coefficients in OpenCV's order `[k1, k2, p1, p2, k3]`.
+    pub fn coefficients(&self) -> [f64; 5] {
+        [self.k1, self.k2, self.p1, self.p2, self.k3]
+    }
 }
 
 /// Per-clip offsets of the camera mount, each drawn uniformly from its range `[min, max]` with the clip's seed
@@ -184,6 +220,7 @@ impl Default for Rgb {
             fov_deg: 90.0,
             mount: Mount::default(),
             mount_spread: MountSpread::default(),
+            distortion: Distortion::default(),
         }
     }
 }

@@ -71,6 +71,62 @@ impl Validator<'_> {
         );
     }
 
+    /// `sensors.rgb.distortion`: coefficients in a real lens's range, and a lens that does not fold over inside
+    /// the image (its radial map grows out to the image's corners, so every pixel sees one direction).
+    fn distortion(&mut self, rgb: &Rgb) {
+        let d = &rgb.distortion;
+        let before = self.problems.len();
+        for (key, value, bound) in [
+            ("k1", d.k1, 2.0),
+            ("k2", d.k2, 2.0),
+            ("p1", d.p1, 0.2),
+            ("p2", d.p2, 0.2),
+            ("k3", d.k3, 2.0),
+        ] {
+            self.num(
+                &format!("sensors.rgb.distortion.{key}"),
+                value,
+                -bound,
+                bound,
+                "an OpenCV distortion coefficient",
+            );
+        }
+        let valid_size = rgb.width_px >= 1 && rgb.height_px >= 1 && rgb.fov_deg > 0.0 && rgb.fov_deg < 180.0;
+        if self.problems.len() > before || d.is_zero() || !valid_size {
+            return;
+        }
+        let lens = crate::util::lens::Lens::new(d.coefficients());
+        let f = f64::from(rgb.width_px) / (2.0 * (rgb.fov_deg.to_radians() / 2.0).tan());
+        let (x, y) = (f64::from(rgb.width_px) * 0.5 / f, f64::from(rgb.height_px) * 0.5 / f);
+        let corners = [
+            (x, y),
+            (-x, y),
+            (x, -y),
+            (-x, -y),
+            (x, 0.0),
+            (0.0, y),
+            (-x, 0.0),
+            (0.0, -y),
+        ];
+        // Beyond the corners' radius by 2 %: the canvas's margin.
+        let folds = corners
+            .iter()
+            .any(|&(cx, cy)| lens.undistort(cx * 1.02, cy * 1.02).is_none());
+        if folds {
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!(
+                    "`sensors.rgb.distortion` folds over inside the image: its radial map stops growing at {:.0}° off \
+                     the axis, before the image's corners",
+                    lens.valid_r2.sqrt().atan().to_degrees()
+                ),
+            )
+            .at(self.span("sensors.rgb.distortion"), "this lens")
+            .help("a real lens's calibration keeps k1 r² + k2 r⁴ + k3 r⁶ small over the image; check the signs and the order [k1, k2, p1, p2, k3]");
+            self.problems.push(problem);
+        }
+    }
+
     pub(super) fn sensors(&mut self, s: &Sensors) {
         self.num(
             "sensors.rgb.width_px",
@@ -121,6 +177,7 @@ impl Validator<'_> {
             45.0,
             "a pitch offset in degrees",
         );
+        self.distortion(&s.rgb);
         let l = &s.lidar;
         self.num(
             "sensors.lidar.channels",

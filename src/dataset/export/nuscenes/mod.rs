@@ -111,6 +111,14 @@ pub fn export(ds: &Dataset, out: &Path, link: LinkMode, keyframe_hz: f64) -> Res
     }
     let frames = super::image_frames(ds, link, "nuScenes")?;
     let with_camera = frames.is_some();
+    if with_camera && !ds.spec.sensors.rgb.distortion.is_zero() {
+        return Err(refuse(format!(
+            "{}: the camera has lens distortion (sensors.rgb.distortion), and nuScenes' CAM_FRONT is a pinhole \
+             (camera_intrinsic only): the devkit would project boxes and points to the wrong pixels. Generate \
+             with sensors.rgb.distortion unset for nuScenes",
+            ds.layout.root().display()
+        )));
+    }
     let rendered = |s: &str| ds.manifest.sensors.get(s).is_some_and(|v| v.starts_with("rendered"));
     let with_lidar = rendered("lidar");
     if !with_camera && !with_lidar {
