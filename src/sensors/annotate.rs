@@ -627,8 +627,34 @@ pub fn annotate(
             });
         }
     }
+    if annotations.annotator_box.keyframe_every != crate::spec::types::CountRange(1, 1) {
+        redraw_at_keyframes(&mut out.rows, annotations, script.seed, camera);
+    }
     out.crossing = labels;
     out
+}
+
+/// Redraws every pedestrian's annotator boxes from keyframes ([`super::annotator::keyframe_track`]).
+fn redraw_at_keyframes(rows: &mut [AnnotationRow], annotations: &Annotations, clip_seed: u64, camera: &Camera) {
+    let mut by_pedestrian: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+    for (i, r) in rows.iter().enumerate() {
+        by_pedestrian.entry(r.pedestrian).or_default().push(i);
+    }
+    for (pedestrian, mut idx) in by_pedestrian {
+        idx.sort_by_key(|&i| rows[i].frame);
+        let frames: Vec<u32> = idx.iter().map(|&i| rows[i].frame).collect();
+        let tight: Vec<[f64; 4]> = idx.iter().map(|&i| rows[i].bbox_px.map(f64::from)).collect();
+        let boxes = super::annotator::keyframe_track(
+            &frames,
+            &tight,
+            &annotations.annotator_box,
+            (clip_seed, pedestrian),
+            (camera.width_px, camera.height_px),
+        );
+        for (&i, b) in idx.iter().zip(boxes) {
+            rows[i].annotator_bbox_px = b.map(|x| x as f32);
+        }
+    }
 }
 
 /// Writes joint `k` into a row's keypoint arrays: its pixel `px` with visibility `flag` (COCO's 0 / 1 / 2), and

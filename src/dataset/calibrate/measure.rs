@@ -105,6 +105,42 @@ pub fn quantile(xs: &mut [f64], q: f64) -> f64 {
     xs[i]
 }
 
+/// Lengths, in frames, of the pieces over which hand-drawn boxes move linearly: along every run of consecutive
+/// frames of a track, a piece of the left edge ends where its second difference exceeds one pixel (an
+/// annotation tool's interpolation between two keyframes, on whole pixels, keeps it within one). The
+/// annotator's keyframe spacing (`annotations.annotator_box.keyframe_every`) is fitted to these.
+pub fn linear_pieces(videos: &[RealVideo]) -> Vec<f64> {
+    let mut pieces = Vec::new();
+    for t in videos.iter().flat_map(|v| &v.tracks) {
+        let mut run: Vec<f64> = Vec::new();
+        let mut flush = |run: &mut Vec<f64>| {
+            let mut len = 1.0;
+            for w in run.windows(3) {
+                if (w[2] - 2.0 * w[1] + w[0]).abs() > 1.0 {
+                    pieces.push(len);
+                    len = 1.0;
+                } else {
+                    len += 1.0;
+                }
+            }
+            if run.len() >= 3 {
+                pieces.push(len);
+            }
+            run.clear();
+        };
+        let mut last = None;
+        for b in &t.boxes {
+            if last.is_some_and(|f| b.frame != f + 1) {
+                flush(&mut run);
+            }
+            run.push(b.x_min_px);
+            last = Some(b.frame);
+        }
+        flush(&mut run);
+    }
+    pieces
+}
+
 /// ROC AUC of `score` for `positive` (Mann–Whitney, ties counted half); `None` without both classes.
 pub fn auc(samples: &[(f64, bool)]) -> Option<f64> {
     let mut s: Vec<(f64, bool)> = samples.to_vec();

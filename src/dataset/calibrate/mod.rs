@@ -100,6 +100,9 @@ pub struct Fit {
     /// `annotations.annotator_box.min_aspect`: the 10th and 90th percentiles of the windows' box aspect
     /// (width / height), both classes.
     pub min_aspect: (f64, f64),
+    /// `annotations.annotator_box.keyframe_every`: the 25th and 75th percentiles of the lengths of the pieces
+    /// over which the real boxes' left edge moves linearly ([`measure::linear_pieces`]), frames.
+    pub keyframe_every: (u32, u32),
     /// `crossing.layers.behaviour_mix.mix`'s `sudden` share: crossers walking in the last frame of their windows
     /// (a sudden crosser walks into the road without stopping at the curb); `normal` and `jaywalk` share the
     /// rest 2 : 1 as the paper's mix does. `None` where the real data has no standing/walking labels.
@@ -234,6 +237,12 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
             round(aspect.p90.clamp(0.0, 2.0), 2),
         ),
         sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
+        keyframe_every: {
+            let mut pieces = measure::linear_pieces(videos);
+            let mut at = |q| (measure::quantile(&mut pieces, q).round() as u32).clamp(1, 300);
+            let lo = at(0.25);
+            (lo, at(0.75).max(lo))
+        },
     };
     Ok(Calibration {
         splits: options.splits.clone(),
@@ -318,8 +327,8 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     }
     let _ = writeln!(
         out,
-        "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows (p10, p90)",
-        f.min_aspect.0, f.min_aspect.1
+        "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows (p10, p90)\n    keyframe_every: [{}, {}]  # frames over which the real boxes move linearly (p25, p75): keyframes, interpolated",
+        f.min_aspect.0, f.min_aspect.1, f.keyframe_every.0, f.keyframe_every.1
     );
     out
 }

@@ -67,6 +67,17 @@ pub struct AnnotatorBox {
     pub noise_px: f64,
     /// Edges on whole pixels, as annotation tools write them.
     pub whole_pixels: bool,
+    /// Frames between the keyframes a person draws, `[min, max]` (each gap drawn per pedestrian and keyframe):
+    /// between keyframes the tool interpolates the box's corner, width and height linearly and writes each on
+    /// whole pixels, so the size holds for frames at a time as in JAAD. `[1, 1]` (the default) draws every
+    /// frame.
+    #[serde(skip_serializing_if = "is_every_frame")]
+    pub keyframe_every: super::CountRange,
+}
+
+/// Whether keyframes are every frame (the default, left out of the resolved spec).
+fn is_every_frame(r: &super::CountRange) -> bool {
+    *r == super::CountRange(1, 1)
 }
 
 impl Default for AnnotatorBox {
@@ -76,6 +87,7 @@ impl Default for AnnotatorBox {
             min_aspect: Range(0.3, 0.45),
             noise_px: 0.5,
             whole_pixels: true,
+            keyframe_every: super::CountRange(1, 1),
         }
     }
 }

@@ -357,5 +357,12 @@ impl Validator<'_> {
             100.0,
             "a noise in pixels",
         );
+        self.count_range(
+            "annotations.annotator_box.keyframe_every",
+            b.keyframe_every,
+            1,
+            300,
+            "frames between drawn keyframes",
+        );
     }
 }
