@@ -77,6 +77,9 @@ pub struct SimParams {
     /// plan file).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cyclists: Option<Cyclists>,
+    /// The ego's heading wobble (absent when off, and then absent from the plan file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego_heading: Option<crate::spec::types::HeadingWobble>,
 }
 
 impl SimParams {
@@ -95,6 +98,7 @@ impl SimParams {
             gestures: spec.pedestrians.gestures.clone(),
             signals: spec.traffic.signals.enabled.then(|| spec.traffic.signals.clone()),
             cyclists: (spec.traffic.cyclists.per_clip.max() > 0).then(|| spec.traffic.cyclists.clone()),
+            ego_heading: Some(spec.traffic.ego.heading_wobble).filter(|w| w.sd_deg > 0.0),
         }
     }
 }

@@ -105,7 +105,31 @@ pub fn simulate_all(plan: &Plan, towns: &BTreeMap<String, TownContext>) -> Resul
 pub fn simulate(script: &ClipScript, params: &SimParams, town: &RoadNetwork) -> ClipTrace {
     let mut sim = Sim::new(script, params, town);
     sim.run();
-    sim.trace
+    let mut trace = sim.trace;
+    if let Some(wobble) = &params.ego_heading {
+        wobble_heading(&mut trace, wobble, script.seed, script.fps);
+    }
+    trace
+}
+
+/// Adds the ego's heading wobble to its recorded headings: an AR(1) of stationary deviation `sd_deg` and
+/// correlation time `correlation_s`, from the clip's `"ego heading"` stream (the same draws whatever else the
+/// spec changes). The sensors point along the recorded heading; the simulated path is unchanged.
+fn wobble_heading(trace: &mut ClipTrace, wobble: &crate::spec::types::HeadingWobble, clip_seed: u64, fps: u32) {
+    use rand_distr::{Distribution, StandardNormal};
+    let mut rng = crate::plan::seeds::clip_rng(clip_seed, "ego heading");
+    let sd_rad = wobble.sd_deg.to_radians();
+    let rho = (-1.0 / (f64::from(fps.max(1)) * wobble.correlation_s.max(1e-3))).exp();
+    let innovation = sd_rad * (1.0 - rho * rho).sqrt();
+    let first: f64 = StandardNormal.sample(&mut rng);
+    let mut offset_rad = sd_rad * first;
+    for (i, frame) in trace.ego.iter_mut().enumerate() {
+        if i > 0 {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            offset_rad = rho * offset_rad + innovation * z;
+        }
+        frame.yaw_rad += offset_rad;
+    }
 }
 
 /// The state of one clip's simulation.

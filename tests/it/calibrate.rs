@@ -91,6 +91,15 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         spec.crossing.scenario.crosser_ego_within_m.min(),
         f.crosser_ego_within_m.0
     );
+    // JAAD's boxes move linearly over pieces of 2–10 frames (p25–p75): the annotator's keyframes. Pedestrians seen
+    // together share a change of bearing of a 1.9° heading wobble (tools' Python estimate of the same: 1.90°).
+    assert_eq!(f.keyframe_every, (2, 10));
+    assert_eq!(
+        spec.annotations.annotator_box.keyframe_every,
+        pedsynth::spec::types::CountRange(2, 10)
+    );
+    assert_eq!(f.heading_wobble_sd_deg, Some(1.9));
+    assert_eq!(spec.traffic.ego.heading_wobble.sd_deg, 1.9);
 }
 
 #[test]

@@ -37,3 +37,48 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     assert!(one.1 == alone, "a clip alone differs from the same clip in a batch");
     Ok(())
 }
+
+#[test]
+fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+    let plan_with = |overrides: &[&str]| {
+        let options = LoadOptions {
+            overrides: overrides.iter().map(|s| s.to_string()).collect(),
+            allow_large: false,
+            profile: None,
+        };
+        pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
+    };
+    let (_, towns, off) = plan_with(&[]);
+    let (_, _, on) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
+    assert!(off.sim.ego_heading.is_none(), "off: absent from the plan file");
+    assert_eq!(off.clips, on.clips, "the wobble changes no clip script");
+    let net = &towns[&off.clips[0].town].network;
+    let (a, b) = (
+        sim::simulate(&off.clips[0], &off.sim, net),
+        sim::simulate(&on.clips[0], &on.sim, net),
+    );
+    assert_eq!(
+        b,
+        sim::simulate(&on.clips[0], &on.sim, net),
+        "a pure function of the clip"
+    );
+    let offsets: Vec<f64> = a
+        .ego
+        .iter()
+        .zip(&b.ego)
+        .map(|(x, y)| (y.yaw_rad - x.yaw_rad).to_degrees())
+        .collect();
+    for (x, y) in a.ego.iter().zip(&b.ego) {
+        assert_eq!((x.pos, x.speed_mps), (y.pos, y.speed_mps), "the path is unchanged");
+    }
+    assert_eq!(a.pedestrians, b.pedestrians, "nobody else moves differently");
+    // An AR(1) of sd 2° and 1 s correlation at 30 frames/s changes by sd·√(2 (1 − e^(−1/30))) = 0.512° a frame.
+    let steps: Vec<f64> = offsets.windows(2).map(|w| w[1] - w[0]).collect();
+    let step_sd = (steps.iter().map(|d| d * d).sum::<f64>() / steps.len() as f64).sqrt();
+    assert!((step_sd - 0.512).abs() < 0.08, "per-frame change sd {step_sd}°");
+    assert!(
+        offsets.iter().all(|o| o.abs() < 10.0) && offsets.iter().any(|o| o.abs() > 0.5),
+        "{offsets:?}"
+    );
+}

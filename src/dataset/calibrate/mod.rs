@@ -103,6 +103,9 @@ pub struct Fit {
     /// `annotations.annotator_box.keyframe_every`: the 25th and 75th percentiles of the lengths of the pieces
     /// over which the real boxes' left edge moves linearly ([`measure::linear_pieces`]), frames.
     pub keyframe_every: (u32, u32),
+    /// `traffic.ego.heading_wobble.sd_deg`: [`measure::pan_sd_deg`] with the fitted focal length (correlation
+    /// time 1 s, assumed). `None` where too few pedestrians are seen together.
+    pub heading_wobble_sd_deg: Option<f64>,
     /// `crossing.layers.behaviour_mix.mix`'s `sudden` share: crossers walking in the last frame of their windows
     /// (a sudden crosser walks into the road without stopping at the curb); `normal` and `jaywalk` share the
     /// rest 2 : 1 as the paper's mix does. `None` where the real data has no standing/walking labels.
@@ -237,6 +240,7 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
             round(aspect.p90.clamp(0.0, 2.0), 2),
         ),
         sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
+        heading_wobble_sd_deg: measure::pan_sd_deg(videos, focal_px).map(|sd| round(sd.clamp(0.0, 10.0), 1)),
         keyframe_every: {
             let mut pieces = measure::linear_pieces(videos);
             let mut at = |q| (measure::quantile(&mut pieces, q).round() as u32).clamp(1, 300);
@@ -323,6 +327,12 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
             out,
             "  layers:\n    behaviour_mix:\n      mix: {{normal: {normal}, sudden: {sudden}, jaywalk: {jaywalk}}}  # {:.0} % of real crossers walk 1-2 s before crossing",
             100.0 * sudden
+        );
+    }
+    if let Some(sd) = f.heading_wobble_sd_deg {
+        let _ = writeln!(
+            out,
+            "traffic:\n  ego:\n    heading_wobble: {{sd_deg: {sd}, correlation_s: 1}}  # what pedestrians seen together share of their change of bearing over 0.5 s (an upper bound: includes the car's forward motion; 1 s assumed)"
         );
     }
     let _ = writeln!(

@@ -247,6 +247,31 @@ pub struct Ego {
     /// ... and waits at most this long, seconds `[min, max]` drawn per clip; then it drives on at its eased speed
     /// (the pedestrian still may cross: the ego brakes for anyone crossing in its path).
     pub courtesy_patience_s: Range,
+    /// The ego's heading about its path as a real car's wanders (lane-keeping corrections, the road's camber
+    /// and curves a lane does not have): off by default.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub heading_wobble: HeadingWobble,
+}
+
+/// An AR(1) offset of the ego's recorded heading (so of its camera and LiDAR), drawn per clip from its seed
+/// (the stream `"ego heading"`): stationary standard deviation `sd_deg`, correlation time `correlation_s`. The
+/// simulated path does not change, only where the car (and its sensors) point along it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct HeadingWobble {
+    /// Standard deviation of the heading offset, degrees (0: off).
+    pub sd_deg: f64,
+    /// Correlation time of the offset, seconds.
+    pub correlation_s: f64,
+}
+
+impl Default for HeadingWobble {
+    fn default() -> Self {
+        HeadingWobble {
+            sd_deg: 0.0,
+            correlation_s: 1.0,
+        }
+    }
 }
 
 impl Default for Ego {
@@ -262,6 +287,7 @@ impl Default for Ego {
             courtesy_lateral_m: 10.0,
             courtesy_stop_short_m: 8.0,
             courtesy_patience_s: Range(5.0, 12.0),
+            heading_wobble: HeadingWobble::default(),
         }
     }
 }

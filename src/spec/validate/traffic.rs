@@ -94,6 +94,20 @@ impl Validator<'_> {
             "a percentage below the speed limit",
         );
         self.positive("traffic.ego.min_gap_m", t.ego.min_gap_m, 50.0, "a gap in metres");
+        self.num(
+            "traffic.ego.heading_wobble.sd_deg",
+            t.ego.heading_wobble.sd_deg,
+            0.0,
+            10.0,
+            "a standard deviation of the heading in degrees",
+        );
+        self.num(
+            "traffic.ego.heading_wobble.correlation_s",
+            t.ego.heading_wobble.correlation_s,
+            0.05,
+            60.0,
+            "a correlation time in seconds",
+        );
         self.positive(
             "traffic.ego.brake_ahead_m",
             t.ego.brake_ahead_m,
