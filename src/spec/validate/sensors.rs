@@ -98,20 +98,13 @@ impl Validator<'_> {
         let lens = crate::util::lens::Lens::new(d.coefficients());
         let f = f64::from(rgb.width_px) / (2.0 * (rgb.fov_deg.to_radians() / 2.0).tan());
         let (x, y) = (f64::from(rgb.width_px) * 0.5 / f, f64::from(rgb.height_px) * 0.5 / f);
-        let corners = [
-            (x, y),
-            (-x, y),
-            (x, -y),
-            (-x, -y),
-            (x, 0.0),
-            (0.0, y),
-            (-x, 0.0),
-            (0.0, -y),
-        ];
-        // Beyond the corners' radius by 2 %: the canvas's margin.
-        let folds = corners
-            .iter()
-            .any(|&(cx, cy)| lens.undistort(cx * 1.02, cy * 1.02).is_none());
+        // The renderer inverts the lens at every border pixel (its canvas covers their undistorted positions):
+        // check the border, 2 % out for the canvas's margin, at 257 points an edge.
+        let mut border = (0..=256).flat_map(|k| {
+            let t = f64::from(k) / 128.0 - 1.0;
+            [(t * x, y), (t * x, -y), (x, t * y), (-x, t * y)]
+        });
+        let folds = border.any(|(bx, by)| lens.undistort(bx * 1.02, by * 1.02).is_none());
         if folds {
             let problem = Problem::new(
                 code::OUT_OF_RANGE,
