@@ -1,6 +1,7 @@
 //! Where a clip's pedestrians start: on the sidewalk 10–55 m ahead on alternating sides; crossers and hard
-//! negatives back along the sidewalk from their curb point by their approach; mid-road jaywalkers in a driving
-//! lane; group followers beside their leader; at the first signalised crosswalk where lights run.
+//! negatives back along the sidewalk from their curb point by their approach; non-crossers optionally at a drawn
+//! distance to the side; mid-road jaywalkers in a driving lane; group followers beside their leader; at the
+//! first signalised crosswalk where lights run.
 
 use super::*;
 
@@ -153,7 +154,17 @@ pub(super) fn plan_pedestrians(
                 }
                 // Walkers too start within the spawn range, so that the camera sees them about as long as crossers
                 // (the benchmark protocol counts a track only when it is long enough).
-                (Role::NonCrosser, _) => place_sidewalk(net, route, walker_range.0, walker_range.1, &scripts, rng),
+                // With a lateral rule, a walker starts on sidewalk at its drawn distance to the side: in the
+                // walkers' range ahead, else anywhere in view ahead (side streets are few), else beside the route.
+                (Role::NonCrosser, _) => scenario_rng
+                    .as_mut()
+                    .filter(|_| scenario.walker_lateral_m.max() > 0.0)
+                    .map(|r| draw(r, scenario.walker_lateral_m))
+                    .and_then(|lateral_m| {
+                        place_aside(net, route, walker_range, lateral_m, &scripts, rng)
+                            .or_else(|| place_aside(net, route, (spawn_ahead.min(), far_m), lateral_m, &scripts, rng))
+                    })
+                    .or_else(|| place_sidewalk(net, route, walker_range.0, walker_range.1, &scripts, rng)),
             }
         };
         let (spawn, heading, ahead, crossing, place) = placed.ok_or_else(|| {
@@ -376,15 +387,44 @@ pub(super) fn place_sidewalk(
         if !far_from_others(sample.pos, scripts) || !is_lane(net, sample.pos, LaneType::Sidewalk) {
             continue;
         }
-        let along = route.pose_at(s).heading_rad;
-        let heading = if rng.random_bool(0.5) {
-            along
-        } else {
-            wrap_angle(along + PI)
-        };
+        let heading = either_way(route.pose_at(s).heading_rad, rng);
         // Non-crossers never cross: no crossing vector (the costliest query) is computed for them.
         let crossing = None;
         return Some((sample.pos, heading, s, crossing, SpawnPlace::Sidewalk));
+    }
+    None
+}
+
+/// A walker's heading: along the route's `heading_rad` or against it, even odds.
+fn either_way(heading_rad: f64, rng: &mut ChaCha20Rng) -> f64 {
+    if rng.random_bool(0.5) {
+        heading_rad
+    } else {
+        wrap_angle(heading_rad + PI)
+    }
+}
+
+/// A non-crosser on free sidewalk `lateral_m` to the side of the ego's route (either side), somewhere in
+/// `ahead_m` (arc length along it, `[lo, hi]` metres): beside a wide road, along a side street or across a
+/// junction. `None` where the route has no such sidewalk within [`PLACEMENT_ATTEMPTS`] draws.
+pub(super) fn place_aside(
+    net: &RoadNetwork,
+    route: &Route,
+    (lo, hi): (f64, f64),
+    lateral_m: f64,
+    scripts: &[PedestrianScript],
+    rng: &mut ChaCha20Rng,
+) -> Option<Placement> {
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        let s = if hi > lo { rng.random_range(lo..hi) } else { lo };
+        let pose = route.pose_at(s);
+        let left = DVec2::from_angle(pose.heading_rad).perp();
+        let n = if rng.random_bool(0.5) { left } else { -left };
+        let p = pose.pos + n * lateral_m;
+        if !is_lane(net, p, LaneType::Sidewalk) || !far_from_others(p, scripts) {
+            continue;
+        }
+        return Some((p, either_way(pose.heading_rad, rng), s, None, SpawnPlace::Sidewalk));
     }
     None
 }
@@ -477,4 +517,54 @@ pub(super) fn place_follower(
         ));
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::SeedableRng;
+
+    use super::*;
+
+    /// Walkers placed aside stand on free sidewalk exactly their drawn distance to the side of the route, at
+    /// every distance a town has sidewalk; where it has none in reach, there is no placement (the planner then
+    /// falls back to the sidewalk beside the route).
+    #[test]
+    fn walkers_aside_stand_on_sidewalk_at_their_distance_from_the_route() {
+        let net = RoadNetwork::builtin("town01_like").expect("a built-in town");
+        let mut rng = ChaCha20Rng::seed_from_u64(7);
+        let mut placed_by_distance = BTreeMap::new();
+        for _ in 0..40 {
+            let route = net.random_route(&mut rng, 150.0).expect("a route");
+            for lateral_m in [4.0, 9.0, 12.0, 18.0, 30.0] {
+                let Some((spawn, _, ahead_m, crossing, place)) =
+                    place_aside(&net, &route, (10.0, 120.0), lateral_m, &[], &mut rng)
+                else {
+                    continue;
+                };
+                *placed_by_distance.entry(lateral_m as u32).or_insert(0) += 1;
+                assert!((10.0..=120.0).contains(&ahead_m));
+                assert!(crossing.is_none() && place == SpawnPlace::Sidewalk);
+                assert!(is_lane(&net, spawn, LaneType::Sidewalk));
+                let pose = route.pose_at(ahead_m);
+                let offset = spawn - pose.pos;
+                let along = DVec2::from_angle(pose.heading_rad);
+                assert!(offset.dot(along).abs() < 1e-9, "straight out to the side");
+                assert!((offset.length() - lateral_m).abs() < 1e-9);
+            }
+        }
+        // Sidewalk beside the route (4-9 m in town01_like) is found on every route; side streets and the far
+        // sides of junctions (12-30 m) on some (24, 16 and 12 of 40 when this was written).
+        for (lateral_m, least) in [(4, 40), (9, 40), (12, 10), (18, 8), (30, 5)] {
+            let got = placed_by_distance.get(&lateral_m).copied().unwrap_or(0);
+            assert!(
+                got >= least,
+                "{got} of 40 routes have sidewalk {lateral_m} m aside: {placed_by_distance:?}"
+            );
+        }
+        let route = net.random_route(&mut rng, 150.0).expect("a route");
+        assert!(
+            place_aside(&net, &route, (10.0, 60.0), 400.0, &[], &mut rng).is_none(),
+            "beyond the town"
+        );
+    }
 }

@@ -94,9 +94,14 @@ pub struct Fit {
     /// inside it (they wait for their gap and the ego's yield): hence the nearer half of the real distances.
     pub crosser_ego_within_m: (f64, f64),
     /// `crossing.scenario.walker_ahead_m`: the 50th and 90th percentiles of non-crossers' distance when first
-    /// annotated, tracks of the benchmark's minimum length only (walkers are placed at the clip's start, and the
+    /// annotated, tracks of the benchmark's minimum length of pedestrians not labelled crossers only (a crosser
+    /// whose crossing point is unknown is no walker; walkers are placed at the clip's start, and the
     /// ego drives towards them during the clip: the farther half keeps them ahead, as real bystanders are).
     pub walker_ahead_m: (f64, f64),
+    /// `crossing.scenario.walker_lateral_m`: the 10th and 90th percentiles of how far to the side of the camera
+    /// non-crossers are when first annotated (box centre's offset from the image's centre column, in metres at
+    /// the box's distance through the mean height), the same tracks as `walker_ahead_m`.
+    pub walker_lateral_m: (f64, f64),
     /// `annotations.annotator_box.min_aspect`: the 10th and 90th percentiles of the windows' box aspect
     /// (width / height), both classes.
     pub min_aspect: (f64, f64),
@@ -188,22 +193,27 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     let distance = |b: &RealBox| measure::distance_m(focal_px, options.person_height_m, b.y_max_px - b.y_min_px);
     let mut at_crossing = Vec::new();
     let mut walkers_first = Vec::new();
-    for t in videos.iter().flat_map(|v| &v.tracks) {
+    let mut walkers_aside = Vec::new();
+    for (v, t) in videos.iter().flat_map(|v| v.tracks.iter().map(move |t| (v, t))) {
         match t.crossing_frame {
             Some(f) if t.crosser => {
                 if let Some(b) = t.boxes.iter().rev().find(|b| b.frame <= f && !b.occluded) {
                     at_crossing.push(distance(b));
                 }
             }
-            _ if t.boxes.len() >= options.pab.min_track => {
+            _ if !t.crosser && t.boxes.len() >= options.pab.min_track => {
                 if let Some(b) = t.boxes.iter().find(|b| !b.occluded) {
                     walkers_first.push(distance(b));
+                    let centre_px = (b.x_min_px + b.x_max_px) / 2.0 - v.width_px / 2.0;
+                    walkers_aside
+                        .push((centre_px / (b.y_max_px - b.y_min_px).max(1.0) * options.person_height_m).abs());
                 }
             }
             _ => {}
         }
     }
     let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
+    let walkers_aside = measure::Spread::of(walkers_aside);
     let aspect = measure::Spread::of(
         measure::windows(videos, &options.pab)
             .iter()
@@ -235,6 +245,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
             round(walkers_at.p50.clamp(1.0, 200.0), 1),
             round(walkers_at.p90.clamp(1.0, 200.0), 1),
         ),
+        walker_lateral_m: {
+            let lo = round(walkers_aside.p10.clamp(0.0, 100.0), 1);
+            (lo, round(walkers_aside.p90.clamp(lo, 100.0), 1))
+        },
         min_aspect: (
             round(aspect.p10.clamp(0.0, 2.0), 2),
             round(aspect.p90.clamp(0.0, 2.0), 2),
@@ -317,8 +331,13 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p50)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p50, p90)",
-        f.crosser_ego_within_m.0, f.crosser_ego_within_m.1, f.walker_ahead_m.0, f.walker_ahead_m.1
+        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p50)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p50, p90)\n    walker_lateral_m: [{}, {}]  # and how far to the side (p10, p90)",
+        f.crosser_ego_within_m.0,
+        f.crosser_ego_within_m.1,
+        f.walker_ahead_m.0,
+        f.walker_ahead_m.1,
+        f.walker_lateral_m.0,
+        f.walker_lateral_m.1
     );
     if let Some(sudden) = f.sudden_share {
         let normal = (((1.0 - sudden) * 2.0 / 3.0) * 100.0).round() / 100.0;

@@ -68,6 +68,12 @@ pub struct Scenario {
     /// Where non-crossers walking along the sidewalk start, ahead of the ego along its route, metres
     /// `[min, max]`. `[0, 0]` (default): from layer 1's `spawn_ahead_m` minimum to the visibility distance.
     pub walker_ahead_m: Range,
+    /// How far to the side of the ego's route non-crossers walking along a sidewalk start, metres `[min, max]`,
+    /// drawn per walker: the planner looks for free sidewalk at that distance (beside a wide road, along a side
+    /// street, across a junction) and falls back to the sidewalk beside the route where there is none in reach.
+    /// Real bystanders stand at every distance to the side; the sidewalk beside a two-lane road is 4–7 m out.
+    /// `[0, 0]` (default): the sidewalk beside the route.
+    pub walker_lateral_m: Range,
 }
 
 impl Default for Scenario {
@@ -75,6 +81,7 @@ impl Default for Scenario {
         Scenario {
             crosser_ego_within_m: Range(0.0, 0.0),
             walker_ahead_m: Range(0.0, 0.0),
+            walker_lateral_m: Range(0.0, 0.0),
         }
     }
 }

@@ -225,6 +225,7 @@ impl Validator<'_> {
                 c.scenario.crosser_ego_within_m,
             ),
             ("crossing.scenario.walker_ahead_m", c.scenario.walker_ahead_m),
+            ("crossing.scenario.walker_lateral_m", c.scenario.walker_lateral_m),
         ] {
             self.range(key, range, 0.0, 500.0, "a distance to the ego in metres ([0, 0]: off)");
         }
