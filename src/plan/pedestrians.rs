@@ -161,8 +161,12 @@ pub(super) fn plan_pedestrians(
                     .filter(|_| scenario.walker_lateral_m.max() > 0.0)
                     .map(|r| draw(r, scenario.walker_lateral_m))
                     .and_then(|lateral_m| {
-                        place_aside(net, route, walker_range, lateral_m, &scripts, rng)
-                            .or_else(|| place_aside(net, route, (spawn_ahead.min(), far_m), lateral_m, &scripts, rng))
+                        let in_view = (spawn_ahead.min(), far_m);
+                        place_aside(net, route, walker_range, lateral_m, &scripts, rng).or_else(|| {
+                            (walker_range != in_view)
+                                .then(|| place_aside(net, route, in_view, lateral_m, &scripts, rng))
+                                .flatten()
+                        })
                     })
                     .or_else(|| place_sidewalk(net, route, walker_range.0, walker_range.1, &scripts, rng)),
             }

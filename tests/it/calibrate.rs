@@ -99,8 +99,9 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         pedsynth::spec::types::CountRange(2, 10)
     );
     assert_eq!(f.heading_wobble_sd_deg, Some(1.9));
-    // Non-crossers (JAAD's crossing attribute not 1, tracks of 76+ frames, 666 of them) first seen 2.1–19.4 m
-    // to the side (p10–p90; numpy's percentiles of the same boxes: 2.09 and 19.44).
+    // Non-crossers (JAAD's crossing attribute not 1, tracks of 76+ frames, 666 of them) first seen 2.1–19.5 m
+    // to the side (p10–p90 as `measure::quantile` reads them; numpy's interpolated percentiles of the same boxes:
+    // 2.09 and 19.44).
     assert_eq!(f.walker_lateral_m, (2.1, 19.5));
     assert_eq!(
         spec.crossing.scenario.walker_lateral_m,

@@ -71,7 +71,7 @@ pub struct Scenario {
     /// How far to the side of the ego's route non-crossers walking along a sidewalk start, metres `[min, max]`,
     /// drawn per walker: the planner looks for free sidewalk at that distance (beside a wide road, along a side
     /// street, across a junction) and falls back to the sidewalk beside the route where there is none in reach.
-    /// Real bystanders stand at every distance to the side; the sidewalk beside a two-lane road is 4–7 m out.
+    /// Real bystanders stand at every distance to the side; the sidewalk beside a two-lane road is 2–9 m out.
     /// `[0, 0]` (default): the sidewalk beside the route.
     pub walker_lateral_m: Range,
 }
