@@ -59,6 +59,28 @@ fn render_rgb_clip_frames(bencher: divan::Bencher, weather: &str) {
         });
 }
 
+/// The sensor noise of the `jaad` profile (`shot` 0.012, `read` 0.0005) added to the busiest night-rain frame,
+/// on one core: what a noisy camera costs per frame.
+#[divan::bench]
+fn add_noise(bencher: divan::Bencher) {
+    let s = common::busy_quickstart_clip(&[
+        "dataset.weathers=[night_rainy]".to_owned(),
+        "sensors.rgb.noise.shot=0.012".to_owned(),
+        "sensors.rgb.noise.read=0.0005".to_owned(),
+    ]);
+    let mut r = s.busy_render();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+    pool.install(|| s.render_busy(&mut r));
+    let clean = r.img.clone();
+    bencher.bench_local(|| {
+        r.img.rgb.copy_from_slice(&clean.rgb);
+        pool.install(|| {
+            r.renderer
+                .add_noise(&mut r.img, sensors::camera::noise_seed(s.script.seed, s.frame))
+        });
+    });
+}
+
 #[divan::bench]
 fn build_frame_scene(bencher: divan::Bencher) {
     let s = setup("clear_noon");

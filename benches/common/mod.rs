@@ -6,7 +6,6 @@ use std::path::Path;
 
 use pedsynth::plan::ClipScript;
 use pedsynth::sensors;
-use pedsynth::sensors::camera::light::Lighting;
 use pedsynth::sensors::camera::{CameraImages, Renderer, streak_seed};
 use pedsynth::sensors::scene::{FrameScene, SceneTime, StaticScene, ego_at};
 use pedsynth::sim;
@@ -73,10 +72,10 @@ impl BusyClip {
 
     /// A renderer with the clip's lighting, set up for its busiest frame.
     pub fn busy_render(&self) -> BusyRender {
-        let light = Lighting::from_weather(&self.script.weather_params);
         let (frame, pose) = self.camera_frame(self.frame);
         BusyRender {
-            renderer: Renderer::new(&self.rig.camera, light, self.script.seed),
+            // Exposed as the clip is (auto-exposure's gain is in the tone curve's table: no cost per frame).
+            renderer: pedsynth::sensors::clip_renderer(&self.scene, &self.script, &self.trace, &self.rig),
             frame,
             pose,
             img: CameraImages::default(),

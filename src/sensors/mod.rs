@@ -73,8 +73,7 @@ pub fn render_cameras<E>(
     rig: &Rig,
     mut sink: impl FnMut(SensorFrame) -> Result<(), E>,
 ) -> Result<(), E> {
-    let light = camera::light::Lighting::from_weather(&script.weather_params);
-    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut renderer = clip_renderer(stat, script, trace, rig);
     let mut frame_scene = scene::FrameScene::default();
     let mut images = camera::CameraImages::default();
     let (w, h) = (rig.camera.width_px as usize, rig.camera.height_px as usize);
@@ -82,18 +81,19 @@ pub fn render_cameras<E>(
     let substeps = sensors.dvs.substeps.max(1);
     let mut events = Vec::new();
     let frames = trace.frame_count.min(trace.ego.len() as u32);
-    let mut render = |t: scene::SceneTime, k: u32, images: &mut camera::CameraImages| {
-        frame_scene.build(stat, script, trace, t);
-        let (pos, yaw) = scene::ego_at(trace, t);
-        let pose = rig.camera.at(pos, yaw);
-        renderer.render(
-            stat,
-            &frame_scene,
-            &pose,
-            camera::streak_seed(script.seed, t.frame, k),
-            images,
-        );
-    };
+    let mut render =
+        |renderer: &mut camera::Renderer, t: scene::SceneTime, k: u32, images: &mut camera::CameraImages| {
+            frame_scene.build(stat, script, trace, t);
+            let (pos, yaw) = scene::ego_at(trace, t);
+            let pose = rig.camera.at(pos, yaw);
+            renderer.render(
+                stat,
+                &frame_scene,
+                &pose,
+                camera::streak_seed(script.seed, t.frame, k),
+                images,
+            );
+        };
     for frame in 0..frames {
         events.clear();
         if let Some(esim) = esim.as_mut()
@@ -104,7 +104,7 @@ pub fn render_cameras<E>(
                     frame: frame - 1,
                     alpha: f64::from(k) / f64::from(substeps),
                 };
-                render(t, k, &mut images);
+                render(&mut renderer, t, k, &mut images);
                 let now = frame_time_ns(frame - 1, script.fps, k, substeps);
                 esim.step(
                     &images.rgb,
@@ -114,7 +114,7 @@ pub fn render_cameras<E>(
                 );
             }
         }
-        render(scene::SceneTime::at(frame), 0, &mut images);
+        render(&mut renderer, scene::SceneTime::at(frame), 0, &mut images);
         let now = frame_time_ns(frame, script.fps, 0, 1);
         if let Some(esim) = esim.as_mut() {
             esim.step(
@@ -124,6 +124,8 @@ pub fn render_cameras<E>(
                 &mut events,
             );
         }
+        // The DVS saw the clean image; the RGB stream gets the sensor's noise.
+        renderer.add_noise(&mut images, camera::noise_seed(script.seed, frame));
         sink(SensorFrame {
             frame,
             timestamp_ns: now,
@@ -216,8 +218,7 @@ pub fn render_frame(
     frame: u32,
 ) -> camera::CameraImages {
     let stat = scene::StaticScene::build(script, trace, town);
-    let light = camera::light::Lighting::from_weather(&script.weather_params);
-    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let mut renderer = clip_renderer(&stat, script, trace, rig);
     let mut frame_scene = scene::FrameScene::default();
     let mut images = camera::CameraImages::default();
     let t = scene::SceneTime::at(frame);
@@ -230,5 +231,46 @@ pub fn render_frame(
         camera::streak_seed(script.seed, frame, 0),
         &mut images,
     );
+    renderer.add_noise(&mut images, camera::noise_seed(script.seed, frame));
     images
+}
+
+/// Frames auto-exposure meters, as shares of the clip.
+const METERED_QUARTERS: u64 = 4;
+
+/// The renderer of a clip's camera, exposed for the clip. With auto-exposure (`sensors.rgb.exposure`), four
+/// frames at 0, ¼, ½ and ¾ of the clip are rendered at a gain of 1 and metered
+/// ([`camera::expose::brightness`]); the clip is rendered at the gain their geometric mean calls for
+/// ([`camera::expose::auto_gain`]). A pure function of (script, trace, rig): every frame stays a pure function
+/// of (script, trace, frame).
+pub fn clip_renderer(stat: &scene::StaticScene, script: &ClipScript, trace: &ClipTrace, rig: &Rig) -> camera::Renderer {
+    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    let frames = u64::from(trace.frame_count.min(trace.ego.len() as u32));
+    let Some((key, max_gain)) = rig.camera.imaging.auto_exposure else {
+        return renderer;
+    };
+    if frames == 0 {
+        return renderer;
+    }
+    let mut frame_scene = scene::FrameScene::default();
+    let mut images = camera::CameraImages::default();
+    let mut log_sum = 0.0;
+    for k in 0..METERED_QUARTERS {
+        let frame = (frames * k / METERED_QUARTERS) as u32;
+        let t = scene::SceneTime::at(frame);
+        frame_scene.build(stat, script, trace, t);
+        let (pos, yaw) = scene::ego_at(trace, t);
+        renderer.render(
+            stat,
+            &frame_scene,
+            &rig.camera.at(pos, yaw),
+            camera::streak_seed(script.seed, frame, 0),
+            &mut images,
+        );
+        log_sum += camera::expose::brightness(&images.rgb).max(1.0e-12).ln();
+    }
+    let brightness = (log_sum / METERED_QUARTERS as f64).exp();
+    renderer.set_gain(camera::expose::auto_gain(brightness, key, max_gain));
+    renderer
 }

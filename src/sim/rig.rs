@@ -11,7 +11,7 @@ use glam::{DAffine3, DMat3, DVec2, DVec3};
 use rand::RngExt;
 
 use crate::plan::seeds::clip_rng;
-use crate::spec::types::{Mount, Rgb, Sensors};
+use crate::spec::types::{ExposureMode, Mount, Rgb, Sensors};
 use crate::util::lens::Lens;
 
 /// The sensors on the ego vehicle, placed and configured from the spec.
@@ -60,6 +60,47 @@ pub struct Camera {
     pub vehicle_from_sensor: DAffine3,
     /// Lens distortion between the pinhole and the pixels ([`Lens::is_pinhole`] for none).
     pub lens: Lens,
+    /// What the sensor does with the light: exposure, vignetting, noise.
+    pub imaging: Imaging,
+}
+
+/// The camera's imaging of light into pixels (from `sensors.rgb`'s `exposure`, `vignetting` and `noise`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Imaging {
+    /// Auto-exposure's `(key, max_gain)`; `None` for a fixed gain of 1.
+    pub auto_exposure: Option<(f32, f32)>,
+    /// Share of the light lost at the image's corners.
+    pub vignetting: f32,
+    /// Shot noise's standard deviation at a linear signal of 1.
+    pub shot_noise: f32,
+    /// Read noise's standard deviation.
+    pub read_noise: f32,
+}
+
+impl Imaging {
+    /// The imaging of a spec's RGB camera.
+    pub fn from_spec(rgb: &Rgb) -> Imaging {
+        let e = &rgb.exposure;
+        Imaging {
+            auto_exposure: (e.mode == ExposureMode::Auto).then_some((e.key as f32, e.max_gain as f32)),
+            vignetting: rgb.vignetting as f32,
+            shot_noise: rgb.noise.shot as f32,
+            read_noise: rgb.noise.read as f32,
+        }
+    }
+
+    /// An ideal sensor: a gain of 1, no vignetting, no noise.
+    pub const IDEAL: Imaging = Imaging {
+        auto_exposure: None,
+        vignetting: 0.0,
+        shot_noise: 0.0,
+        read_noise: 0.0,
+    };
+
+    /// Whether the sensor adds noise.
+    pub fn noisy(&self) -> bool {
+        self.shot_noise > 0.0 || self.read_noise > 0.0
+    }
 }
 
 /// The rotation taking sensor axes (x forward, y left, z up) to optical axes (x right, y down, z forward).
@@ -138,6 +179,7 @@ impl Camera {
             focal_px,
             vehicle_from_sensor: vehicle_from_mount(&rgb.mount),
             lens: Lens::new(rgb.distortion.coefficients()),
+            imaging: Imaging::from_spec(rgb),
         }
     }
 

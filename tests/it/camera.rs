@@ -34,12 +34,12 @@ fn options(overrides: &[&str]) -> LoadOptions {
 }
 
 pub(crate) struct Clip {
-    plan: Plan,
-    towns: BTreeMap<String, TownContext>,
-    script: ClipScript,
-    trace: ClipTrace,
+    pub(crate) plan: Plan,
+    pub(crate) towns: BTreeMap<String, TownContext>,
+    pub(crate) script: ClipScript,
+    pub(crate) trace: ClipTrace,
     ann: ClipAnnotations,
-    rig: Rig,
+    pub(crate) rig: Rig,
 }
 
 /// The first clip of a spec, simulated and annotated.
@@ -67,7 +67,7 @@ fn clip_at(spec_path: &Path, overrides: &[&str], index: usize) -> Clip {
 }
 
 impl Clip {
-    fn render(&self, frame: u32) -> CameraImages {
+    pub(crate) fn render(&self, frame: u32) -> CameraImages {
         sensors::render_frame(
             &self.script,
             &self.trace,
@@ -78,7 +78,7 @@ impl Clip {
     }
 
     /// The frames with the most annotated pedestrians, `n` of them spread over the clip.
-    fn busy_frames(&self, n: usize) -> Vec<u32> {
+    pub(crate) fn busy_frames(&self, n: usize) -> Vec<u32> {
         let mut counts = vec![0usize; self.trace.frame_count as usize];
         for r in &self.ann.rows {
             counts[r.frame as usize] += 1;
@@ -485,7 +485,7 @@ fn a_point_projects_to_the_same_pixel_in_the_renderer_and_the_annotations() {
     assert!(d < 1.0, "centroid {centroid} vs projection {project} ({d:.2} px apart)");
 }
 
-fn mean_luminance(img: &CameraImages) -> f64 {
+pub(crate) fn mean_luminance(img: &CameraImages) -> f64 {
     img.rgb.chunks_exact(3).map(|p| f64::from(luminance(p))).sum::<f64>() / (img.width * img.height) as f64
 }
 
@@ -519,9 +519,14 @@ fn streak_energy(img: &CameraImages) -> f64 {
 
 #[test]
 fn weathers_look_measurably_different() {
+    // The light itself, at a fixed exposure (auto-exposure would brighten the night: tests/it/imaging.rs).
     let mut c = clip(
         &spec("quickstart.yaml"),
-        &["sensors.rgb.width_px=640", "sensors.rgb.height_px=360"],
+        &[
+            "sensors.rgb.width_px=640",
+            "sensors.rgb.height_px=360",
+            "sensors.rgb.exposure.mode=fixed",
+        ],
     );
     let frame = c.busy_frames(1)[0];
     let mut render = |p: WeatherPreset, tweak: &dyn Fn(&mut pedsynth::spec::types::WeatherParams)| {

@@ -18,6 +18,7 @@ mod emergency;
 mod export;
 mod fuzz_corpus;
 mod hashes;
+mod imaging;
 mod intention;
 mod lens;
 mod lidar;

@@ -11,6 +11,7 @@
 //! - [`light`] — lighting from the weather.
 //! - [`shade`] — textures, road paint, lights, reflections, fog.
 //! - [`dvs`] — the ESIM event simulator.
+//! - [`expose`] — the sensor: auto-exposure's meter and gain, vignetting, noise.
 //!
 //! A camera with lens distortion draws its frame on a pinhole canvas and resamples it through the lens
 //! ([`lens`]).
@@ -25,6 +26,7 @@
 
 pub mod band;
 pub mod dvs;
+pub mod expose;
 pub mod group;
 pub mod lanes;
 mod lens;
@@ -134,6 +136,12 @@ pub struct Renderer {
     streak_bins: Vec<Vec<u32>>,
     /// A distorting camera's canvas and resampling (`None` for a pinhole: the frame is drawn in place).
     warp: Option<Box<lens::LensWarp>>,
+    /// The exposure's gain on the linear light (in `lut`).
+    gain: f32,
+    /// Vignetting of the canvas (`None` without).
+    vignette: Option<expose::Vignette>,
+    /// Sensor noise (`None` without), added by [`Renderer::add_noise`].
+    noise_model: Option<expose::NoiseModel>,
 }
 
 /// The (up to) `n` items nearest to `from` within `radius_m`, nearest first (ties by index), into `out`.
@@ -151,12 +159,19 @@ fn nearest<T>(items: &[T], pos: impl Fn(&T) -> Vec3, from: Vec3, radius_m: f32, 
 }
 
 impl Renderer {
-    /// A renderer for a camera, a clip's lighting and its texture seed.
+    /// A renderer for a camera, a clip's lighting and its texture seed, at a gain of 1 (see
+    /// [`Renderer::set_gain`]).
     pub fn new(camera: &Camera, light: Lighting, seed: u64) -> Renderer {
         let warp = lens::LensWarp::new(camera).map(Box::new);
+        let (image_w, image_h) = (camera.width_px, camera.height_px);
+        let imaging = camera.imaging;
         // The stages draw with the pinhole of the canvas where the camera distorts.
         let camera = warp.as_ref().map_or(*camera, |w| w.canvas_camera);
         let h = camera.height_px as usize;
+        let vignette = expose::Vignette::new(imaging.vignetting, camera.width_px, camera.height_px, image_w, image_h);
+        let noise_model = imaging
+            .noisy()
+            .then(|| expose::NoiseModel::new(imaging.shot_noise, imaging.read_noise, seed));
         Renderer {
             camera,
             light,
@@ -168,10 +183,36 @@ impl Renderer {
             sun: None,
             lights: ActiveLights::default(),
             nearby: Vec::new(),
-            lut: build_lut(),
+            lut: build_lut(1.0),
             streaks: Vec::new(),
             streak_bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
             warp,
+            gain: 1.0,
+            vignette,
+            noise_model,
+        }
+    }
+
+    /// Sets the exposure's gain on the linear light (auto-exposure's, [`expose::auto_gain`]): the tone curve's
+    /// lookup table and the noise's spread follow it.
+    pub fn set_gain(&mut self, gain: f32) {
+        self.gain = gain;
+        self.lut = build_lut(gain);
+        if let Some(noise) = &mut self.noise_model {
+            noise.set_gain(gain);
+        }
+    }
+
+    /// The exposure's gain on the linear light.
+    pub fn gain(&self) -> f32 {
+        self.gain
+    }
+
+    /// Adds the sensor's noise (if any) to a rendered RGB image; `frame_seed` draws it
+    /// ([`noise_seed`]). The label streams are left exact.
+    pub fn add_noise(&self, images: &mut CameraImages, frame_seed: u64) {
+        if let Some(noise) = &self.noise_model {
+            noise.apply(&mut images.rgb, images.width, frame_seed);
         }
     }
 
@@ -234,6 +275,11 @@ pub fn luminance(rgb: &[u8]) -> f32 {
     0.2989 * f32::from(rgb[0]) + 0.587 * f32::from(rgb[1]) + 0.114 * f32::from(rgb[2])
 }
 
+/// The seed of a frame's sensor noise.
+pub fn noise_seed(clip_seed: u64, frame: u32) -> u64 {
+    splitmix64(clip_seed ^ 0x5e45_0e00 ^ splitmix64(u64::from(frame)))
+}
+
 /// A random generator for a (clip, frame, sub-step) stream.
 pub fn streak_seed(clip_seed: u64, frame: u32, substep: u32) -> u64 {
     splitmix64(clip_seed ^ splitmix64((u64::from(frame) << 16) | u64::from(substep)))
@@ -264,7 +310,7 @@ mod tests {
 
     #[test]
     fn the_row_tone_map_equals_the_per_value_formula() {
-        let lut = build_lut();
+        let lut = build_lut(1.0);
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         // Every row length up to 13 (whole quads and a rest), values below 0, in range and beyond LUT_MAX.
         for n in 0..=13 {

@@ -12,15 +12,16 @@ pub(super) struct Streak {
     pub(super) alpha: f32,
 }
 
-/// Linear → sRGB lookup: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]` with a soft shoulder.
+/// Linear → sRGB lookup: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]` with a soft shoulder, the exposure's gain
+/// applied to the linear light first.
 pub(super) const LUT_LEN: usize = 4096;
 
 pub(super) const LUT_MAX: f32 = 8.0;
 
-pub(super) fn build_lut() -> Box<[u8; LUT_LEN]> {
+pub(super) fn build_lut(gain: f32) -> Box<[u8; LUT_LEN]> {
     Box::new(std::array::from_fn(|i| {
         let s = i as f32 / (LUT_LEN - 1) as f32;
-        let x = s * s * LUT_MAX;
+        let x = s * s * LUT_MAX * gain;
         let mapped = 1.0 - (-1.1 * x).exp();
         let srgb = if mapped <= 0.003_130_8 {
             12.92 * mapped

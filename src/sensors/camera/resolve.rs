@@ -236,6 +236,9 @@ impl Renderer {
                 semantic[x] = edge_tag[e];
                 e += 4;
             }
+            if let Some(vignette) = &self.vignette {
+                vignette.dim_row(y, rgb);
+            }
             tone_map(rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
         self.draw_streaks(y0, out.rgb);

@@ -102,6 +102,10 @@ impl CameraProfile {
     /// - `pie`: PIE's `calibration_data.json` (github.com/aras62/PIE): 1920×1080, `fx` 1004.8 px, i.e.
     ///   2·atan(960 / 1004.8) = 87.4° horizontally, and `cam_height_mm` 1270. Its `cam_pitch_deg` (−10) comes
     ///   without a convention and is not used: the pitch is 0, level with the road.
+    /// - `jaad` and `pie` also set a dashcam's sensor: vignetting 0.25 and noise (`shot` 0.012, `read` 0.0005:
+    ///   about 1.5 levels of 255 on a mid-grey wall by day and 5–8 at night at the highest gain). Neither
+    ///   dataset publishes its sensor's noise or vignetting, and their annotations cannot measure it: these are
+    ///   chosen to look like a consumer dashcam, not fitted.
     pub fn preset(self) -> &'static [(&'static str, &'static str)] {
         match self {
             CameraProfile::Carla => &[
@@ -117,6 +121,9 @@ impl CameraProfile {
                 ("fov_deg", "90"),
                 ("mount.up_m", "1.38"),
                 ("mount.pitch_deg", "7.3"),
+                ("vignetting", "0.25"),
+                ("noise.shot", "0.012"),
+                ("noise.read", "0.0005"),
             ],
             CameraProfile::Pie => &[
                 ("width_px", "1920"),
@@ -124,6 +131,9 @@ impl CameraProfile {
                 ("fov_deg", "87.4"),
                 ("mount.up_m", "1.27"),
                 ("mount.pitch_deg", "0"),
+                ("vignetting", "0.25"),
+                ("noise.shot", "0.012"),
+                ("noise.read", "0.0005"),
             ],
         }
     }
@@ -155,6 +165,77 @@ pub struct Rgb {
     /// and keypoints. All zero (a pinhole) by default.
     #[serde(skip_serializing_if = "super::is_default")]
     pub distortion: Distortion,
+    /// Auto-exposure: how the camera brightens a dark clip (night, dusk) as a dashcam's does. On by default.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub exposure: Exposure,
+    /// Share of the light lost at the image's corners (vignetting: `1 − vignetting × r² / r_corner²` of the
+    /// light reaches a pixel `r` from the centre), 0–0.9. 0 (none) by default.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub vignetting: f64,
+    /// Sensor noise (shot and read noise, amplified by the exposure's gain). Off by default; the `jaad` and
+    /// `pie` profiles turn it on.
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub noise: SensorNoise,
+}
+
+/// How the exposure is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ExposureMode {
+    /// Metered per clip: the light is multiplied by a gain of `key` over the clip's metered brightness,
+    /// between 1 and `max_gain` (daylight keeps the renderer's exposure; dark clips are brightened).
+    #[default]
+    Auto,
+    /// The renderer's exposure (a gain of 1) in every clip: night stays as dark as the light is.
+    Fixed,
+}
+
+/// Auto-exposure. The meter: four frames of the clip (at 0, ¼, ½ and ¾ of it) rendered at a gain of 1; their
+/// brightness is the geometric mean of the linear luminance of each frame's pixels between its 10th and 90th
+/// percentiles, averaged (geometrically) over the four. The clip is then rendered at
+/// `gain = clamp(key / brightness, 1, max_gain)`, applied to the linear light before the tone curve (no
+/// banding), so that every image is still a pure function of the clip and the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Exposure {
+    /// `auto` (the default) or `fixed`.
+    pub mode: ExposureMode,
+    /// The metered brightness auto-exposure aims at (linear luminance; a clear noon clip meters 0.11–0.13,
+    /// dusk 0.04–0.09, night 0.005–0.02).
+    pub key: f64,
+    /// The most auto-exposure amplifies the light (a dashcam's highest gain; more gain, more noise).
+    pub max_gain: f64,
+}
+
+impl Default for Exposure {
+    fn default() -> Self {
+        Exposure {
+            mode: ExposureMode::Auto,
+            key: 0.1,
+            max_gain: 16.0,
+        }
+    }
+}
+
+/// Sensor noise, per pixel and channel, independent from frame to frame, seeded per clip and frame: a linear
+/// signal `x` (the light before the exposure's gain) gets a Gaussian error of standard deviation
+/// `sqrt(shot² × x + read²)`, amplified by the gain with the signal, then the tone curve maps both. Only the
+/// RGB stream is noisy: the DVS sees the clean image and the label streams are exact.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensorNoise {
+    /// Shot noise: the standard deviation at a linear signal of 1 (about a white wall in full sun), which
+    /// grows with the square root of the signal.
+    pub shot: f64,
+    /// Read noise: the standard deviation at no signal (linear units).
+    pub read: f64,
+}
+
+impl SensorNoise {
+    /// Whether the sensor adds no noise.
+    pub fn is_off(&self) -> bool {
+        self.shot == 0.0 && self.read == 0.0
+    }
 }
 
 /// Brown–Conrady lens distortion in OpenCV's convention (`cv2.projectPoints`, `cv2.undistort` with
@@ -221,6 +302,9 @@ impl Default for Rgb {
             mount: Mount::default(),
             mount_spread: MountSpread::default(),
             distortion: Distortion::default(),
+            exposure: Exposure::default(),
+            vignetting: 0.0,
+            noise: SensorNoise::default(),
         }
     }
 }

@@ -120,6 +120,44 @@ impl Validator<'_> {
         }
     }
 
+    /// `sensors.rgb`'s exposure, vignetting and noise.
+    fn imaging(&mut self, rgb: &Rgb) {
+        self.positive(
+            "sensors.rgb.exposure.key",
+            rgb.exposure.key,
+            10.0,
+            "a linear brightness (clear noon meters about 0.12)",
+        );
+        self.num(
+            "sensors.rgb.exposure.max_gain",
+            rgb.exposure.max_gain,
+            1.0,
+            1000.0,
+            "a gain of at least 1",
+        );
+        self.num(
+            "sensors.rgb.vignetting",
+            rgb.vignetting,
+            0.0,
+            0.9,
+            "a share of the light lost at the corners",
+        );
+        self.num(
+            "sensors.rgb.noise.shot",
+            rgb.noise.shot,
+            0.0,
+            1.0,
+            "a standard deviation",
+        );
+        self.num(
+            "sensors.rgb.noise.read",
+            rgb.noise.read,
+            0.0,
+            1.0,
+            "a standard deviation",
+        );
+    }
+
     pub(super) fn sensors(&mut self, s: &Sensors) {
         self.num(
             "sensors.rgb.width_px",
@@ -171,6 +209,7 @@ impl Validator<'_> {
             "a pitch offset in degrees",
         );
         self.distortion(&s.rgb);
+        self.imaging(&s.rgb);
         let l = &s.lidar;
         self.num(
             "sensors.lidar.channels",
