@@ -12,8 +12,9 @@ a person is found; a joint agrees when it lies within 10 % of the box height of 
 pedestrian crop, a crop of the same size at a seeded place in the same frame whose instance pixels hold no
 pedestrian, cyclist or child (skipped where 50 tries find none).
 
-Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check]` (the dataset needs RGB as PNG and the
-instance stream). Prints one row per weather; `--check` exits 1 unless issue 44's figures hold (found ≥ 94 % in
+Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png]` (the dataset needs
+RGB as PNG and the instance stream). `--sheet` also writes a crop sheet: per weather (a row), six crops evenly
+spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found. Prints one row per weather; `--check` exits 1 unless issue 44's figures hold (found ≥ 94 % in
 every weather, ≥ 80 % of joints, background ≤ 5 %).
 """
 import argparse
@@ -45,6 +46,7 @@ def main() -> int:
     ap.add_argument("dataset", type=Path)
     ap.add_argument("--per-clip", type=int, default=60)
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--sheet", type=Path)
     a = ap.parse_args()
     root = a.dataset
     weather = {}
@@ -54,6 +56,7 @@ def main() -> int:
     pose = mp.solutions.pose.Pose(static_image_mode=True, model_complexity=1, min_detection_confidence=0.5)
     rng = np.random.default_rng(44)
     per = {}
+    sheet = {}
     for path in sorted(glob.glob(str(root / "tables/annotations/*.parquet"))):
         t = pq.read_table(path).to_pydict()
         clip = t["clip_id"][0] if t["clip_id"] else None
@@ -69,6 +72,7 @@ def main() -> int:
         if len(rows) > a.per_clip:
             rows = [rows[int(k * len(rows) / a.per_clip)] for k in range(a.per_clip)]
         s = per.setdefault(weather[clip], {"crops": 0, "found": 0, "joints": 0, "agree": 0, "bg": 0, "bg_found": 0})
+        shown = set(rows[int(k * len(rows) / 6)] for k in range(6)) if rows else set()
         for i in rows:
             frame = t["frame"][i]
             rgb = np.asarray(Image.open(root / f"sensors/rgb/{clip}/{frame:06d}.png").convert("RGB"))
@@ -80,6 +84,12 @@ def main() -> int:
             x0, y0, x1, y1 = crop_box(b, w, h)
             s["crops"] += 1
             res = pose.process(np.ascontiguousarray(rgb[y0:y1, x0:x1]))
+            if a.sheet and i in shown:
+                crop = Image.fromarray(rgb[y0:y1, x0:x1])
+                crop = np.asarray(crop.resize((max(1, round(200 * crop.width / crop.height)), 200))).copy()
+                if not res.pose_landmarks:
+                    crop[:6] = [220, 0, 0]
+                sheet.setdefault(weather[clip], []).append(crop)
             if res.pose_landmarks:
                 s["found"] += 1
                 lm = res.pose_landmarks.landmark
@@ -120,6 +130,13 @@ def main() -> int:
         f"{100 * bg:10.1f}%  ({total['joints']} joints, {total['bg']} background crops)"
     )
     ok &= joints >= 0.8 and bg <= 0.05
+    if a.sheet and sheet:
+        rows_px = []
+        width = max(sum(c.shape[1] for c in crops) for crops in sheet.values())
+        for wx in sorted(sheet):
+            row = np.concatenate(sheet[wx], axis=1)
+            rows_px.append(np.pad(row, ((0, 0), (0, width - row.shape[1]), (0, 0)), constant_values=255))
+        Image.fromarray(np.concatenate(rows_px, axis=0)).save(a.sheet)
     if a.check and not ok:
         print("issue 44's figures do not hold", file=sys.stderr)
         return 1

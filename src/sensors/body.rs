@@ -87,7 +87,7 @@ pub fn push_keypoints(coco: &[f32; 51], format: PoseFormat, flags: bool, out: &m
 }
 
 /// Number of capsules in a body silhouette.
-pub const CAPSULES: usize = 14;
+pub const CAPSULES: usize = 17;
 
 /// A capsule: the set of points within `radius_m` of the segment `a`–`b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -185,7 +185,8 @@ pub(crate) fn head_points(neck: DVec3, head_rot: DMat3, h: f64) -> ([DVec3; 5], 
 }
 
 /// The capsules of a body of height `h` from its joints in the body frame (COCO order) and its torso points
-/// `[pelvis, chest, neck, head centre]`, placed in the world by `to_world`: the same silhouette for a walker
+/// `[pelvis, chest, neck, head centre]` (torso, shoulders, head, upper arms, forearms, thighs, shins, feet, neck,
+/// hands and hips), placed in the world by `to_world`: the same silhouette for a walker
 /// and a cyclist's rider.
 pub(crate) fn silhouette(
     joints: &[DVec3; 17],
@@ -194,6 +195,8 @@ pub(crate) fn silhouette(
     to_world: impl Fn(DVec3) -> DVec3,
 ) -> [Capsule; CAPSULES] {
     let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
+    // A hand: on from the wrist along the forearm (to the knuckles; the fingers' length again is not drawn).
+    let hand = |elbow: DVec3, wrist: DVec3| wrist + (wrist - elbow).normalize_or_zero() * (0.05 * h);
     let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
         a: to_world(a),
         b: to_world(b),
@@ -215,6 +218,9 @@ pub(crate) fn silhouette(
         cap(j(15), toe(j(15)), 0.022),
         cap(j(16), toe(j(16)), 0.022),
         cap(neck, head_centre, 0.035),
+        cap(j(9), hand(j(7), j(9)), 0.02),
+        cap(j(10), hand(j(8), j(10)), 0.02),
+        cap(j(11), j(12), 0.05),
     ]
 }
 

@@ -247,8 +247,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 normal = capsule_normals(c, p);
             }
             if prim.material == Material::Head {
-                let hair = normal.z.simd_gt(F::splat(0.25)) | normal.dot_v(prim.normal).simd_lt(F::splat(-0.3));
-                albedo = V3::select(hair, V3::splat(prim.albedo2), albedo);
+                albedo = face(prim, normal, albedo);
             }
             albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06));
         }
@@ -419,6 +418,33 @@ fn capsule_normals(c: &SceneCapsule, p: V3) -> V3 {
 pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
     let f = exp_lanes(F::splat(-light.fog_per_m) * dist_m);
     colour.scale(f).add(V3::splat(light.fog).scale(F::ONE - f))
+}
+
+/// A head's colours at unit normals `normal` of its sphere: hair on top and at the back (`albedo2`), and a
+/// face on the skin around the gaze direction (`prim.normal`): eyes, eyebrows in the hair's colour and a
+/// mouth, placed by the normal's components along the gaze, to the side and up (a face of a sphere 0.07 of the
+/// body height: eyes ±4 cm apart, as a person's are).
+#[inline(always)]
+fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
+    let fwd = prim.normal;
+    let side = Vec3::new(fwd.y, -fwd.x, 0.0).normalize_or_zero();
+    let (f, s, u) = (normal.dot_v(fwd), normal.dot_v(side).abs(), normal.z);
+    let front = f.simd_gt(F::splat(0.55));
+    let hair = u.simd_gt(F::splat(0.25)) | f.simd_lt(F::splat(-0.3));
+    let sq = |x: F| x * x;
+    let eye = front & (sq(s - F::splat(0.33)) + sq(u - F::splat(0.06)) * F::splat(2.0)).simd_lt(F::splat(0.0081));
+    let brow = front
+        & (s - F::splat(0.33)).abs().simd_lt(F::splat(0.14))
+        & (u - F::splat(0.19)).abs().simd_lt(F::splat(0.035));
+    let mouth = front & s.simd_lt(F::splat(0.17)) & (u + F::splat(0.36)).abs().simd_lt(F::splat(0.04));
+    let mut colour = V3::select(hair | brow, V3::splat(prim.albedo2), skin);
+    colour = V3::select(eye, V3::splat(Vec3::new(0.02, 0.02, 0.025)), colour);
+    let lips = V3 {
+        x: skin.x * 0.45,
+        y: skin.y * 0.25,
+        z: skin.z * 0.25,
+    };
+    V3::select(mouth, lips, colour)
 }
 
 #[cfg(test)]

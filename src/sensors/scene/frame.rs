@@ -87,6 +87,9 @@ pub(super) const WEAR: [Wear; CAPSULES] = [
     Wear::Shoes,  // feet
     Wear::Shoes,  //
     Wear::Skin,   // neck
+    Wear::Skin,   // hands
+    Wear::Skin,   //
+    Wear::Bottom, // hips
 ];
 
 impl FrameScene {
