@@ -114,13 +114,14 @@ pub(super) fn plan_clip(
         .filter_map(|p| timeline_duration_s(p, &schedule, plans.as_ref().map(|plans| (plans, net))))
         .fold(0.0, f64::max);
     let frame_count = lengthened_frame_count(&spec.dataset, basics.frame_count, needed_s);
+    let (weather_params, look) = super::look::randomise(&spec.domain_randomisation, weather.params(), basics.seed);
 
     Ok(ClipScript {
         clip_id,
         seed: basics.seed,
         town: town_ref.name().to_owned(),
         weather: weather.name().to_owned(),
-        weather_params: weather.params(),
+        weather_params,
         split: split_of(spec, town_ref),
         fps,
         frame_count,
@@ -131,6 +132,7 @@ pub(super) fn plan_clip(
         signal_offsets,
         timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
         labelled_crossers: basics.labelled_crossers,
+        look,
     })
 }
 

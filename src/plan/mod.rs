@@ -14,6 +14,7 @@ pub mod calibration;
 mod clip;
 pub mod identity;
 mod lazy;
+mod look;
 mod pedestrians;
 pub mod prepared;
 pub mod quota;

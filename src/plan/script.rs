@@ -143,6 +143,37 @@ pub struct ClipScript {
     /// (`sensors::realise`). Absent without layer 1 (crosser allocation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub labelled_crossers: Option<u32>,
+    /// How the clip's light and camera look under `domain_randomisation` (absent from the plan file without it).
+    #[serde(default, skip_serializing_if = "ClipLook::is_identity")]
+    pub look: ClipLook,
+}
+
+/// A clip's draws of `domain_randomisation` for its light and camera (all 1 without it).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClipLook {
+    /// Factor on the sun's and the sky's light.
+    pub light_intensity: f64,
+    /// The camera's gain per channel (red, green, blue) on the linear light.
+    pub white_balance: [f64; 3],
+    /// Factor on auto-exposure's key.
+    pub exposure_key: f64,
+}
+
+impl Default for ClipLook {
+    fn default() -> Self {
+        ClipLook {
+            light_intensity: 1.0,
+            white_balance: [1.0; 3],
+            exposure_key: 1.0,
+        }
+    }
+}
+
+impl ClipLook {
+    /// Whether the look changes nothing.
+    pub fn is_identity(&self) -> bool {
+        *self == ClipLook::default()
+    }
 }
 
 impl ClipScript {

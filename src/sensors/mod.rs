@@ -241,11 +241,17 @@ const METERED_QUARTERS: u64 = 4;
 /// The renderer of a clip's camera, exposed for the clip. With auto-exposure (`sensors.rgb.exposure`), four
 /// frames at 0, ¼, ½ and ¾ of the clip are rendered at a gain of 1 and metered
 /// ([`camera::expose::brightness`]); the clip is rendered at the gain their geometric mean calls for
-/// ([`camera::expose::auto_gain`]). A pure function of (script, trace, rig): every frame stays a pure function
-/// of (script, trace, frame).
+/// ([`camera::expose::auto_gain`]). The clip's `look` (domain randomisation) scales the light, sets the colour
+/// balance and scales the exposure's key. A pure function of (script, trace, rig): every frame stays a pure
+/// function of (script, trace, frame).
 pub fn clip_renderer(stat: &scene::StaticScene, script: &ClipScript, trace: &ClipTrace, rig: &Rig) -> camera::Renderer {
-    let light = camera::light::Lighting::from_weather(&script.weather_params);
+    let look = &script.look;
+    let light =
+        camera::light::Lighting::from_weather(&script.weather_params).with_intensity(look.light_intensity as f32);
     let mut renderer = camera::Renderer::new(&rig.camera, light, script.seed);
+    if !look.is_identity() {
+        renderer.set_white_balance(look.white_balance.map(|g| g as f32));
+    }
     let frames = u64::from(trace.frame_count.min(trace.ego.len() as u32));
     let Some((key, max_gain)) = rig.camera.imaging.auto_exposure else {
         return renderer;
@@ -271,6 +277,7 @@ pub fn clip_renderer(stat: &scene::StaticScene, script: &ClipScript, trace: &Cli
         log_sum += camera::expose::brightness(&images.rgb).max(1.0e-12).ln();
     }
     let brightness = (log_sum / METERED_QUARTERS as f64).exp();
+    let key = key * look.exposure_key as f32;
     renderer.set_gain(camera::expose::auto_gain(brightness, key, max_gain));
     renderer
 }

@@ -48,7 +48,7 @@ pub(crate) fn clip(spec_path: &Path, overrides: &[&str]) -> Clip {
 }
 
 /// Clip `index` of a spec, simulated and annotated.
-fn clip_at(spec_path: &Path, overrides: &[&str], index: usize) -> Clip {
+pub(crate) fn clip_at(spec_path: &Path, overrides: &[&str], index: usize) -> Clip {
     let (_, towns, plan) = pedsynth::dataset::inputs::plan_spec_file(spec_path, &options(overrides))
         .unwrap_or_else(|e| panic!("{}", e.render()));
     let script = plan.clips[index].clone();

@@ -142,3 +142,47 @@ fn the_dvs_sees_the_clean_image() {
     assert_eq!(quiet, noisy);
     assert_ne!(quiet_rgb, noisy_rgb, "the RGB stream is noisy");
 }
+
+#[test]
+fn domain_randomisation_draws_a_look_per_clip_and_the_images_follow_it() {
+    let dr = [
+        "domain_randomisation.light_intensity=[0.5, 2]",
+        "domain_randomisation.white_balance=[0.6, 1.6]",
+        "domain_randomisation.sun_azimuth_offset_deg=[-90, 90]",
+        "sensors.rgb.exposure.mode=fixed",
+    ];
+    let mut overrides: Vec<&str> = SMALL.to_vec();
+    overrides.extend(dr);
+    let mut a = clip(&spec("quickstart.yaml"), &overrides);
+    let b = crate::camera::clip_at(&spec("quickstart.yaml"), &overrides, 1);
+    assert!(!a.script.look.is_identity() && !b.script.look.is_identity());
+    assert_ne!(a.script.look, b.script.look, "each clip draws its own look");
+    // The same clip without domain randomisation: the weather as the preset has it, the identity look.
+    let mut plain: Vec<&str> = SMALL.to_vec();
+    plain.push("sensors.rgb.exposure.mode=fixed");
+    let p = clip(&spec("quickstart.yaml"), &plain);
+    assert!(p.script.look.is_identity());
+    assert_ne!(
+        a.script.weather_params.sun_azimuth_deg,
+        p.script.weather_params.sun_azimuth_deg
+    );
+    // The colour balance shows: the channel with the larger gain gains on the other (in the mean level).
+    let frame = a.busy_frames(1)[0];
+    let tinted = a.render(frame);
+    let wb = a.script.look.white_balance;
+    a.script.look.white_balance = [1.0; 3];
+    let untinted = a.render(frame);
+    let means = |img: &CameraImages| -> [f64; 3] {
+        let n = (img.rgb.len() / 3) as f64;
+        std::array::from_fn(|c| img.rgb.iter().skip(c).step_by(3).map(|&v| f64::from(v)).sum::<f64>() / n)
+    };
+    let (t, u) = (means(&tinted), means(&untinted));
+    for (i, j) in [(0, 1), (1, 2), (0, 2)] {
+        let (gain_ratio, level_ratio) = (wb[i] / wb[j], (t[i] / t[j]) / (u[i] / u[j]));
+        assert_eq!(
+            gain_ratio > 1.0,
+            level_ratio > 1.0,
+            "channels {i}/{j}: gains {wb:?}, means {t:?} vs {u:?}"
+        );
+    }
+}

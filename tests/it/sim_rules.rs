@@ -175,6 +175,7 @@ fn clip(
         signal_offsets: Vec::new(),
         timeline_extension_s: 0.0,
         labelled_crossers: None,
+        look: Default::default(),
     }
 }
 

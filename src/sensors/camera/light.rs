@@ -52,6 +52,23 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 }
 
 impl Lighting {
+    /// The same lighting with the sun's and the sky's light (and the sky's and the fog's colours, which are
+    /// that light scattered) times `k`; street lamps and headlights are unchanged. `k = 1` changes nothing.
+    pub fn with_intensity(self, k: f32) -> Lighting {
+        if k == 1.0 {
+            return self;
+        }
+        Lighting {
+            sun: self.sun * k,
+            sky_ambient: self.sky_ambient * k,
+            ground_ambient: self.ground_ambient * k,
+            zenith: self.zenith * k,
+            horizon: self.horizon * k,
+            fog: self.fog * k,
+            ..self
+        }
+    }
+
     /// The lighting of a weather.
     pub fn from_weather(w: &WeatherParams) -> Lighting {
         let alt = (w.sun_altitude_deg as f32).to_radians();

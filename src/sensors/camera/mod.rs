@@ -129,15 +129,18 @@ pub struct Renderer {
     lights: ActiveLights,
     /// Scratch of [`nearest`]: (squared distance, index), reused from frame to frame.
     nearby: Vec<(f32, u32)>,
-    lut: Box<[u8; LUT_LEN]>,
+    /// The tone curve per channel (red, green, blue), the exposure's gain and the colour balance in it.
+    luts: [Box<[u8; LUT_LEN]>; 3],
     /// The frame's rain streaks, in drawing order, and per band of rows the ones that reach it (drawn while
     /// the band is in cache: a whole-image pass misses the cache at every streak pixel).
     streaks: Vec<Streak>,
     streak_bins: Vec<Vec<u32>>,
     /// A distorting camera's canvas and resampling (`None` for a pinhole: the frame is drawn in place).
     warp: Option<Box<lens::LensWarp>>,
-    /// The exposure's gain on the linear light (in `lut`).
+    /// The exposure's gain on the linear light (in `luts`).
     gain: f32,
+    /// The colour balance: a gain per channel on the linear light (in `luts`).
+    white_balance: [f32; 3],
     /// Vignetting of the canvas (`None` without).
     vignette: Option<expose::Vignette>,
     /// Sensor noise (`None` without), added by [`Renderer::add_noise`].
@@ -183,11 +186,12 @@ impl Renderer {
             sun: None,
             lights: ActiveLights::default(),
             nearby: Vec::new(),
-            lut: build_lut(1.0),
+            luts: [build_lut(1.0), build_lut(1.0), build_lut(1.0)],
             streaks: Vec::new(),
             streak_bins: vec![Vec::new(); h.div_ceil(BAND_ROWS)],
             warp,
             gain: 1.0,
+            white_balance: [1.0; 3],
             vignette,
             noise_model,
         }
@@ -197,10 +201,17 @@ impl Renderer {
     /// lookup table and the noise's spread follow it.
     pub fn set_gain(&mut self, gain: f32) {
         self.gain = gain;
-        self.lut = build_lut(gain);
+        self.luts = self.white_balance.map(|wb| build_lut(gain * wb));
         if let Some(noise) = &mut self.noise_model {
             noise.set_gain(gain);
         }
+    }
+
+    /// Sets the colour balance: a gain per channel (red, green, blue) on the linear light, on top of the
+    /// exposure's (domain randomisation's `white_balance`).
+    pub fn set_white_balance(&mut self, white_balance: [f32; 3]) {
+        self.white_balance = white_balance;
+        self.set_gain(self.gain);
     }
 
     /// The exposure's gain on the linear light.
@@ -322,7 +333,7 @@ mod tests {
             };
             let rgb: [Vec<f32>; 3] = std::array::from_fn(|c| (0..n + 3).map(|i| value(i + c)).collect());
             let mut out = vec![0u8; n * 3];
-            tone_map(&rgb, &lut, &mut out);
+            tone_map(&rgb, [&lut, &lut, &lut], &mut out);
             let expected: Vec<u8> = (0..n * 3)
                 .map(|i| {
                     let v: f32 = rgb[i % 3][i / 3];

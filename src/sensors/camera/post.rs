@@ -33,9 +33,9 @@ pub(super) fn build_lut(gain: f32) -> Box<[u8; LUT_LEN]> {
 }
 
 /// Maps a row of linear colours (one slice per channel, at least as long as the row) to interleaved sRGB
-/// bytes through the lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`, four pixels at a time (`wide`:
+/// bytes through each channel's lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`, four pixels at a time (`wide`:
 /// SSE square roots, correctly rounded, and truncations, so the same values as one at a time).
-pub(super) fn tone_map(rgb: &[Vec<f32>; 3], lut: &[u8; LUT_LEN], out: &mut [u8]) {
+pub(super) fn tone_map(rgb: &[Vec<f32>; 3], luts: [&[u8; LUT_LEN]; 3], out: &mut [u8]) {
     #[inline(always)]
     fn index(v: f32x4) -> [usize; 4] {
         let s = (v.max(f32x4::ZERO) * (1.0 / LUT_MAX)).min(f32x4::ONE).sqrt();
@@ -61,7 +61,7 @@ pub(super) fn tone_map(rgb: &[Vec<f32>; 3], lut: &[u8; LUT_LEN], out: &mut [u8])
         let load = |c: &[f32]| index(f32x4::new([c[0], c[1], c[2], c[3]]));
         let (r, g, b) = (load(r), load(g), load(b));
         for (i, o) in px.chunks_exact_mut(3).enumerate() {
-            o.copy_from_slice(&[lut[r[i]], lut[g[i]], lut[b[i]]]);
+            o.copy_from_slice(&[luts[0][r[i]], luts[1][g[i]], luts[2][b[i]]]);
         }
     }
 }

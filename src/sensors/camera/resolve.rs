@@ -239,7 +239,8 @@ impl Renderer {
             if let Some(vignette) = &self.vignette {
                 vignette.dim_row(y, rgb);
             }
-            tone_map(rgb, &self.lut, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
+            let luts = [&*self.luts[0], &*self.luts[1], &*self.luts[2]];
+            tone_map(rgb, luts, &mut out.rgb[row * w * 3..(row + 1) * w * 3]);
         }
         self.draw_streaks(y0, out.rgb);
         if let (Ok(mut pool), Some(scratch)) = (self.band_buffers.0.lock(), taken) {

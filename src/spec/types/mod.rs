@@ -12,6 +12,7 @@ mod annotations;
 mod crossing;
 mod dataset;
 mod pedestrians;
+mod randomisation;
 mod sensors;
 mod traffic;
 
@@ -19,6 +20,7 @@ pub use annotations::*;
 pub use crossing::*;
 pub use dataset::*;
 pub use pedestrians::*;
+pub use randomisation::*;
 pub use sensors::*;
 pub use traffic::*;
 
@@ -93,6 +95,9 @@ pub struct Spec {
     pub output: Output,
     /// Sanity limits on the size of a dataset; exceeding one is an error unless `--allow-large` is given.
     pub limits: Limits,
+    /// Domain randomisation: how each clip's light and camera vary, drawn per clip. Off by default.
+    #[serde(skip_serializing_if = "is_default")]
+    pub domain_randomisation: DomainRandomisation,
 }
 
 impl Default for Spec {
@@ -107,6 +112,7 @@ impl Default for Spec {
             annotations: Annotations::default(),
             output: Output::default(),
             limits: Limits::default(),
+            domain_randomisation: DomainRandomisation::default(),
         }
     }
 }

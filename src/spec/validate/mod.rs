@@ -27,6 +27,7 @@ pub fn validate(spec: &Spec, tree: &Node, base_dir: &Path, allow_large: bool, pr
     v.traffic(&spec.traffic);
     v.sensors(&spec.sensors);
     v.annotations(&spec.annotations);
+    v.domain_randomisation(&spec.domain_randomisation);
     v.num(
         "output.zstd_level",
         f64::from(spec.output.zstd_level),

@@ -120,6 +120,46 @@ impl Validator<'_> {
         }
     }
 
+    /// `domain_randomisation`: ranges in what a light, a sun and a camera can be.
+    pub(super) fn domain_randomisation(&mut self, d: &DomainRandomisation) {
+        let base = "domain_randomisation";
+        self.range(
+            &format!("{base}.light_intensity"),
+            d.light_intensity,
+            0.05,
+            20.0,
+            "a factor on the light",
+        );
+        self.range(
+            &format!("{base}.sun_azimuth_offset_deg"),
+            d.sun_azimuth_offset_deg,
+            -180.0,
+            180.0,
+            "an angle in degrees",
+        );
+        self.range(
+            &format!("{base}.sun_altitude_offset_deg"),
+            d.sun_altitude_offset_deg,
+            -90.0,
+            90.0,
+            "an angle in degrees",
+        );
+        self.range(
+            &format!("{base}.white_balance"),
+            d.white_balance,
+            0.2,
+            5.0,
+            "a gain per colour channel",
+        );
+        self.range(
+            &format!("{base}.exposure_key"),
+            d.exposure_key,
+            0.05,
+            20.0,
+            "a factor on auto-exposure's key",
+        );
+    }
+
     /// `sensors.rgb`'s exposure, vignetting and noise.
     fn imaging(&mut self, rgb: &Rgb) {
         self.positive(
