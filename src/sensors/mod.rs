@@ -81,19 +81,12 @@ pub fn render_cameras<E>(
     let substeps = sensors.dvs.substeps.max(1);
     let mut events = Vec::new();
     let frames = trace.frame_count.min(trace.ego.len() as u32);
-    let mut render =
-        |renderer: &mut camera::Renderer, t: scene::SceneTime, k: u32, images: &mut camera::CameraImages| {
-            frame_scene.build(stat, script, trace, t);
-            let (pos, yaw) = scene::ego_at(trace, t);
-            let pose = rig.camera.at(pos, yaw);
-            renderer.render(
-                stat,
-                &frame_scene,
-                &pose,
-                camera::streak_seed(script.seed, t.frame, k),
-                images,
-            );
-        };
+    let clip = ClipView {
+        stat,
+        script,
+        trace,
+        rig,
+    };
     for frame in 0..frames {
         events.clear();
         if let Some(esim) = esim.as_mut()
@@ -104,7 +97,7 @@ pub fn render_cameras<E>(
                     frame: frame - 1,
                     alpha: f64::from(k) / f64::from(substeps),
                 };
-                render(&mut renderer, t, k, &mut images);
+                clip.render(&mut renderer, &mut frame_scene, t, k, &mut images);
                 let now = frame_time_ns(frame - 1, script.fps, k, substeps);
                 esim.step(
                     &images.rgb,
@@ -114,7 +107,13 @@ pub fn render_cameras<E>(
                 );
             }
         }
-        render(&mut renderer, scene::SceneTime::at(frame), 0, &mut images);
+        clip.render(
+            &mut renderer,
+            &mut frame_scene,
+            scene::SceneTime::at(frame),
+            0,
+            &mut images,
+        );
         let now = frame_time_ns(frame, script.fps, 0, 1);
         if let Some(esim) = esim.as_mut() {
             esim.step(
@@ -219,20 +218,53 @@ pub fn render_frame(
 ) -> camera::CameraImages {
     let stat = scene::StaticScene::build(script, trace, town);
     let mut renderer = clip_renderer(&stat, script, trace, rig);
-    let mut frame_scene = scene::FrameScene::default();
     let mut images = camera::CameraImages::default();
-    let t = scene::SceneTime::at(frame);
-    frame_scene.build(&stat, script, trace, t);
-    let (pos, yaw) = scene::ego_at(trace, t);
-    renderer.render(
-        &stat,
-        &frame_scene,
-        &rig.camera.at(pos, yaw),
-        camera::streak_seed(script.seed, frame, 0),
+    let clip = ClipView {
+        stat: &stat,
+        script,
+        trace,
+        rig,
+    };
+    clip.render(
+        &mut renderer,
+        &mut scene::FrameScene::default(),
+        scene::SceneTime::at(frame),
+        0,
         &mut images,
     );
     renderer.add_noise(&mut images, camera::noise_seed(script.seed, frame));
     images
+}
+
+/// What rendering a clip's frames needs: its static scene, script, trace and rig.
+struct ClipView<'a> {
+    stat: &'a scene::StaticScene,
+    script: &'a ClipScript,
+    trace: &'a ClipTrace,
+    rig: &'a Rig,
+}
+
+impl ClipView<'_> {
+    /// Renders the clip at time `t` (sub-step `k` of its frame, which seeds the rain streaks) into `images`,
+    /// building the frame's scene in `frame_scene`.
+    fn render(
+        &self,
+        renderer: &mut camera::Renderer,
+        frame_scene: &mut scene::FrameScene,
+        t: scene::SceneTime,
+        k: u32,
+        images: &mut camera::CameraImages,
+    ) {
+        frame_scene.build(self.stat, self.script, self.trace, t);
+        let (pos, yaw) = scene::ego_at(self.trace, t);
+        renderer.render(
+            self.stat,
+            frame_scene,
+            &self.rig.camera.at(pos, yaw),
+            camera::streak_seed(self.script.seed, t.frame, k),
+            images,
+        );
+    }
 }
 
 /// Frames auto-exposure meters, as shares of the clip.
@@ -259,19 +291,22 @@ pub fn clip_renderer(stat: &scene::StaticScene, script: &ClipScript, trace: &Cli
     if frames == 0 {
         return renderer;
     }
+    let clip = ClipView {
+        stat,
+        script,
+        trace,
+        rig,
+    };
     let mut frame_scene = scene::FrameScene::default();
     let mut images = camera::CameraImages::default();
     let mut log_sum = 0.0;
     for k in 0..METERED_QUARTERS {
         let frame = (frames * k / METERED_QUARTERS) as u32;
-        let t = scene::SceneTime::at(frame);
-        frame_scene.build(stat, script, trace, t);
-        let (pos, yaw) = scene::ego_at(trace, t);
-        renderer.render(
-            stat,
-            &frame_scene,
-            &rig.camera.at(pos, yaw),
-            camera::streak_seed(script.seed, frame, 0),
+        clip.render(
+            &mut renderer,
+            &mut frame_scene,
+            scene::SceneTime::at(frame),
+            0,
             &mut images,
         );
         log_sum += camera::expose::brightness(&images.rgb).max(1.0e-12).ln();

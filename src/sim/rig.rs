@@ -89,14 +89,6 @@ impl Imaging {
         }
     }
 
-    /// An ideal sensor: a gain of 1, no vignetting, no noise.
-    pub const IDEAL: Imaging = Imaging {
-        auto_exposure: None,
-        vignetting: 0.0,
-        shot_noise: 0.0,
-        read_noise: 0.0,
-    };
-
     /// Whether the sensor adds noise.
     pub fn noisy(&self) -> bool {
         self.shot_noise > 0.0 || self.read_noise > 0.0

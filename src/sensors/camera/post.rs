@@ -2,6 +2,7 @@
 //! the sRGB curve), and rain streaks placed once per frame and drawn band by band.
 
 use super::*;
+use crate::util::srgb;
 
 /// A rain streak: a slanted, semi-transparent line from `(x0, y0)` down `steps` pixel rows.
 #[derive(Clone, Copy, Debug)]
@@ -22,14 +23,19 @@ pub(super) fn build_lut(gain: f32) -> Box<[u8; LUT_LEN]> {
     Box::new(std::array::from_fn(|i| {
         let s = i as f32 / (LUT_LEN - 1) as f32;
         let x = s * s * LUT_MAX * gain;
-        let mapped = 1.0 - (-1.1 * x).exp();
-        let srgb = if mapped <= 0.003_130_8 {
-            12.92 * mapped
-        } else {
-            1.055 * mapped.powf(1.0 / 2.4) - 0.055
-        };
-        (srgb * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+        (tone_curve(x) * 255.0 + 0.5).clamp(0.0, 255.0) as u8
     }))
+}
+
+/// The tone curve: linear light (after the exposure's gain) to sRGB's encoded value in [0, 1] — a soft
+/// shoulder `1 − e^(−1.1 x)`, then sRGB's encoding.
+pub(super) fn tone_curve(x: f32) -> f32 {
+    srgb::encode(1.0 - (-1.1 * x).exp())
+}
+
+/// The tone curve's shoulder undone: the linear light whose shoulder value is `mapped` (< 1).
+pub(super) fn shoulder_inverse(mapped: f64) -> f64 {
+    -(1.0 - mapped).ln() / 1.1
 }
 
 /// Maps a row of linear colours (one slice per channel, at least as long as the row) to interleaved sRGB

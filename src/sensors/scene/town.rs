@@ -136,14 +136,7 @@ impl Outfit {
 
 /// An sRGB colour (0–255) in linear RGB.
 pub fn linear(c: [u8; 3]) -> Vec3 {
-    let f = |v: u8| {
-        let x = f32::from(v) / 255.0;
-        if x <= 0.04045 {
-            x / 12.92
-        } else {
-            ((x + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let f = |v: u8| crate::util::srgb::decode(f32::from(v) / 255.0);
     Vec3::new(f(c[0]), f(c[1]), f(c[2]))
 }
 

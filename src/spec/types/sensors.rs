@@ -231,13 +231,6 @@ pub struct SensorNoise {
     pub read: f64,
 }
 
-impl SensorNoise {
-    /// Whether the sensor adds no noise.
-    pub fn is_off(&self) -> bool {
-        self.shot == 0.0 && self.read == 0.0
-    }
-}
-
 /// Brown–Conrady lens distortion in OpenCV's convention (`cv2.projectPoints`, `cv2.undistort` with
 /// `D = [k1, k2, p1, p2, k3]`): a point at normalised image coordinates `(x, y) = (X/Z, Y/Z)`, `r² = x² + y²`,
 /// is seen at `x' = x·(1 + k1 r² + k2 r⁴ + k3 r⁶) + 2 p1 x y + p2 (r² + 2 x²)` and
