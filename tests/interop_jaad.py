@@ -33,6 +33,8 @@ def main():
     db = JAAD(data_path=out, regen_pkl=True).generate_database()
     imdb = JAAD(data_path=out)
     seen = 0
+    figures = {}
+    label_key = lambda worn: ",".join(k for k, v in worn.items() if v) or "none"  # noqa: E731
     for clip_id, video in video_of.items():
         v = db[video]
         if v["num_frames"] != clips[clip_id]["frame_count"]:
@@ -57,8 +59,21 @@ def main():
             sides = [a["appearance"][k][0] for k in ["pose_front", "pose_back", "pose_left", "pose_right"]]
             if sorted(sides) != ["0", "0", "0", "1"]:
                 fail(f"{pid}: appearance sides {sides}")
+            # The figure's labels, constant over the track, equal the pedestrians table's.
+            worn = {
+                "backpack": ped["carry"] == "backpack",
+                "bag_shoulder": ped["carry"] == "shoulder_bag",
+                "bag_left_side": ped["carry"] == "shoulder_bag",
+                "cap": bool(ped["headwear"]),
+                "clothes_below_knee": ped["garment"] == "coat",
+            }
+            for label, want in worn.items():
+                if set(a["appearance"][label]) != {str(int(want))}:
+                    fail(f"{pid}: appearance {label} {sorted(set(a['appearance'][label]))}, the table says {want}")
+            figures[label_key(worn)] = figures.get(label_key(worn), 0) + 1
             seen += 1
-    print(f"interop_jaad: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables")
+    print(f"interop_jaad: generate_database: {seen} pedestrian tracks in {len(video_of)} videos equal the tables "
+          f"(appearance labels worn: {dict(sorted(figures.items()))})")
     report_behaviour("interop_jaad")
 
     config = yaml.safe_load(open(os.path.join(SHARED, "pedestrian_action_benchmark", "configs_default.yaml")))

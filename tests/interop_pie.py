@@ -181,7 +181,8 @@ def setup(name, formats):
     clips = {r["clip_id"]: r for r in table(args.dataset, "clips", ["clip_id", "split", "frame_count"])}
     peds = {
         (r["clip_id"], r["pedestrian"]): r
-        for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender"])
+        for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender",
+                                                     "headwear", "garment", "carry"])
     }
     ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
                 "crossing", "state", "occlusion", "on_crosswalk"] + BEHAVIOUR_COLUMNS + (["keypoints"] if poses_too else [])

@@ -12,10 +12,11 @@ a person is found; a joint agrees when it lies within 10 % of the box height of 
 pedestrian crop, a crop of the same size at a seeded place in the same frame whose instance pixels hold no
 pedestrian, cyclist or child (skipped where 50 tries find none).
 
-Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png]` (the dataset needs
-RGB as PNG and the instance stream). `--sheet` also writes a crop sheet: per weather (a row), six crops evenly
-spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found. Prints one row per weather; `--check` exits 1 unless issue 44's figures hold (found ≥ 94 % in
-every weather, ≥ 80 % of joints, background ≤ 5 %).
+Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png] [--per-joint]` (the
+dataset needs RGB as PNG and the instance stream). `--sheet` also writes a crop sheet: per weather (a row), six
+crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found.
+`--per-joint` also prints each joint's agreement over all weathers. Prints one row per weather; `--check` exits 1
+unless issue 44's figures hold (found ≥ 94 % in every weather, ≥ 80 % of joints, background ≤ 5 %).
 """
 import argparse
 import glob
@@ -30,6 +31,9 @@ import mediapipe as mp
 
 # BlazePose landmark index of each COCO keypoint MediaPipe has (COCO index → BlazePose index).
 COCO_TO_BLAZE = {0: 0, 5: 11, 6: 12, 7: 13, 8: 14, 9: 15, 10: 16, 11: 23, 12: 24, 13: 25, 14: 26, 15: 27, 16: 28}
+COCO_NAMES = {0: "nose", 5: "left_shoulder", 6: "right_shoulder", 7: "left_elbow", 8: "right_elbow", 9: "left_wrist",
+              10: "right_wrist", 11: "left_hip", 12: "right_hip", 13: "left_knee", 14: "right_knee", 15: "left_ankle",
+              16: "right_ankle"}
 MIN_HEIGHT_PX = 120
 MARGIN = 0.25
 
@@ -47,6 +51,7 @@ def main() -> int:
     ap.add_argument("--per-clip", type=int, default=60)
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--sheet", type=Path)
+    ap.add_argument("--per-joint", action="store_true", help="also print the agreement of each joint")
     a = ap.parse_args()
     root = a.dataset
     weather = {}
@@ -57,6 +62,7 @@ def main() -> int:
     rng = np.random.default_rng(44)
     per = {}
     sheet = {}
+    per_joint = {}
     for path in sorted(glob.glob(str(root / "tables/annotations/*.parquet"))):
         t = pq.read_table(path).to_pydict()
         clip = t["clip_id"][0] if t["clip_id"] else None
@@ -100,7 +106,11 @@ def main() -> int:
                     px = x0 + lm[blaze].x * (x1 - x0)
                     py = y0 + lm[blaze].y * (y1 - y0)
                     s["joints"] += 1
-                    s["agree"] += int(np.hypot(px - kp[3 * coco], py - kp[3 * coco + 1]) <= 0.1 * (b[3] - b[1]))
+                    agree = int(np.hypot(px - kp[3 * coco], py - kp[3 * coco + 1]) <= 0.1 * (b[3] - b[1]))
+                    s["agree"] += agree
+                    j = per_joint.setdefault(coco, [0, 0])
+                    j[0] += agree
+                    j[1] += 1
             # A background crop of the same size with no person in it.
             cw, ch = x1 - x0, y1 - y0
             people = (inst > 0) & ((inst < 32768) | (inst >= 49152))
@@ -130,6 +140,10 @@ def main() -> int:
         f"{100 * bg:10.1f}%  ({total['joints']} joints, {total['bg']} background crops)"
     )
     ok &= joints >= 0.8 and bg <= 0.05
+    if a.per_joint:
+        for coco in sorted(per_joint):
+            agree, n = per_joint[coco]
+            print(f"  {COCO_NAMES[coco]:16s} {100 * agree / max(1, n):5.1f}% of {n}")
     if a.sheet and sheet:
         rows_px = []
         width = max(sum(c.shape[1] for c in crops) for crops in sheet.values())

@@ -3,14 +3,20 @@
 //! per pedestrian rather than per archetype (the seed system gave each archetype one look).
 //!
 //! Heights come from a blake3 hash of the clip seed and the pedestrian id (adults 1.55–1.95 m, children
-//! 1.0–1.3 m); looks from the ChaCha20 stream `ped/<id>/identity` (the child's from `ped/<id>/child`), so that
+//! 1.0–1.3 m); looks from the ChaCha20 stream `ped/<id>/identity` (the child's from `ped/<id>/child`), and the
+//! figure (build, hair style, headwear, garment, bag) from `…/figure` after the looks' stream name, so that
 //! drawing them shifts no other random stream of the plan.
+//!
+//! The figure's shares are pedsynth's choices for a city street (no dataset we have publishes them): a
+//! backpack on a quarter of adults and on 45 % of young people and children, a shoulder bag on 30 % of women and
+//! 10 % of men, a hat on 15 %, a coat on 15 %, a skirt or dress on 30 % of women and girls, long hair or a bun on
+//! 75 % of women and girls and 5 % of men, baldness on a third of senior men.
 
 use rand::RngExt;
 use rand::seq::IndexedRandom;
 use rand_chacha::ChaCha20Rng;
 
-use super::script::{AgeGroup, Gender, Identity};
+use super::script::{AgeGroup, Carry, Figure, Garment, Gender, HairStyle, Identity};
 use super::seeds;
 use crate::spec::types::Body;
 
@@ -88,18 +94,18 @@ pub fn identities(clip_seed: u64, id: u32, archetype: &str, body: Body) -> (Iden
         _ => AgeGroup::Adult,
     };
     let height_m = if body == Body::Child { child_m } else { adult_m };
-    let main = looks(
-        &mut seeds::clip_rng(clip_seed, &format!("ped/{id}/identity")),
-        height_m,
-        age,
-    );
-    let child = (body == Body::AdultWithChild).then(|| {
-        looks(
-            &mut seeds::clip_rng(clip_seed, &format!("ped/{id}/child")),
-            child_m,
-            AgeGroup::Child,
-        )
-    });
+    let person = |stream: &str, height_m: f64, age: AgeGroup| {
+        let mut identity = looks(&mut seeds::clip_rng(clip_seed, stream), height_m, age);
+        identity.figure = figure(
+            &mut seeds::clip_rng(clip_seed, &format!("{stream}/figure")),
+            age,
+            identity.gender,
+            true,
+        );
+        identity
+    };
+    let main = person(&format!("ped/{id}/identity"), height_m, age);
+    let child = (body == Body::AdultWithChild).then(|| person(&format!("ped/{id}/child"), child_m, AgeGroup::Child));
     (main, child)
 }
 
@@ -112,7 +118,14 @@ pub fn rider_identity(clip_seed: u64, id: u32) -> Identity {
     } else {
         AgeGroup::Adult
     };
-    looks(&mut rng, height_m, age)
+    let mut identity = looks(&mut rng, height_m, age);
+    identity.figure = figure(
+        &mut seeds::clip_rng(clip_seed, &format!("cyclist/{id}/figure")),
+        age,
+        identity.gender,
+        false,
+    );
+    identity
 }
 
 /// An adult's and a child's height for pedestrian `id`, metres.
@@ -125,6 +138,67 @@ fn heights_m(clip_seed: u64, id: u32) -> (f64, f64) {
         ADULT_HEIGHT_M.0 + ADULT_HEIGHT_M.1 * u1,
         CHILD_HEIGHT_M.0 + CHILD_HEIGHT_M.1 * u2,
     )
+}
+
+/// Colours of hats and bags (sRGB).
+const ACCESSORIES: [[u8; 3]; 8] = [
+    [20, 20, 22],
+    [60, 40, 30],
+    [120, 84, 52],
+    [40, 52, 90],
+    [150, 30, 36],
+    [90, 92, 96],
+    [200, 196, 186],
+    [46, 86, 60],
+];
+
+/// A person's figure; `skirts`: whether a skirt, dress or coat may be drawn (not for a cyclist's rider).
+fn figure(rng: &mut ChaCha20Rng, age: AgeGroup, gender: Gender, skirts: bool) -> Figure {
+    let female = gender == Gender::Female;
+    let build = match age {
+        AgeGroup::Child => rng.random_range(0.92..1.08),
+        _ => rng.random_range(0.85..1.25),
+    };
+    let u = rng.random_range(0.0..1.0);
+    let hair = match (female, age) {
+        (true, _) if u < 0.5 => HairStyle::Long,
+        (true, _) if u < 0.75 => HairStyle::Bun,
+        (false, AgeGroup::Senior) if u < 0.33 => HairStyle::Bald,
+        (false, AgeGroup::Adult) if u < 0.08 => HairStyle::Bald,
+        (false, _) if u > 0.95 => HairStyle::Long,
+        _ => HairStyle::Short,
+    };
+    let pick = |rng: &mut ChaCha20Rng| *ACCESSORIES.choose(rng).unwrap_or(&[60, 60, 60]);
+    let headwear = rng.random_bool(0.15).then(|| pick(rng));
+    let u = rng.random_range(0.0..1.0);
+    let garment = match (skirts, female) {
+        (false, _) => Garment::Trousers,
+        (true, true) if u < 0.2 => Garment::Skirt,
+        (true, true) if u < 0.3 => Garment::Dress,
+        (true, _) if u > 0.85 && age != AgeGroup::Child => Garment::Coat,
+        _ => Garment::Trousers,
+    };
+    let u = rng.random_range(0.0..1.0);
+    let backpack = if matches!(age, AgeGroup::Young | AgeGroup::Child) {
+        0.45
+    } else {
+        0.25
+    };
+    let bag = if female { 0.3 } else { 0.1 };
+    let carry = if u < backpack {
+        Some((Carry::Backpack, pick(rng)))
+    } else if u < backpack + bag && age != AgeGroup::Child {
+        Some((Carry::ShoulderBag, pick(rng)))
+    } else {
+        None
+    };
+    Figure {
+        build,
+        hair,
+        headwear,
+        garment,
+        carry,
+    }
 }
 
 fn looks(rng: &mut ChaCha20Rng, height_m: f64, age: AgeGroup) -> Identity {
@@ -157,6 +231,7 @@ fn looks(rng: &mut ChaCha20Rng, height_m: f64, age: AgeGroup) -> Identity {
         top_rgb,
         bottom_rgb,
         shoes_rgb,
+        figure: Figure::PLAIN,
     }
 }
 

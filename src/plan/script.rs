@@ -586,4 +586,114 @@ pub struct Identity {
     pub bottom_rgb: [u8; 3],
     /// Colour of the shoes.
     pub shoes_rgb: [u8; 3],
+    /// Build, hair style, headwear, garment and what the person carries (plans written before figures existed
+    /// read as [`Figure::PLAIN`]).
+    #[serde(default)]
+    pub figure: Figure,
+}
+
+/// The shape of a person beyond height and colours: drawn by the planner with the identity (its own random
+/// stream), so that the labels, the cameras and the LiDAR see the same silhouette.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Figure {
+    /// Girth against an average build of the same height (1.0): scales the torso's, the hips' and the limbs'
+    /// radii (0.85 slim … 1.25 heavy).
+    pub build: f64,
+    /// Hair style.
+    pub hair: HairStyle,
+    /// A hat or cap, and its colour (sRGB).
+    pub headwear: Option<[u8; 3]>,
+    /// The garment over the legs or the body.
+    pub garment: Garment,
+    /// What the person carries, and its colour (sRGB).
+    pub carry: Option<(Carry, [u8; 3])>,
+}
+
+impl Figure {
+    /// An average build with short hair, trousers and nothing carried.
+    pub const PLAIN: Figure = Figure {
+        build: 1.0,
+        hair: HairStyle::Short,
+        headwear: None,
+        garment: Garment::Trousers,
+        carry: None,
+    };
+}
+
+impl Default for Figure {
+    fn default() -> Self {
+        Self::PLAIN
+    }
+}
+
+/// A hair style.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HairStyle {
+    /// No hair: the scalp shows.
+    Bald,
+    /// Short hair over the top and the back of the head.
+    Short,
+    /// Hair down to the shoulders, behind the head.
+    Long,
+    /// Hair tied in a bun at the back of the head.
+    Bun,
+}
+
+/// The garment that shapes a silhouette.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Garment {
+    /// Trousers or shorts: the legs show their shape.
+    Trousers,
+    /// A skirt to above the knee, in the bottom's colour.
+    Skirt,
+    /// A dress to above the knee, in the top's colour.
+    Dress,
+    /// A coat to the knees, in the top's colour.
+    Coat,
+}
+
+/// Something a person carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Carry {
+    /// A backpack on the back.
+    Backpack,
+    /// A bag hanging from the left shoulder at the hip.
+    ShoulderBag,
+}
+
+impl HairStyle {
+    /// The style's name (the people table's `hair` column).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bald => "bald",
+            Self::Short => "short",
+            Self::Long => "long",
+            Self::Bun => "bun",
+        }
+    }
+}
+
+impl Garment {
+    /// The garment's name (the people table's `garment` column).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Trousers => "trousers",
+            Self::Skirt => "skirt",
+            Self::Dress => "dress",
+            Self::Coat => "coat",
+        }
+    }
+}
+
+impl Carry {
+    /// The object's name (the people table's `carry` column).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Backpack => "backpack",
+            Self::ShoulderBag => "shoulder_bag",
+        }
+    }
 }

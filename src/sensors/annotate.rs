@@ -17,7 +17,7 @@ use glam::{DVec2, DVec3};
 use super::body::{self, BodyPose, CHILD_OFFSET_M, Capsule};
 use super::cyclist;
 use super::scene;
-use crate::plan::ClipScript;
+use crate::plan::{ClipScript, Figure};
 use crate::sim::gate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px, min_box, too_small};
 use crate::sim::rig::{Camera, CameraPose};
 use crate::sim::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction, WalkSignal};
@@ -276,7 +276,7 @@ fn sphere_interval(lateral: f64, depth: f64, r: f64, focal: f64, principal: f64)
 /// of the projections, so the box is the union of the end spheres' exact image intervals.
 /// Returns None if any part of the body is within 5 cm of the camera plane or behind it.
 pub fn project_box(pose: &BodyPose, cam: &CameraPose) -> Option<[f64; 4]> {
-    project_capsules_box(&pose.capsules, cam)
+    project_capsules_box(pose.parts(), cam)
 }
 
 /// [`project_box`] of any set of capsules (a cyclist: its rider and its bicycle).
@@ -360,8 +360,14 @@ pub fn annotate(
         .chain(std::iter::repeat((1.75, None)))
         .take(n_peds)
         .collect();
+    let figures: Vec<Figure> = (0..n_peds)
+        .map(|k| script.pedestrians.get(k).map_or(Figure::PLAIN, |p| p.identity.figure))
+        .collect();
     let rider_heights: Vec<f64> = (0..trace.cyclists.len())
         .map(|k| script.cyclists.get(k).map_or(1.75, |c| c.rider.height_m))
+        .collect();
+    let rider_figures: Vec<Figure> = (0..trace.cyclists.len())
+        .map(|k| script.cyclists.get(k).map_or(Figure::PLAIN, |c| c.rider.figure))
         .collect();
     let labels: Vec<Vec<bool>> = trace
         .pedestrians
@@ -443,9 +449,9 @@ pub fn annotate(
             if (f.pos - cam.centre).dot(cam.forward) <= 0.0 {
                 continue;
             }
-            let rider = cyclist::rider_pose(f, rider_heights[ci]);
+            let rider = cyclist::rider_pose(f, rider_heights[ci], &rider_figures[ci]);
             let bike = cyclist::bicycle(f, rider_heights[ci]);
-            let Some(bbox) = project_capsules_box(rider.capsules.iter().chain(&bike), &cam) else {
+            let Some(bbox) = project_capsules_box(rider.parts().chain(&bike), &cam) else {
                 continue;
             };
             let clipped = [
@@ -513,7 +519,7 @@ pub fn annotate(
                 out.rejections.behind += 1;
                 continue;
             }
-            let pose = body::pose(f, heights[id].0, DVec3::ZERO);
+            let pose = body::pose(f, heights[id].0, &figures[id], DVec3::ZERO);
             let Some(bbox) = project_box(&pose, &cam) else {
                 out.rejections.behind += 1;
                 continue;

@@ -10,6 +10,7 @@ use std::f64::consts::TAU;
 
 use glam::{DMat3, DVec3};
 
+use crate::plan::{Carry, Figure, Garment, HairStyle};
 use crate::sim::trace::{Gesture, PedFrame};
 use crate::spec::types::PoseFormat;
 
@@ -86,8 +87,9 @@ pub fn push_keypoints(coco: &[f32; 51], format: PoseFormat, flags: bool, out: &m
     }
 }
 
-/// Number of capsules in a body silhouette.
-pub const CAPSULES: usize = 17;
+/// Number of capsules in a body silhouette: 18 of the body (always present) and 4 of its figure (hair, headwear,
+/// bag, garment; absent ones have a radius of 0).
+pub const CAPSULES: usize = 22;
 
 /// A capsule: the set of points within `radius_m` of the segment `a`–`b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,8 +98,22 @@ pub struct Capsule {
     pub a: DVec3,
     /// Other end.
     pub b: DVec3,
-    /// Radius, metres.
+    /// Radius, metres (0: a part the figure does not have).
     pub radius_m: f64,
+}
+
+impl Capsule {
+    /// A part a figure does not have.
+    pub const ABSENT: Capsule = Capsule {
+        a: DVec3::ZERO,
+        b: DVec3::ZERO,
+        radius_m: 0.0,
+    };
+
+    /// Whether the capsule is drawn (a figure's absent parts are not).
+    pub fn is_present(&self) -> bool {
+        self.radius_m > 0.0
+    }
 }
 
 /// A posed body in world coordinates.
@@ -105,7 +121,8 @@ pub struct Capsule {
 pub struct BodyPose {
     /// COCO-17 joints.
     pub joints: [DVec3; 17],
-    /// The silhouette: torso, head, limbs, feet.
+    /// The silhouette: torso, head, limbs, feet, and the figure's hair, headwear, bag and garment (absent
+    /// ones have a radius of 0: iterate [`BodyPose::parts`]).
     pub capsules: [Capsule; CAPSULES],
     /// Body height, metres.
     pub height_m: f64,
@@ -123,6 +140,11 @@ pub struct BodyPose {
 pub const CAPSULE_MESH_SCALE: f32 = 1.04;
 
 impl BodyPose {
+    /// The capsules that are drawn (the figure's absent parts left out).
+    pub fn parts(&self) -> impl Iterator<Item = &Capsule> + Clone {
+        self.capsules.iter().filter(|c| c.is_present())
+    }
+
     /// The 3D box around the rendered body (its capsules' meshes, which reach [`CAPSULE_MESH_SCALE`] radii from
     /// their axes: every camera pixel and LiDAR point of the body lies in it), aligned with the body's yaw: its centre in the world and
     /// its extents (length along the yaw, width, height), metres.
@@ -131,7 +153,7 @@ impl BodyPose {
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         let scale = f64::from(CAPSULE_MESH_SCALE);
-        for c in &self.capsules {
+        for c in self.parts() {
             for p in [c.a, c.b] {
                 let q = to_body * (p - self.ground);
                 lo = lo.min(q - DVec3::splat(c.radius_m * scale));
@@ -159,39 +181,63 @@ const RUN_MPS: f64 = 2.4;
 
 impl BodyPose {
     /// The points besides the 17 joints whose occlusion counts towards a body's: both ends of the torso, the
-    /// head's centre and the middle of both thighs (the capsules of [`silhouette`]'s layout).
+    /// head's centre and the middle of both thighs (the capsules of [`silhouette`]'s layout: the torso's two
+    /// halves are capsules 0 and 17).
     pub fn occlusion_samples(&self) -> [DVec3; 5] {
         let c = &self.capsules;
-        [c[0].a, c[0].b, c[2].a, (c[7].a + c[7].b) * 0.5, (c[8].a + c[8].b) * 0.5]
+        let mid = |a: DVec3, b: DVec3| (a + b) * 0.5;
+        [
+            mid(c[0].a, c[17].a),
+            mid(c[0].b, c[17].b),
+            mid(c[2].a, c[2].b),
+            mid(c[7].a, c[7].b),
+            mid(c[8].a, c[8].b),
+        ]
     }
 }
 
+/// How much larger a head is, against the body's height, than an adult's: 1 for adults (1.5 m and taller),
+/// up to 1.25 for a 1.0 m child (a young child's head is about a sixth of its height, an adult's about an
+/// eighth).
+pub(crate) fn head_scale(h: f64) -> f64 {
+    1.0 + 0.25 * ((1.5 - h) / 0.5).clamp(0.0, 1.0)
+}
+
+/// The head: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and half-length (its
+/// height with the radius: 23 cm), fractions of the body height (an adult's).
+const HEAD_RADIUS: f64 = 0.047;
+const HEAD_HALF_LENGTH: f64 = 0.018;
+
 /// The head's keypoints (nose, left and right eye, left and right ear) and its centre for a body of height
 /// `h` whose neck is at `neck` and whose head is turned by `head_rot` about it: the one head layout of walkers
-/// and riders (COCO-17's first five joints).
+/// and riders (COCO-17's first five joints), on or just inside the head's surface (its capsule renders no nose).
+/// The head's top is at the body's height; a child's larger head ([`head_scale`]) sits on a shorter neck.
 pub(crate) fn head_points(neck: DVec3, head_rot: DMat3, h: f64) -> ([DVec3; 5], DVec3) {
-    let head_point =
-        |x: f64, y: f64, z: f64| neck + head_rot * (DVec3::new(x, y, z) * h - DVec3::new(0.0, 0.0, 0.87 * h));
+    let s = head_scale(h);
+    let centre = neck + head_rot * DVec3::new(0.0, 0.0, (0.13 - (HEAD_RADIUS + HEAD_HALF_LENGTH) * s) * h);
+    let head_point = |x: f64, y: f64, z: f64| centre + head_rot * (DVec3::new(x, y, z - 0.93) * (h * s));
     (
         [
-            head_point(0.06, 0.0, 0.92),
-            head_point(0.05, 0.018, 0.936),
-            head_point(0.05, -0.018, 0.936),
+            head_point(0.045, 0.0, 0.92),
+            head_point(0.04, 0.018, 0.936),
+            head_point(0.04, -0.018, 0.936),
             head_point(-0.005, 0.045, 0.93),
             head_point(-0.005, -0.045, 0.93),
         ],
-        head_point(0.0, 0.0, 0.93),
+        centre,
     )
 }
 
-/// The capsules of a body of height `h` from its joints in the body frame (COCO order) and its torso points
-/// `[pelvis, chest, neck, head centre]` (torso, shoulders, head, upper arms, forearms, thighs, shins, feet, neck,
-/// hands and hips), placed in the world by `to_world`: the same silhouette for a walker
-/// and a cyclist's rider.
+/// The capsules of a body of height `h` and figure `figure` from its joints in the body frame (COCO order), its
+/// torso points `[pelvis, chest, neck, head centre]` and its head's rotation (torso, shoulders, head, upper
+/// arms, forearms, thighs, shins, feet, neck, hands and hips, then the figure's hair, headwear, bag and
+/// garment), placed in the world by `to_world`: the same silhouette for a walker and a cyclist's rider.
 pub(crate) fn silhouette(
     joints: &[DVec3; 17],
     [pelvis, chest, neck, head_centre]: [DVec3; 4],
+    head_rot: DMat3,
     h: f64,
+    figure: &Figure,
     to_world: impl Fn(DVec3) -> DVec3,
 ) -> [Capsule; CAPSULES] {
     let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
@@ -203,30 +249,86 @@ pub(crate) fn silhouette(
         radius_m: r * h,
     };
     let j = |k: usize| joints[k];
+    let g = figure.build.clamp(0.7, 1.4);
+    let head_s = head_scale(h);
+    let head_r = HEAD_RADIUS * head_s;
+    let in_head = |x: f64, z: f64| head_centre + head_rot * (DVec3::new(x, 0.0, z) * (h * head_s));
+    // The torso's axis (up the spine) and the direction out of the back, perpendicular to it.
+    let torso_m = (chest - pelvis).length();
+    let up = (chest - pelvis).normalize_or(DVec3::Z);
+    let back = DVec3::new(-up.z, 0.0, up.x);
+    // The torso: two capsules side by side (wider than deep: 35 cm by 21 cm for an average 1.75 m adult),
+    // their axes closer at the waist than at the chest.
+    let torso_r = 0.06 * g;
+    let torso_half = |side: f64| {
+        (
+            pelvis + DVec3::new(0.0, side * 0.03 * h * g, 0.0),
+            chest + DVec3::new(0.0, side * 0.042 * h * g, 0.0),
+        )
+    };
+    let ((l_waist, l_chest), (r_waist, r_chest)) = (torso_half(1.0), torso_half(-1.0));
+    let head_up = head_rot * DVec3::Z * (HEAD_HALF_LENGTH * head_s * h);
+    let hair = match figure.hair {
+        HairStyle::Long => cap(in_head(-0.015, 0.012), in_head(-0.04, -0.1), 0.052 * head_s),
+        HairStyle::Bun => cap(in_head(-0.062, 0.03), in_head(-0.062, 0.03), 0.026 * head_s),
+        HairStyle::Short | HairStyle::Bald => Capsule::ABSENT,
+    };
+    // A hat: a dome a little larger than the head's top, down to above the eyebrows.
+    let headwear = match figure.headwear {
+        Some(_) => cap(in_head(0.0, 0.032), in_head(0.0, 0.032), 0.049 * head_s),
+        None => Capsule::ABSENT,
+    };
+    let carry = match figure.carry {
+        Some((Carry::Backpack, _)) => {
+            let off = back * ((torso_r + 0.045) * h);
+            cap(
+                pelvis + up * (0.45 * torso_m) + off,
+                pelvis + up * (0.95 * torso_m) + off,
+                0.055,
+            )
+        }
+        Some((Carry::ShoulderBag, _)) => {
+            let side = DVec3::new(-0.02 * h, (0.055 + 0.045 * g + 0.045) * h, 0.0);
+            cap(pelvis + side + up * (0.02 * h), pelvis + side - up * (0.04 * h), 0.04)
+        }
+        None => Capsule::ABSENT,
+    };
+    let garment = match figure.garment {
+        // Over the thighs, about as wide as the hips (the thighs swing through it when striding); a coat's skirt
+        // stays narrower than the hanging arms' reach, so that the arms show against it.
+        Garment::Skirt | Garment::Dress => cap(pelvis - up * (0.02 * h), pelvis - up * (0.15 * h), 0.085 * g),
+        Garment::Coat => cap(pelvis + up * (0.3 * torso_m), pelvis - up * (0.7 * torso_m), 0.075 * g),
+        Garment::Trousers => Capsule::ABSENT,
+    };
     [
-        cap(pelvis, chest, 0.085),
-        cap(j(5), j(6), 0.04),
-        cap(head_centre, head_centre, 0.07),
-        cap(j(5), j(7), 0.03),
-        cap(j(6), j(8), 0.03),
-        cap(j(7), j(9), 0.025),
-        cap(j(8), j(10), 0.025),
-        cap(j(11), j(13), 0.045),
-        cap(j(12), j(14), 0.045),
-        cap(j(13), j(15), 0.035),
-        cap(j(14), j(16), 0.035),
+        cap(l_waist, l_chest, torso_r),
+        cap(j(5), j(6), 0.04 * g),
+        cap(head_centre - head_up, head_centre + head_up, head_r),
+        cap(j(5), j(7), 0.03 * g),
+        cap(j(6), j(8), 0.03 * g),
+        cap(j(7), j(9), 0.025 * g),
+        cap(j(8), j(10), 0.025 * g),
+        cap(j(11), j(13), 0.045 * g),
+        cap(j(12), j(14), 0.045 * g),
+        cap(j(13), j(15), 0.035 * g),
+        cap(j(14), j(16), 0.035 * g),
         cap(j(15), toe(j(15)), 0.022),
         cap(j(16), toe(j(16)), 0.022),
         cap(neck, head_centre, 0.035),
         cap(j(9), hand(j(7), j(9)), 0.02),
         cap(j(10), hand(j(8), j(10)), 0.02),
-        cap(j(11), j(12), 0.05),
+        cap(j(11), j(12), 0.05 * g),
+        cap(r_waist, r_chest, torso_r),
+        hair,
+        headwear,
+        carry,
+        garment,
     ]
 }
 
-/// Poses a body of height `height_m` for one trace frame; `offset_body` shifts it in the body frame (used for
+/// Poses a body of height `height_m` and figure `figure` for one trace frame; `offset_body` shifts it in the body frame (used for
 /// a parent's child).
-pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
+pub fn pose(frame: &PedFrame, height_m: f64, figure: &Figure, offset_body: DVec3) -> BodyPose {
     let h = height_m;
     let speed = frame.velocity.length();
     let swing = if speed < STAND_MPS {
@@ -261,14 +363,17 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
 
     // Upper body: arms swing opposite to the legs; the right hand holds a phone in front of the chest.
     let shoulder_z = 0.818 * h;
-    let shoulder_y = 0.11 * h;
+    // Broader shoulders for a heavier build, and arms that hang a little away from the body (abducted by
+    // about 7° at the shoulder and 9° at the elbow), so that they stay clear of the torso's sides.
+    let g = figure.build.clamp(0.7, 1.4);
+    let shoulder_y = 0.11 * h * (0.6 + 0.4 * g);
     let upper = 0.186 * h;
     let fore = 0.146 * h;
     let arm = |side: f64, angle: f64| {
         let shoulder = DVec3::new(0.0, side * shoulder_y, shoulder_z);
-        let elbow = shoulder + DVec3::new(angle.sin(), 0.0, -angle.cos()) * upper;
+        let elbow = shoulder + DVec3::new(angle.sin(), side * 0.12, -angle.cos()).normalize() * upper;
         let fore_angle = angle + 0.25;
-        let wrist = elbow + DVec3::new(fore_angle.sin(), 0.0, -fore_angle.cos()) * fore;
+        let wrist = elbow + DVec3::new(fore_angle.sin(), side * 0.16, -fore_angle.cos()).normalize() * fore;
         (shoulder, elbow, wrist)
     };
     let (l_shoulder, l_elbow, l_wrist) = arm(1.0, -0.8 * theta);
@@ -323,7 +428,14 @@ pub fn pose(frame: &PedFrame, height_m: f64, offset_body: DVec3) -> BodyPose {
     let chest = DVec3::new(0.0, 0.0, 0.78 * h);
     BodyPose {
         joints,
-        capsules: silhouette(&local, [pelvis, chest, neck, head_centre], h, to_world),
+        capsules: silhouette(
+            &local,
+            [pelvis, chest, neck, head_centre],
+            head_rot,
+            h,
+            figure,
+            to_world,
+        ),
         height_m,
         ground: to_world(DVec3::ZERO),
         yaw_rad: frame.yaw_rad,
@@ -356,7 +468,7 @@ mod tests {
 
     #[test]
     fn standing_body_has_plausible_proportions() {
-        let p = pose(&frame(0.0, 0.0), 1.75, DVec3::ZERO);
+        let p = pose(&frame(0.0, 0.0), 1.75, &Figure::PLAIN, DVec3::ZERO);
         let z = |i: usize| p.joints[i].z;
         assert!(
             z(0) > z(5) && z(5) > z(11) && z(11) > z(13) && z(13) > z(15),
@@ -370,9 +482,72 @@ mod tests {
         assert!((p.joints[5] - p.joints[6]).truncate().dot(left) > 0.0);
     }
 
+    /// A figure's parts hang on the body: each present one touches the body's own capsules (hair and hat on
+    /// the head, a bag at the back or the hip, a skirt or coat over the thighs) and leaves the joints where they
+    /// are (the build alone broadens the shoulders); absent ones are left out of the
+    /// parts and the box; a heavy build is wider than a slim one; a child's head is larger against its height.
+    #[test]
+    fn figures_dress_the_same_skeleton() {
+        use crate::plan::{Carry, Garment, HairStyle};
+        let f = frame(1.3, 0.4);
+        let plain = pose(&f, 1.75, &Figure::PLAIN, DVec3::ZERO);
+        assert_eq!(plain.parts().count(), 18);
+        let touches = |c: &Capsule, body: &[Capsule]| {
+            body.iter().any(|b| {
+                let d = (0..=20)
+                    .flat_map(|i| (0..=20).map(move |k| (f64::from(i) / 20.0, f64::from(k) / 20.0)))
+                    .map(|(s, t)| c.a.lerp(c.b, s).distance(b.a.lerp(b.b, t)))
+                    .fold(f64::INFINITY, f64::min);
+                d <= c.radius_m + b.radius_m + 0.01
+            })
+        };
+        for (hair, garment, carry) in [
+            (HairStyle::Long, Garment::Skirt, Carry::Backpack),
+            (HairStyle::Bun, Garment::Coat, Carry::ShoulderBag),
+            (HairStyle::Bald, Garment::Dress, Carry::Backpack),
+        ] {
+            let figure = Figure {
+                build: 1.2,
+                hair,
+                headwear: Some([10, 10, 10]),
+                garment,
+                carry: Some((carry, [20, 20, 20])),
+            };
+            let p = pose(&f, 1.75, &figure, DVec3::ZERO);
+            let average = pose(&f, 1.75, &Figure { build: 1.0, ..figure }, DVec3::ZERO);
+            assert_eq!(
+                average.joints, plain.joints,
+                "only the build moves joints (the shoulders)"
+            );
+            let extra: Vec<&Capsule> = p.capsules[18..].iter().filter(|c| c.is_present()).collect();
+            assert_eq!(extra.len(), if hair == HairStyle::Bald { 3 } else { 4 });
+            for c in extra {
+                assert!(
+                    touches(c, &p.capsules[..18]),
+                    "{hair:?} {garment:?} {carry:?}: a part off the body: {c:?}"
+                );
+            }
+            assert!(p.box3d().1.y > plain.box3d().1.y, "{carry:?} widens the body");
+        }
+        let slim = pose(
+            &f,
+            1.75,
+            &Figure {
+                build: 0.85,
+                ..Figure::PLAIN
+            },
+            DVec3::ZERO,
+        );
+        assert!(slim.capsules[0].radius_m < plain.capsules[0].radius_m);
+        let child = pose(&f, 1.0, &Figure::PLAIN, DVec3::ZERO);
+        assert!(child.capsules[2].radius_m / 1.0 > 1.2 * plain.capsules[2].radius_m / 1.75);
+        let top = |p: &BodyPose| p.parts().map(|c| c.a.z.max(c.b.z) + c.radius_m).fold(0.0, f64::max);
+        assert!((top(&child) - 1.0).abs() < 0.03 && (top(&plain) - 1.75).abs() < 0.03);
+    }
+
     #[test]
     fn walking_swings_the_legs_in_opposition() {
-        let p = pose(&frame(1.4, 0.25), 1.75, DVec3::ZERO);
+        let p = pose(&frame(1.4, 0.25), 1.75, &Figure::PLAIN, DVec3::ZERO);
         let fwd = DVec2::from_angle(0.3);
         let l = (p.joints[15] - p.joints[11]).truncate().dot(fwd);
         let r = (p.joints[16] - p.joints[12]).truncate().dot(fwd);
@@ -387,7 +562,7 @@ mod tests {
             let mut f = frame(1.0, 0.3);
             f.head_yaw_rad = head_yaw;
             f.on_phone = on_phone;
-            let p = pose(&f, 1.7, DVec3::ZERO);
+            let p = pose(&f, 1.7, &Figure::PLAIN, DVec3::ZERO);
             assert!((p.gaze.length() - 1.0).abs() < 1e-12);
             let nose_dir = p.joints[0] - (p.joints[3] + p.joints[4]) * 0.5;
             let heading = |v: DVec3| v.y.atan2(v.x);
@@ -410,11 +585,11 @@ mod tests {
     #[test]
     fn gestures_move_the_right_arm_or_the_head() {
         let h = 1.7;
-        let plain = pose(&frame(0.0, 0.0), h, DVec3::ZERO);
+        let plain = pose(&frame(0.0, 0.0), h, &Figure::PLAIN, DVec3::ZERO);
         let at = |g: Gesture, t: f64| {
             let mut f = frame(0.0, 0.0);
             f.gesture = Some((g, t));
-            pose(&f, h, DVec3::ZERO)
+            pose(&f, h, &Figure::PLAIN, DVec3::ZERO)
         };
         let up = at(Gesture::HandAck, 0.6);
         assert!(up.joints[10].z > up.joints[0].z, "wrist above the nose");

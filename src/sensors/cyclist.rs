@@ -10,6 +10,7 @@ use std::f64::consts::{PI, TAU};
 use glam::{DMat3, DVec3};
 
 use super::body::{BodyPose, Capsule};
+use crate::plan::Figure;
 use crate::sim::trace::CyclistFrame;
 
 /// Wheel radius (a 700c / 28" wheel with its tyre), metres.
@@ -50,7 +51,7 @@ fn two_link(root: DVec3, target: DVec3, l1: f64, l2: f64, hint: DVec3) -> (DVec3
 
 /// The rider of a cyclist in frame `frame`: height `height_m`, hands on the handlebar, feet on the pedals (the
 /// crank angle from the frame), torso leaning forward, head level looking ahead.
-pub fn rider_pose(frame: &CyclistFrame, height_m: f64) -> BodyPose {
+pub fn rider_pose(frame: &CyclistFrame, height_m: f64, figure: &Figure) -> BodyPose {
     let h = height_m;
     let hip_z = hip_height_m(h);
     let pelvis = DVec3::new(-0.25, 0.0, hip_z);
@@ -93,7 +94,14 @@ pub fn rider_pose(frame: &CyclistFrame, height_m: f64) -> BodyPose {
     let to_world = |p: DVec3| frame.pos + rot * p;
     BodyPose {
         joints: local.map(to_world),
-        capsules: super::body::silhouette(&local, [pelvis, chest, neck, head_centre], h, to_world),
+        capsules: super::body::silhouette(
+            &local,
+            [pelvis, chest, neck, head_centre],
+            DMat3::IDENTITY,
+            h,
+            figure,
+            to_world,
+        ),
         height_m,
         ground: frame.pos,
         yaw_rad: frame.yaw_rad,
@@ -179,7 +187,7 @@ mod tests {
         let h = 1.75;
         for phase in [0.0, 0.13, 0.5, 0.77] {
             let f = frame(phase);
-            let rider = rider_pose(&f, h);
+            let rider = rider_pose(&f, h, &Figure::PLAIN);
             let bike = bicycle(&f, h);
             let rot = DMat3::from_rotation_z(-f.yaw_rad);
             let local = |p: DVec3| rot * (p - f.pos);

@@ -76,6 +76,7 @@ pub fn render_cameras<E>(
     let mut renderer = clip_renderer(stat, script, trace, rig);
     let mut frame_scene = scene::FrameScene::default();
     let mut images = camera::CameraImages::default();
+    let mut shutter = Shutter::new(&rig.camera.imaging, renderer.gain(), script.fps);
     let (w, h) = (rig.camera.width_px as usize, rig.camera.height_px as usize);
     let mut esim = sensors.dvs.enabled.then(|| camera::dvs::Esim::new(&sensors.dvs, w, h));
     let substeps = sensors.dvs.substeps.max(1);
@@ -107,13 +108,7 @@ pub fn render_cameras<E>(
                 );
             }
         }
-        clip.render(
-            &mut renderer,
-            &mut frame_scene,
-            scene::SceneTime::at(frame),
-            0,
-            &mut images,
-        );
+        clip.render_exposed(&mut renderer, &mut frame_scene, frame, &mut shutter, &mut images);
         let now = frame_time_ns(frame, script.fps, 0, 1);
         if let Some(esim) = esim.as_mut() {
             esim.step(
@@ -123,7 +118,8 @@ pub fn render_cameras<E>(
                 &mut events,
             );
         }
-        // The DVS saw the clean image; the RGB stream gets the sensor's noise.
+        // The DVS saw the frame's instant; the RGB stream gets the open shutter's blur and the sensor's noise.
+        shutter.blend(&mut images.rgb);
         renderer.add_noise(&mut images, camera::noise_seed(script.seed, frame));
         sink(SensorFrame {
             frame,
@@ -219,19 +215,21 @@ pub fn render_frame(
     let stat = scene::StaticScene::build(script, trace, town);
     let mut renderer = clip_renderer(&stat, script, trace, rig);
     let mut images = camera::CameraImages::default();
+    let mut shutter = Shutter::new(&rig.camera.imaging, renderer.gain(), script.fps);
     let clip = ClipView {
         stat: &stat,
         script,
         trace,
         rig,
     };
-    clip.render(
+    clip.render_exposed(
         &mut renderer,
         &mut scene::FrameScene::default(),
-        scene::SceneTime::at(frame),
-        0,
+        frame,
+        &mut shutter,
         &mut images,
     );
+    shutter.blend(&mut images.rgb);
     renderer.add_noise(&mut images, camera::noise_seed(script.seed, frame));
     images
 }
@@ -264,6 +262,94 @@ impl ClipView<'_> {
             camera::streak_seed(self.script.seed, t.frame, k),
             images,
         );
+    }
+}
+
+impl ClipView<'_> {
+    /// Renders frame `frame` as the camera exposes it: with motion blur, first the earlier instants of its open
+    /// shutter (summed into `shutter`), then the frame's instant into `images` (whose labels and depth are the
+    /// frame's); [`Shutter::blend`] then averages the RGB.
+    fn render_exposed(
+        &self,
+        renderer: &mut camera::Renderer,
+        frame_scene: &mut scene::FrameScene,
+        frame: u32,
+        shutter: &mut Shutter,
+        images: &mut camera::CameraImages,
+    ) {
+        shutter.summed = 0;
+        for k in (1..shutter.samples).rev() {
+            // Sample k of the shutter: k/(samples − 1) of the shutter before the frame (clamped to the clip's start).
+            let before = shutter.frames * f64::from(k) / f64::from(shutter.samples - 1);
+            let t = f64::from(frame) - before;
+            let at = if t <= 0.0 {
+                scene::SceneTime::at(0)
+            } else {
+                scene::SceneTime {
+                    frame: t.floor() as u32,
+                    alpha: t - t.floor(),
+                }
+            };
+            // The rain streaks of the frame's instant (a streak already is the rain's blur).
+            frame_scene.build(self.stat, self.script, self.trace, at);
+            let (pos, yaw) = scene::ego_at(self.trace, at);
+            renderer.render(
+                self.stat,
+                frame_scene,
+                &self.rig.camera.at(pos, yaw),
+                camera::streak_seed(self.script.seed, frame, 0),
+                images,
+            );
+            shutter.add(&images.rgb);
+        }
+        self.render(renderer, frame_scene, scene::SceneTime::at(frame), 0, images);
+    }
+}
+
+/// Motion blur's open shutter for a clip: its length in frames, its renders per frame, and the running sum of
+/// a frame's earlier renders.
+struct Shutter {
+    frames: f64,
+    samples: u32,
+    sum: Vec<u16>,
+    summed: u32,
+}
+
+impl Shutter {
+    /// The shutter of a camera's imaging at an exposure's gain, for a clip at `fps`.
+    fn new(imaging: &crate::sim::rig::Imaging, gain: f32, fps: u32) -> Shutter {
+        let (shutter_s, samples) = imaging.blur(gain);
+        Shutter {
+            frames: shutter_s * f64::from(fps.max(1)),
+            samples: if shutter_s > 0.0 { samples } else { 1 },
+            sum: Vec::new(),
+            summed: 0,
+        }
+    }
+
+    /// Adds an earlier render's RGB to the sum.
+    fn add(&mut self, rgb: &[u8]) {
+        if self.summed == 0 {
+            self.sum.clear();
+            self.sum.extend(rgb.iter().map(|&v| u16::from(v)));
+        } else {
+            for (s, &v) in self.sum.iter_mut().zip(rgb) {
+                *s += u16::from(v);
+            }
+        }
+        self.summed += 1;
+    }
+
+    /// Replaces the frame's instant in `rgb` by the mean of it and the earlier renders (rounded; nothing without
+    /// blur).
+    fn blend(&self, rgb: &mut [u8]) {
+        if self.summed == 0 {
+            return;
+        }
+        let n = self.summed + 1;
+        for (v, &s) in rgb.iter_mut().zip(&self.sum) {
+            *v = ((u32::from(s) + u32::from(*v) + n / 2) / n) as u8;
+        }
     }
 }
 

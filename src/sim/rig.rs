@@ -64,7 +64,11 @@ pub struct Camera {
     pub imaging: Imaging,
 }
 
-/// The camera's imaging of light into pixels (from `sensors.rgb`'s `exposure`, `vignetting` and `noise`).
+/// Shutter time per motion-blur render, seconds.
+const BLUR_SAMPLE_SPACING_S: f64 = 0.002;
+
+/// The camera's imaging of light into pixels (from `sensors.rgb`'s `exposure`, `vignetting`, `noise` and
+/// `motion_blur`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Imaging {
     /// Auto-exposure's `(key, max_gain)`; `None` for a fixed gain of 1.
@@ -75,6 +79,12 @@ pub struct Imaging {
     pub shot_noise: f32,
     /// Read noise's standard deviation.
     pub read_noise: f32,
+    /// Motion blur's shutter at a gain of 1, seconds (0: none).
+    pub shutter_s: f64,
+    /// Motion blur's longest shutter, seconds.
+    pub max_shutter_s: f64,
+    /// Motion blur's renders per frame at most.
+    pub blur_samples: u32,
 }
 
 impl Imaging {
@@ -86,7 +96,19 @@ impl Imaging {
             vignetting: rgb.vignetting as f32,
             shot_noise: rgb.noise.shot as f32,
             read_noise: rgb.noise.read as f32,
+            shutter_s: rgb.motion_blur.shutter_ms / 1000.0,
+            max_shutter_s: rgb.motion_blur.max_shutter_ms / 1000.0,
+            blur_samples: rgb.motion_blur.samples,
         }
+    }
+
+    /// Motion blur at an exposure's gain: the shutter time, seconds, and the renders per frame (1: none).
+    pub fn blur(&self, gain: f32) -> (f64, u32) {
+        let shutter_s = (self.shutter_s * f64::from(gain.max(1.0))).min(self.max_shutter_s);
+        let samples = (shutter_s / BLUR_SAMPLE_SPACING_S)
+            .ceil()
+            .clamp(1.0, f64::from(self.blur_samples.max(1)));
+        (shutter_s, samples as u32)
     }
 
     /// Whether the sensor adds noise.

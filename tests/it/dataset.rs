@@ -827,7 +827,8 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
             }
             // The box of a fully visible pedestrian is the projected body: dense samples of every capsule.
             let height = f64::from(d.pedestrians[&(a.clip.clone(), a.ped)].height_m);
-            let pose = body::pose(f, height, DVec3::ZERO);
+            let figure = &script.pedestrians[a.ped as usize].identity.figure;
+            let pose = body::pose(f, height, figure, DVec3::ZERO);
             let ego = &trace.ego[a.frame as usize];
             let cam = camera.at(ego.pos, ego.yaw_rad);
             let mut lo = DVec2::splat(f64::INFINITY);
@@ -838,7 +839,7 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
                 lo = lo.min(q.px);
                 hi = hi.max(q.px);
             };
-            for c in &pose.capsules {
+            for c in pose.parts() {
                 for dir in &dirs {
                     add(c.a + *dir * c.radius_m);
                     add(c.b + *dir * c.radius_m);

@@ -1,7 +1,7 @@
-//! The camera's sensor (`sensors.rgb.exposure`, `vignetting`, `noise`): auto-exposure brightens a night clip
-//! within its gain and leaves noon as it was, vignetting dims the corners and not the centre, noise is seeded
-//! (the same frame twice is the same bytes) and the label streams and the DVS's events stay exactly what a
-//! noise-free, fixed-exposure camera gives.
+//! The camera's sensor (`sensors.rgb.exposure`, `vignetting`, `noise`, `motion_blur`): auto-exposure brightens a
+//! night clip within its gain and leaves noon as it was, vignetting dims the corners and not the centre, noise is
+//! seeded (the same frame twice is the same bytes), motion blur smears only the RGB, and the label streams and
+//! the DVS's events stay exactly what a noise-free, fixed-exposure camera gives.
 
 use pedsynth::sensors::{self, camera::CameraImages, scene::StaticScene};
 
@@ -184,5 +184,50 @@ fn domain_randomisation_draws_a_look_per_clip_and_the_images_follow_it() {
             level_ratio > 1.0,
             "channels {i}/{j}: gains {wb:?}, means {t:?} vs {u:?}"
         );
+    }
+}
+
+#[test]
+fn motion_blur_smears_the_rgb_of_its_frame_and_leaves_the_labels() {
+    let blur = ["sensors.rgb.motion_blur.shutter_ms=2"];
+    // By day a 2 ms shutter is one render: the same bytes as no blur.
+    assert_eq!(busy("clear_noon", &blur).rgb, busy("clear_noon", &[]).rgb);
+    // At night auto-exposure opens it by its gain: the RGB is smeared, the labels and depth are the frame's.
+    let c = quickstart("night_clear", &blur);
+    let frame = c.busy_frames(1)[0];
+    let blurred = c.render(frame);
+    let sharp = busy("night_clear", &[]);
+    assert_eq!(blurred.depth_m, sharp.depth_m);
+    assert_eq!(blurred.semantic, sharp.semantic);
+    assert_eq!(blurred.instance, sharp.instance);
+    let differ = blurred.rgb.iter().zip(&sharp.rgb).filter(|(x, y)| x != y).count();
+    assert!(
+        differ > blurred.rgb.len() / 50,
+        "{differ} of {} values differ",
+        blurred.rgb.len()
+    );
+    let (b, s) = (mean_luminance(&blurred), mean_luminance(&sharp));
+    assert!(
+        (b - s).abs() < 0.03 * s,
+        "a blur keeps the light: {b:.2} against {s:.2}"
+    );
+    // The clip's frame equals the single frame rendered alone (every frame a pure function of the clip).
+    let mut overrides: Vec<&str> = SMALL.to_vec();
+    overrides.extend([
+        "dataset.weathers=[night_clear]",
+        "dataset.clip_duration_s=[1, 1]",
+        blur[0],
+    ]);
+    let c = clip(&spec("quickstart.yaml"), &overrides);
+    let net = &c.towns[&c.script.town].network;
+    let stat = StaticScene::build(&c.script, &c.trace, net);
+    let mut frames = Vec::new();
+    sensors::render_cameras::<()>(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
+        frames.push(f.images.rgb.clone());
+        Ok(())
+    })
+    .expect("render");
+    for frame in [0u32, 7] {
+        assert_eq!(frames[frame as usize], c.render(frame).rgb, "frame {frame}");
     }
 }

@@ -370,8 +370,8 @@ fn pedestrians_in_clear_view_get_points_and_every_pedestrian_point_is_in_its_box
             let ps = &c.script.pedestrians[pi];
             let frame = &c.trace.pedestrians[pi][t.frame as usize];
             let pose = match (&ps.child, child) {
-                (Some(k), true) => body::pose(frame, k.height_m, body::CHILD_OFFSET_M),
-                _ => body::pose(frame, ps.identity.height_m, DVec3::ZERO),
+                (Some(k), true) => body::pose(frame, k.height_m, &k.figure, body::CHILD_OFFSET_M),
+                _ => body::pose(frame, ps.identity.height_m, &ps.identity.figure, DVec3::ZERO),
             };
             let (centre, size) = pose.box3d();
             let world =

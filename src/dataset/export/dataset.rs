@@ -65,6 +65,12 @@ pub struct Pedestrian {
     pub height_m: f32,
     /// `adult`, `child` or `adult_with_child`.
     pub body: String,
+    /// Wears a hat.
+    pub headwear: bool,
+    /// `trousers`, `skirt`, `dress` or `coat`.
+    pub garment: String,
+    /// `backpack`, `shoulder_bag`, or "" (nothing carried).
+    pub carry: String,
     pub frames: Vec<AnnotatedFrame>,
 }
 
@@ -403,12 +409,16 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         "first_crossing_frame",
         "height_m",
         "body",
+        "headwear",
+        "garment",
+        "carry",
     ];
     for b in tables::read(&file("pedestrians"), &cols)? {
         let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
         let (crosser, intention, group) = (b.bools("crosser")?, b.u32s("intention_frame")?, b.u32s("group_id")?);
         let (behaviour, first_c) = (b.strings("behaviour")?, b.u32s("first_crossing_frame")?);
         let (height, body) = (b.f32s("height_m")?, b.strings("body")?);
+        let (headwear, garment, carry) = (b.bools("headwear")?, b.strings("garment")?, b.strings("carry")?);
         for i in 0..b.rows() {
             clip.pedestrians.insert(
                 id.value(i),
@@ -423,6 +433,9 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                     first_crossing_frame: (!first_c.is_null(i)).then(|| first_c.value(i)),
                     height_m: height.value(i),
                     body: body[i].to_owned(),
+                    headwear: headwear.value(i),
+                    garment: garment[i].to_owned(),
+                    carry: carry[i].to_owned(),
                     frames: Vec::new(),
                 },
             );

@@ -11,7 +11,7 @@ use std::path::Path;
 use glam::DVec2;
 use serde::Serialize;
 
-use super::dataset::{Clip, ClipInfo, Dataset, EgoFrame};
+use super::dataset::{Clip, ClipInfo, Dataset, EgoFrame, Pedestrian};
 use super::pie::{Labels, Place, occlusion_class, place_at, wrap_pi, xml_escape};
 use super::{LinkMode, RgbFiles, link_frames, write_file};
 use crate::world::RoadNetwork;
@@ -105,6 +105,18 @@ const APPEARANCE: [&str; 24] = [
     "sunglasses",
     "umbrella",
 ];
+
+/// Whether a pedestrian's figure shows JAAD's appearance label `label` (a hat is a `cap`; a shoulder bag hangs
+/// on the left; a coat reaches below the knee); the pose labels come from the facing.
+fn worn(p: &Pedestrian, label: &str) -> bool {
+    match label {
+        "backpack" => p.carry == "backpack",
+        "bag_shoulder" | "bag_left_side" => p.carry == "shoulder_bag",
+        "cap" => p.headwear,
+        "clothes_below_knee" => p.garment == "coat",
+        _ => false,
+    }
+}
 
 /// A town's crosswalks as (outline, centre), worked out once per clip.
 fn crosswalks(net: Option<&RoadNetwork>) -> Vec<(&[DVec2], DVec2)> {
@@ -239,7 +251,7 @@ fn write_video(
             );
             ap.push_str("<box");
             for label in APPEARANCE {
-                let _ = write!(ap, " {label}=\"{}\"", u8::from(label == side));
+                let _ = write!(ap, " {label}=\"{}\"", u8::from(label == side || worn(p, label)));
             }
             let _ = writeln!(ap, " frame=\"{}\" />", f.frame);
         }

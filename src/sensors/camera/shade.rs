@@ -245,9 +245,17 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         Material::Body | Material::Head => {
             if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
                 normal = capsule_normals(c, p);
-            }
-            if prim.material == Material::Head {
-                albedo = face(prim, normal, albedo);
+                if prim.material == Material::Head {
+                    // The face is placed by the directions from the head's centre (a sphere's normals).
+                    let rel = p.sub(V3::splat((c.a + c.b) * 0.5));
+                    let dir = rel.scale(F::ONE / rel.length_squared().max(F::splat(1.0e-12)).sqrt());
+                    albedo = face(prim, dir, albedo);
+                }
+                // Cloth and skin darken towards a body part's outline (folds, self-shadowing, a rough
+                // surface's view dependence): `0.6 + 0.4 (n·v)⁺`, so that a limb shows against a torso of its
+                // own colour.
+                let n_dot_v = -normal.dot(pts.ray) / pts.ray_len.max(F::splat(1.0e-6));
+                albedo = albedo.scale(F::splat(0.6) + F::splat(0.4) * n_dot_v.max(F::ZERO));
             }
             albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06));
         }
@@ -420,10 +428,9 @@ pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
     colour.scale(f).add(V3::splat(light.fog).scale(F::ONE - f))
 }
 
-/// A head's colours at unit normals `normal` of its sphere: hair on top and at the back (`albedo2`), and a
-/// face on the skin around the gaze direction (`prim.normal`): eyes, eyebrows in the hair's colour and a
-/// mouth, placed by the normal's components along the gaze, to the side and up (a face of a sphere 0.07 of the
-/// body height: eyes ±4 cm apart, as a person's are).
+/// A head's colours at unit directions `normal` from its centre: hair on top and at the back (`albedo2`), and
+/// a face on the skin around the gaze direction (`prim.normal`, level): eyes, eyebrows in the hair's colour
+/// and a mouth, placed by the direction's components along the gaze, to the side and up.
 #[inline(always)]
 fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
     let fwd = prim.normal;

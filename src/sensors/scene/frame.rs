@@ -70,26 +70,35 @@ pub(super) enum Wear {
     Head,
     Sleeve,
     Leg,
+    Hair,
+    Headwear,
+    Carry,
+    Garment,
 }
 
 pub(super) const WEAR: [Wear; CAPSULES] = [
-    Wear::Top,    // torso
-    Wear::Top,    // shoulders
-    Wear::Head,   // head
-    Wear::Top,    // upper arms
-    Wear::Top,    //
-    Wear::Sleeve, // forearms
-    Wear::Sleeve, //
-    Wear::Bottom, // thighs
-    Wear::Bottom, //
-    Wear::Leg,    // shins
-    Wear::Leg,    //
-    Wear::Shoes,  // feet
-    Wear::Shoes,  //
-    Wear::Skin,   // neck
-    Wear::Skin,   // hands
-    Wear::Skin,   //
-    Wear::Bottom, // hips
+    Wear::Top,      // torso, left half
+    Wear::Top,      // shoulders
+    Wear::Head,     // head
+    Wear::Top,      // upper arms
+    Wear::Top,      //
+    Wear::Sleeve,   // forearms
+    Wear::Sleeve,   //
+    Wear::Bottom,   // thighs
+    Wear::Bottom,   //
+    Wear::Leg,      // shins
+    Wear::Leg,      //
+    Wear::Shoes,    // feet
+    Wear::Shoes,    //
+    Wear::Skin,     // neck
+    Wear::Skin,     // hands
+    Wear::Skin,     //
+    Wear::Bottom,   // hips
+    Wear::Top,      // torso, right half
+    Wear::Hair,     // hair (long, bun)
+    Wear::Headwear, // hat
+    Wear::Carry,    // bag
+    Wear::Garment,  // skirt, dress, coat
 ];
 
 impl FrameScene {
@@ -171,11 +180,11 @@ impl FrameScene {
             let Some((outfit, child_outfit)) = stat.outfits.get(pi) else {
                 continue;
             };
-            let pose = body::pose(&frame, ps.identity.height_m, DVec3::ZERO);
+            let pose = body::pose(&frame, ps.identity.height_m, &ps.identity.figure, DVec3::ZERO);
             self.push_body(stat, &pose, outfit, pedestrian_instance(ps.id), tag::PEDESTRIAN);
             if let (Some(child), Some(child_outfit)) = (&ps.child, child_outfit) {
                 let child_frame = PedFrame { gesture: None, ..frame };
-                let pose = body::pose(&child_frame, child.height_m, CHILD_OFFSET_M);
+                let pose = body::pose(&child_frame, child.height_m, &child.figure, CHILD_OFFSET_M);
                 let inst = CHILD_INSTANCE_BASE.saturating_add(ps.id.min(16_383) as u16);
                 self.push_body(stat, &pose, child_outfit, inst, tag::PEDESTRIAN);
             }
@@ -198,7 +207,7 @@ impl FrameScene {
                 frame.crank_phase = (a.crank_phase + dp * t.alpha).rem_euclid(1.0);
             }
             let instance = CYCLIST_INSTANCE_BASE.saturating_add(cs.id.min(16_383) as u16);
-            let rider = cyclist::rider_pose(&frame, cs.rider.height_m);
+            let rider = cyclist::rider_pose(&frame, cs.rider.height_m, &cs.rider.figure);
             self.push_body(stat, &rider, outfit, instance, tag::RIDER);
             let tyre = linear([22, 22, 22]);
             let metal = linear([150, 150, 152]);
@@ -345,7 +354,14 @@ impl FrameScene {
             let (s, c) = (pose.yaw_rad as f32).sin_cos();
             Vec3::new(c, s, 0.0)
         };
+        // The face looks where the head does (level).
+        let gaze = Vec3::new(pose.gaze.x as f32, pose.gaze.y as f32, 0.0)
+            .try_normalize()
+            .unwrap_or(forward);
         for (cap, &(material, albedo)) in pose.capsules.iter().zip(&outfit.parts) {
+            if !cap.is_present() {
+                continue;
+            }
             let sc = SceneCapsule {
                 a: stat.rel(cap.a),
                 b: stat.rel(cap.b),
@@ -358,7 +374,7 @@ impl FrameScene {
                 instance,
                 albedo,
                 albedo2: outfit.hair,
-                normal: forward,
+                normal: if material == Material::Head { gaze } else { forward },
                 aux: (self.capsules.len() - 1) as u32,
             });
             self.mesh.capsule(&sc, prim);

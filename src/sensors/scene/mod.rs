@@ -25,7 +25,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::body::{self, CAPSULES, CHILD_OFFSET_M};
 use super::cyclist;
-use crate::plan::{ClipScript, EmergencyKind, Identity};
+use crate::plan::{ClipScript, EmergencyKind, Garment, HairStyle, Identity};
 use crate::sim::trace::{ClipTrace, LightState, PedFrame, VehicleFrame};
 use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::util::mix::splitmix64;

@@ -109,14 +109,26 @@ impl Outfit {
     /// The outfit of an identity; `key` seeds sleeve and leg length.
     pub fn of(identity: &Identity, seed: u64, key: u64) -> Outfit {
         let h = splitmix64(seed ^ 0xb0d1 ^ splitmix64(key));
-        let short_sleeves = h & 3 == 0;
-        let shorts = (h >> 2) & 7 == 0;
+        let figure = &identity.figure;
+        let coat = figure.garment == Garment::Coat;
+        let short_sleeves = h & 3 == 0 && !coat;
+        // Under a skirt or a dress: bare legs or dark tights, as often as shorts under trousers are rare.
+        let bare_legs = match figure.garment {
+            Garment::Skirt | Garment::Dress => (h >> 2) & 1 == 0,
+            Garment::Trousers => (h >> 2) & 7 == 0,
+            Garment::Coat => false,
+        };
         let (skin, top, bottom) = (
             linear(identity.skin_rgb),
             linear(identity.top_rgb),
             linear(identity.bottom_rgb),
         );
+        let tights = linear([28, 26, 30]);
         let shoes = linear(identity.shoes_rgb);
+        let hair = linear(identity.hair_rgb);
+        let accessory = |c: Option<[u8; 3]>| linear(c.unwrap_or([60, 60, 60]));
+        // A dress is one garment in the top's colour; a skirt is the bottom's.
+        let skirt = if figure.garment == Garment::Skirt { bottom } else { top };
         Outfit {
             parts: WEAR.map(|w| match w {
                 Wear::Top => (Material::Body, top),
@@ -126,10 +138,18 @@ impl Outfit {
                 Wear::Head => (Material::Head, skin),
                 Wear::Sleeve if short_sleeves => (Material::Body, skin),
                 Wear::Sleeve => (Material::Body, top),
-                Wear::Leg if shorts => (Material::Body, skin),
+                Wear::Leg if bare_legs => (Material::Body, skin),
+                Wear::Leg if figure.garment != Garment::Trousers && figure.garment != Garment::Coat => {
+                    (Material::Body, tights)
+                }
                 Wear::Leg => (Material::Body, bottom),
+                Wear::Hair => (Material::Body, hair),
+                Wear::Headwear => (Material::Body, accessory(figure.headwear)),
+                Wear::Carry => (Material::Body, accessory(figure.carry.map(|c| c.1))),
+                Wear::Garment => (Material::Body, skirt),
             }),
-            hair: linear(identity.hair_rgb),
+            // A bald head shows its scalp where hair would be.
+            hair: if figure.hair == HairStyle::Bald { skin } else { hair },
         }
     }
 }

@@ -105,7 +105,8 @@ impl CameraProfile {
     /// - `jaad` and `pie` also set a dashcam's sensor: vignetting 0.25 and noise (`shot` 0.012, `read` 0.0005:
     ///   about 1.5 levels of 255 on a mid-grey wall by day and 5–8 at night at the highest gain). Neither
     ///   dataset publishes its sensor's noise or vignetting, and their annotations cannot measure it: these are
-    ///   chosen to look like a consumer dashcam, not fitted.
+    ///   chosen to look like a consumer dashcam, not fitted. Likewise motion blur with a 2 ms shutter by day
+    ///   (1/500 s: no blur), opened by auto-exposure's gain up to 33 ms at night.
     pub fn preset(self) -> &'static [(&'static str, &'static str)] {
         match self {
             CameraProfile::Carla => &[
@@ -124,6 +125,7 @@ impl CameraProfile {
                 ("vignetting", "0.25"),
                 ("noise.shot", "0.012"),
                 ("noise.read", "0.0005"),
+                ("motion_blur.shutter_ms", "2"),
             ],
             CameraProfile::Pie => &[
                 ("width_px", "1920"),
@@ -134,6 +136,7 @@ impl CameraProfile {
                 ("vignetting", "0.25"),
                 ("noise.shot", "0.012"),
                 ("noise.read", "0.0005"),
+                ("motion_blur.shutter_ms", "2"),
             ],
         }
     }
@@ -176,6 +179,35 @@ pub struct Rgb {
     /// `pie` profiles turn it on.
     #[serde(skip_serializing_if = "super::is_default")]
     pub noise: SensorNoise,
+    /// Motion blur from the ego's and the agents' motion while the shutter is open. Off by default; the `jaad`
+    /// and `pie` profiles turn it on.
+    pub motion_blur: MotionBlur,
+}
+
+/// Motion blur. The shutter is open for `shutter_ms` before each frame's instant; with auto-exposure it stays
+/// open `gain` times longer (a dashcam lengthens its exposure before it amplifies), up to `max_shutter_ms`. The
+/// RGB image is the mean of renders spread evenly over the open shutter, the last at the frame's instant: one
+/// render per 2 ms of shutter, at most `samples` (a shutter under 2 ms costs nothing and blurs nothing). Only the
+/// RGB stream is blurred: the labels, the depth, the masks and the DVS are of the frame's instant.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct MotionBlur {
+    /// Shutter time at a gain of 1, milliseconds (0: no blur, the default).
+    pub shutter_ms: f64,
+    /// The longest shutter auto-exposure opens, milliseconds (33: a whole frame at 30 frames/s).
+    pub max_shutter_ms: f64,
+    /// Renders per frame at most (each one costs a frame's rendering).
+    pub samples: u32,
+}
+
+impl Default for MotionBlur {
+    fn default() -> Self {
+        MotionBlur {
+            shutter_ms: 0.0,
+            max_shutter_ms: 33.0,
+            samples: 4,
+        }
+    }
 }
 
 /// How the exposure is chosen.
@@ -298,6 +330,7 @@ impl Default for Rgb {
             exposure: Exposure::default(),
             vignetting: 0.0,
             noise: SensorNoise::default(),
+            motion_blur: MotionBlur::default(),
         }
     }
 }

@@ -160,7 +160,7 @@ impl Validator<'_> {
         );
     }
 
-    /// `sensors.rgb`'s exposure, vignetting and noise.
+    /// `sensors.rgb`'s exposure, vignetting, noise and motion blur.
     fn imaging(&mut self, rgb: &Rgb) {
         self.positive(
             "sensors.rgb.exposure.key",
@@ -195,6 +195,27 @@ impl Validator<'_> {
             0.0,
             1.0,
             "a standard deviation",
+        );
+        self.num(
+            "sensors.rgb.motion_blur.shutter_ms",
+            rgb.motion_blur.shutter_ms,
+            0.0,
+            1000.0,
+            "a shutter time in milliseconds",
+        );
+        self.num(
+            "sensors.rgb.motion_blur.max_shutter_ms",
+            rgb.motion_blur.max_shutter_ms,
+            0.0,
+            1000.0,
+            "a shutter time in milliseconds",
+        );
+        self.num(
+            "sensors.rgb.motion_blur.samples",
+            f64::from(rgb.motion_blur.samples),
+            1.0,
+            32.0,
+            "a number of renders per frame",
         );
     }
 

@@ -46,6 +46,23 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
         .column("height_m", false, f32c(&|p| p.identity.height_m))
         .column("age_group", false, s(&|p| p.identity.age.name().to_owned()))
         .column("gender", false, s(&|p| p.identity.gender.name().to_owned()))
+        .column("build", false, f32c(&|p| p.identity.figure.build))
+        .column("hair", false, s(&|p| p.identity.figure.hair.name().to_owned()))
+        .column(
+            "headwear",
+            false,
+            Arc::new(BooleanArray::from_iter(
+                peds.iter().map(|p| Some(p.identity.figure.headwear.is_some())),
+            )),
+        )
+        .column("garment", false, s(&|p| p.identity.figure.garment.name().to_owned()))
+        .column(
+            "carry",
+            true,
+            Arc::new(StringArray::from_iter(
+                peds.iter().map(|p| p.identity.figure.carry.map(|c| c.0.name())),
+            )),
+        )
         .column(
             "crosser",
             false,
