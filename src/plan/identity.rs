@@ -4,8 +4,8 @@
 //!
 //! Heights come from a blake3 hash of the clip seed and the pedestrian id (adults 1.55–1.95 m, children
 //! 1.0–1.3 m); looks from the ChaCha20 stream `ped/<id>/identity` (the child's from `ped/<id>/child`), and the
-//! figure (build, hair style, headwear, garment, bag) from `…/figure` after the looks' stream name, so that
-//! drawing them shifts no other random stream of the plan.
+//! figure (build, hair style, headwear, garment, bag) from `ped/<id>/identity/figure` (`ped/<id>/child/figure`,
+//! a rider's `cyclist/<id>/figure`), so that drawing them shifts no other random stream of the plan.
 //!
 //! The figure's shares are pedsynth's choices for a city street (no dataset we have publishes them): a
 //! backpack on a quarter of adults and on 45 % of young people and children, a shoulder bag on 30 % of women and
@@ -95,14 +95,8 @@ pub fn identities(clip_seed: u64, id: u32, archetype: &str, body: Body) -> (Iden
     };
     let height_m = if body == Body::Child { child_m } else { adult_m };
     let person = |stream: &str, height_m: f64, age: AgeGroup| {
-        let mut identity = looks(&mut seeds::clip_rng(clip_seed, stream), height_m, age);
-        identity.figure = figure(
-            &mut seeds::clip_rng(clip_seed, &format!("{stream}/figure")),
-            age,
-            identity.gender,
-            true,
-        );
-        identity
+        let identity = looks(&mut seeds::clip_rng(clip_seed, stream), height_m, age);
+        with_figure(identity, clip_seed, stream, true)
     };
     let main = person(&format!("ped/{id}/identity"), height_m, age);
     let child = (body == Body::AdultWithChild).then(|| person(&format!("ped/{id}/child"), child_m, AgeGroup::Child));
@@ -118,14 +112,21 @@ pub fn rider_identity(clip_seed: u64, id: u32) -> Identity {
     } else {
         AgeGroup::Adult
     };
-    let mut identity = looks(&mut rng, height_m, age);
-    identity.figure = figure(
-        &mut seeds::clip_rng(clip_seed, &format!("cyclist/{id}/figure")),
-        age,
-        identity.gender,
+    with_figure(
+        looks(&mut rng, height_m, age),
+        clip_seed,
+        &format!("cyclist/{id}"),
         false,
-    );
-    identity
+    )
+}
+
+/// `identity` with its figure drawn from the stream `<stream>/figure`; `skirts`: as [`figure`]'s.
+fn with_figure(identity: Identity, clip_seed: u64, stream: &str, skirts: bool) -> Identity {
+    let mut rng = seeds::clip_rng(clip_seed, &format!("{stream}/figure"));
+    Identity {
+        figure: figure(&mut rng, identity.age, identity.gender, skirts),
+        ..identity
+    }
 }
 
 /// An adult's and a child's height for pedestrian `id`, metres.

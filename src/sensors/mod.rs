@@ -253,13 +253,31 @@ impl ClipView<'_> {
         k: u32,
         images: &mut camera::CameraImages,
     ) {
+        self.render_streaked(
+            renderer,
+            frame_scene,
+            t,
+            camera::streak_seed(self.script.seed, t.frame, k),
+            images,
+        );
+    }
+
+    /// Renders the clip at time `t` with the rain streaks of `streak_seed` into `images`.
+    fn render_streaked(
+        &self,
+        renderer: &mut camera::Renderer,
+        frame_scene: &mut scene::FrameScene,
+        t: scene::SceneTime,
+        streak_seed: u64,
+        images: &mut camera::CameraImages,
+    ) {
         frame_scene.build(self.stat, self.script, self.trace, t);
         let (pos, yaw) = scene::ego_at(self.trace, t);
         renderer.render(
             self.stat,
             frame_scene,
             &self.rig.camera.at(pos, yaw),
-            camera::streak_seed(self.script.seed, t.frame, k),
+            streak_seed,
             images,
         );
     }
@@ -291,15 +309,8 @@ impl ClipView<'_> {
                 }
             };
             // The rain streaks of the frame's instant (a streak already is the rain's blur).
-            frame_scene.build(self.stat, self.script, self.trace, at);
-            let (pos, yaw) = scene::ego_at(self.trace, at);
-            renderer.render(
-                self.stat,
-                frame_scene,
-                &self.rig.camera.at(pos, yaw),
-                camera::streak_seed(self.script.seed, frame, 0),
-                images,
-            );
+            let streaks = camera::streak_seed(self.script.seed, frame, 0);
+            self.render_streaked(renderer, frame_scene, at, streaks, images);
             shutter.add(&images.rgb);
         }
         self.render(renderer, frame_scene, scene::SceneTime::at(frame), 0, images);

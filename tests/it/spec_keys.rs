@@ -278,6 +278,12 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         // The JPEG quality shows in JPEG files only.
         "output.jpeg_quality" => vec![("output.rgb_encoding", json!("jpeg"))],
         "output.h264_qp" => vec![("output.rgb_encoding", json!("h264"))],
+        // Motion blur shows where auto-exposure opens the shutter past 2 ms (at night), after a clip's first frame.
+        "sensors.rgb.motion_blur.shutter_ms" => vec![("dataset.weathers", json!(["night_clear"]))],
+        p if p.starts_with("sensors.rgb.motion_blur.") => vec![
+            ("dataset.weathers", json!(["night_clear"])),
+            ("sensors.rgb.motion_blur.shutter_ms", json!(2.0)),
+        ],
         // Emergency vehicles exist only when enabled, in the walk's few clips only with a large share.
         "traffic.emergency.enabled" => vec![("traffic.emergency.clip_share", json!(1.0))],
         "traffic.emergency.clip_share" => vec![("traffic.emergency.enabled", json!(true))],
