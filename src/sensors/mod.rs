@@ -98,7 +98,8 @@ pub fn render_cameras<E>(
                     frame: frame - 1,
                     alpha: f64::from(k) / f64::from(substeps),
                 };
-                clip.render(&mut renderer, &mut frame_scene, t, k, &mut images);
+                let streaks = camera::streak_seed(script.seed, t.frame, k);
+                clip.render(&mut renderer, &mut frame_scene, t, streaks, &mut images);
                 let now = frame_time_ns(frame - 1, script.fps, k, substeps);
                 esim.step(
                     &images.rgb,
@@ -243,27 +244,9 @@ struct ClipView<'a> {
 }
 
 impl ClipView<'_> {
-    /// Renders the clip at time `t` (sub-step `k` of its frame, which seeds the rain streaks) into `images`,
-    /// building the frame's scene in `frame_scene`.
+    /// Renders the clip at time `t` with the rain streaks of `streak_seed` ([`camera::streak_seed`]) into
+    /// `images`, building the frame's scene in `frame_scene`.
     fn render(
-        &self,
-        renderer: &mut camera::Renderer,
-        frame_scene: &mut scene::FrameScene,
-        t: scene::SceneTime,
-        k: u32,
-        images: &mut camera::CameraImages,
-    ) {
-        self.render_streaked(
-            renderer,
-            frame_scene,
-            t,
-            camera::streak_seed(self.script.seed, t.frame, k),
-            images,
-        );
-    }
-
-    /// Renders the clip at time `t` with the rain streaks of `streak_seed` into `images`.
-    fn render_streaked(
         &self,
         renderer: &mut camera::Renderer,
         frame_scene: &mut scene::FrameScene,
@@ -281,9 +264,7 @@ impl ClipView<'_> {
             images,
         );
     }
-}
 
-impl ClipView<'_> {
     /// Renders frame `frame` as the camera exposes it: with motion blur, first the earlier instants of its open
     /// shutter (summed into `shutter`), then the frame's instant into `images` (whose labels and depth are the
     /// frame's); [`Shutter::blend`] then averages the RGB.
@@ -310,10 +291,11 @@ impl ClipView<'_> {
             };
             // The rain streaks of the frame's instant (a streak already is the rain's blur).
             let streaks = camera::streak_seed(self.script.seed, frame, 0);
-            self.render_streaked(renderer, frame_scene, at, streaks, images);
+            self.render(renderer, frame_scene, at, streaks, images);
             shutter.add(&images.rgb);
         }
-        self.render(renderer, frame_scene, scene::SceneTime::at(frame), 0, images);
+        let streaks = camera::streak_seed(self.script.seed, frame, 0);
+        self.render(renderer, frame_scene, scene::SceneTime::at(frame), streaks, images);
     }
 }
 
@@ -399,11 +381,12 @@ pub fn clip_renderer(stat: &scene::StaticScene, script: &ClipScript, trace: &Cli
     let mut log_sum = 0.0;
     for k in 0..METERED_QUARTERS {
         let frame = (frames * k / METERED_QUARTERS) as u32;
+        let streaks = camera::streak_seed(script.seed, frame, 0);
         clip.render(
             &mut renderer,
             &mut frame_scene,
             scene::SceneTime::at(frame),
-            0,
+            streaks,
             &mut images,
         );
         log_sum += camera::expose::brightness(&images.rgb).max(1.0e-12).ln();
