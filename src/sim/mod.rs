@@ -112,24 +112,48 @@ pub fn simulate(script: &ClipScript, params: &SimParams, town: &RoadNetwork) -> 
     trace
 }
 
-/// Adds the ego's heading wobble to its recorded headings: an AR(1) of stationary deviation `sd_deg` and
-/// correlation time `correlation_s`, from the clip's `"ego heading"` stream (the same draws whatever else the
-/// spec changes). The sensors point along the recorded heading; the simulated path is unchanged.
+/// Adds the ego's heading wobble to its recorded headings: a smooth Gauss–Markov offset (white noise through two
+/// first-order lags of time constant `correlation_s`, autocorrelation `(1 + τ/T) e^{−τ/T}`) of stationary
+/// deviation `sd_deg`, from the clip's `"ego heading"` stream (the same draws whatever else the spec changes).
+/// A car's heading has a rate that changes smoothly (steering), so the offset is smooth too: a single lag
+/// (AR(1)) would turn the camera by a fresh random rate every frame. The lags run for ten time constants before
+/// the clip's first frame, so the offset starts from its stationary spread. The sensors point along the recorded
+/// heading; the simulated path is unchanged.
 fn wobble_heading(trace: &mut ClipTrace, wobble: &crate::spec::types::HeadingWobble, clip_seed: u64, fps: u32) {
+    let offsets_rad = heading_offsets_rad(wobble, clip_seed, fps, trace.ego.len());
+    for (frame, offset_rad) in trace.ego.iter_mut().zip(offsets_rad) {
+        frame.yaw_rad += offset_rad;
+    }
+}
+
+/// The heading wobble's offsets for `frames` frames (see [`wobble_heading`]), radians.
+fn heading_offsets_rad(
+    wobble: &crate::spec::types::HeadingWobble,
+    clip_seed: u64,
+    fps: u32,
+    frames: usize,
+) -> Vec<f64> {
     use rand_distr::{Distribution, StandardNormal};
     let mut rng = crate::plan::seeds::clip_rng(clip_seed, "ego heading");
     let sd_rad = wobble.sd_deg.to_radians();
-    let rho = (-1.0 / (f64::from(fps.max(1)) * wobble.correlation_s.max(1e-3))).exp();
-    let innovation = sd_rad * (1.0 - rho * rho).sqrt();
-    let first: f64 = StandardNormal.sample(&mut rng);
-    let mut offset_rad = sd_rad * first;
-    for (i, frame) in trace.ego.iter_mut().enumerate() {
-        if i > 0 {
-            let z: f64 = StandardNormal.sample(&mut rng);
-            offset_rad = rho * offset_rad + innovation * z;
+    let frames_per_t = f64::from(fps.max(1)) * wobble.correlation_s.max(1e-3);
+    let rho = (-1.0 / frames_per_t).exp();
+    // Two AR(1) lags in cascade: `inner` = ρ inner + √(1 − ρ²) σ_in z, `offset` = ρ offset + (1 − ρ) inner, whose
+    // stationary variance is σ_in² (1 + ρ²) / (1 + ρ)²; σ_in is chosen so that it is `sd_deg`².
+    let sd_inner = sd_rad * (1.0 + rho) / (1.0 + rho * rho).sqrt();
+    let innovation = sd_inner * (1.0 - rho * rho).sqrt();
+    let (mut inner, mut offset_rad) = (0.0_f64, 0.0_f64);
+    let warm_up = (10.0 * frames_per_t).ceil().min(100_000.0) as usize;
+    let mut out = Vec::with_capacity(frames);
+    for i in 0..warm_up + frames {
+        let z: f64 = StandardNormal.sample(&mut rng);
+        inner = rho * inner + innovation * z;
+        offset_rad = rho * offset_rad + (1.0 - rho) * inner;
+        if i >= warm_up {
+            out.push(offset_rad);
         }
-        frame.yaw_rad += offset_rad;
     }
+    out
 }
 
 /// The state of one clip's simulation.
@@ -615,5 +639,60 @@ fn form_groups(script: &ClipScript, peds: &mut [Ped]) {
             line.end += shift;
             peds[i].traits.line = Some(line);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::heading_offsets_rad;
+    use crate::spec::types::HeadingWobble;
+
+    /// The standard deviation of `xs` about their mean.
+    fn sd(xs: &[f64]) -> f64 {
+        let mean = xs.iter().sum::<f64>() / xs.len() as f64;
+        (xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / xs.len() as f64).sqrt()
+    }
+
+    #[test]
+    fn the_heading_wobble_is_smooth_with_the_asked_spread_and_change_over_half_a_second() {
+        let wobble = HeadingWobble {
+            sd_deg: 2.0,
+            correlation_s: 1.0,
+        };
+        // Many clips' offsets (each from its own seed), degrees.
+        let clips: Vec<Vec<f64>> = (0..400_u64)
+            .map(|seed| {
+                heading_offsets_rad(&wobble, seed, 30, 450)
+                    .iter()
+                    .map(|r| r.to_degrees())
+                    .collect()
+            })
+            .collect();
+        let all: Vec<f64> = clips.iter().flatten().copied().collect();
+        let first: Vec<f64> = clips.iter().map(|c| c[0]).collect();
+        // Stationary from the first frame: the spread of frame 0 across clips and of every frame is `sd_deg`.
+        assert!((sd(&all) - 2.0).abs() < 0.1, "sd {}", sd(&all));
+        assert!((sd(&first) - 2.0).abs() < 0.25, "first-frame sd {}", sd(&first));
+        // Its change over 0.5 s is σ √(2 (1 − 1.5 e^{−0.5})) = 0.849° (what `calibrate` inverts) ...
+        let lag: Vec<f64> = clips.iter().flat_map(|c| c.windows(16).map(|w| w[15] - w[0])).collect();
+        assert!((sd(&lag) - 0.849).abs() < 0.05, "0.5 s change sd {}", sd(&lag));
+        // ... and it turns at a smooth rate: the change of the per-frame change is about a third of the per-frame
+        // change (σ/T = 2°/s is 0.067° a frame), where an AR(1)'s would be √2 times it.
+        let steps: Vec<f64> = clips.iter().flat_map(|c| c.windows(2).map(|w| w[1] - w[0])).collect();
+        let bends: Vec<f64> = clips
+            .iter()
+            .flat_map(|c| c.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]))
+            .collect();
+        assert!((sd(&steps) - 0.067).abs() < 0.006, "per-frame change sd {}", sd(&steps));
+        assert!(
+            sd(&bends) < 0.45 * sd(&steps),
+            "bend sd {} against step sd {}",
+            sd(&bends),
+            sd(&steps)
+        );
+        assert_eq!(
+            heading_offsets_rad(&wobble, 9, 30, 100),
+            heading_offsets_rad(&wobble, 9, 30, 100)
+        );
     }
 }

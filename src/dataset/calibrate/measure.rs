@@ -144,13 +144,14 @@ pub fn linear_pieces(videos: &[RealVideo]) -> Vec<f64> {
 /// Frames over which [`pan_sd_deg`] measures each pedestrian's change of bearing (0.5 s at 30 frames/s).
 const PAN_LAG_FRAMES: u32 = 15;
 
-/// The camera's heading wobble, degrees: the standard deviation of an AR(1) heading with a 1 s correlation time
-/// whose change over [`PAN_LAG_FRAMES`] frames explains what pedestrians seen together share of their change of
+/// The camera's heading wobble, degrees: the standard deviation of the simulator's smooth heading offset (two
+/// first-order lags of 1 s, autocorrelation `(1 + τ/T) e^{−τ/T}`) whose change over [`PAN_LAG_FRAMES`] frames explains what pedestrians seen together share of their change of
 /// bearing. In each video, every 15th frame, each pedestrian's bearing `atan((centre − W/2) / f)` is compared with
 /// its bearing 15 frames later; the mean product of two different pedestrians' changes (their own walking and
 /// the annotators' noise are independent and drop out; a turn or wobble of the car moves them all) is the
-/// variance of the common change, `2 σ² (1 − e^{−0.5 s / 1 s})`. The car's forward motion also moves pedestrians
-/// on one side together, so this bounds the wobble from above (a set generated without wobble measures 0.74°).
+/// variance of the common change, `2 σ² (1 − 1.5 e^{−0.5})` (τ = 0.5 s, T = 1 s). The car's forward motion also
+/// moves pedestrians on one side together, so this bounds the wobble from above (a set generated without wobble
+/// measures 1.5°).
 /// `None` with fewer than 100 such pairs.
 pub fn pan_sd_deg(videos: &[RealVideo], focal_px: f64) -> Option<f64> {
     let (mut sum, mut pairs) = (0.0, 0.0);
@@ -182,7 +183,8 @@ pub fn pan_sd_deg(videos: &[RealVideo], focal_px: f64) -> Option<f64> {
     }
     let common_var = (sum / pairs).max(0.0);
     let lag_s = f64::from(PAN_LAG_FRAMES) / 30.0;
-    Some((common_var / (2.0 * (1.0 - (-lag_s).exp()))).sqrt().to_degrees())
+    let correlation = (1.0 + lag_s) * (-lag_s).exp();
+    Some((common_var / (2.0 * (1.0 - correlation))).sqrt().to_degrees())
 }
 
 /// ROC AUC of `score` for `positive` (Mann–Whitney, ties counted half); `None` without both classes.

@@ -253,15 +253,16 @@ pub struct Ego {
     pub heading_wobble: HeadingWobble,
 }
 
-/// An AR(1) offset of the ego's recorded heading (so of its camera and LiDAR), drawn per clip from its seed
-/// (the stream `"ego heading"`): stationary standard deviation `sd_deg`, correlation time `correlation_s`. The
-/// simulated path does not change, only where the car (and its sensors) point along it.
+/// A smooth offset of the ego's recorded heading (so of its camera and LiDAR), drawn per clip from its seed
+/// (the stream `"ego heading"`): white noise through two first-order lags of time constant `correlation_s`,
+/// stationary standard deviation `sd_deg`, so that the heading turns at a smoothly changing rate as a steered
+/// car's does. The simulated path does not change, only where the car (and its sensors) point along it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct HeadingWobble {
     /// Standard deviation of the heading offset, degrees (0: off).
     pub sd_deg: f64,
-    /// Correlation time of the offset, seconds.
+    /// Time constant of each of the two lags, seconds (autocorrelation `(1 + τ/T) e^(−τ/T)`).
     pub correlation_s: f64,
 }
 
