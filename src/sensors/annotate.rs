@@ -197,7 +197,8 @@ enum Occluder {
         height_m: f64,
         owner: u32,
     },
-    /// A street lamp's pole (the square, axis-aligned box the renderer draws): its centre and half extents.
+    /// A street lamp's pole or a piece of street furniture (the axis-aligned box the renderer draws): its centre
+    /// and half extents.
     Pole { centre: DVec3, half_m: DVec3 },
 }
 
@@ -222,17 +223,18 @@ fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
     }
 }
 
-/// The lamp poles of the clip's scene, as the renderer draws them ([`scene::clip_lamp_posts`]; the arm and the
-/// light are above any line of sight to a pedestrian).
-fn lamp_poles(trace: &ClipTrace, town: &RoadNetwork) -> Vec<Occluder> {
-    let half = f64::from(scene::LAMP_POLE_HALF_WIDTH_M);
-    let height_m = f64::from(scene::LAMP_HEIGHT_M + scene::LAMP_POLE_ABOVE_LIGHT_M);
-    scene::clip_lamp_posts(trace, town)
-        .into_iter()
-        .map(|post| Occluder::Pole {
-            centre: post.foot.extend(post.base_z_m + height_m * 0.5),
-            half_m: DVec3::new(half, half, height_m * 0.5),
-        })
+/// The lamp poles and the street furniture of the clip's scene, as the renderer draws them
+/// ([`scene::clip_lamp_posts`], [`scene::clip_furniture`]; a lamp's arm and light are above any line of sight to a
+/// pedestrian), as boxes.
+fn static_occluders(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64) -> Vec<Occluder> {
+    let posts = scene::clip_lamp_posts(trace, town);
+    let furniture = scene::clip_furniture(trace, town, clip_seed, &posts);
+    let boxes = posts
+        .iter()
+        .map(scene::LampPost::pole_box)
+        .chain(furniture.iter().map(|f| (f.centre(), f.half_m)));
+    boxes
+        .map(|(centre, half_m)| Occluder::Pole { centre, half_m })
         .collect()
 }
 
@@ -397,7 +399,7 @@ pub fn annotate(
         }
     }
 
-    let poles = lamp_poles(trace, town);
+    let poles = static_occluders(trace, town, script.seed);
     let mut occluders: Vec<Occluder> = Vec::with_capacity(poles.len() + trace.vehicles.len() + 2 * n_peds);
     let mut near: Vec<Occluder> = Vec::with_capacity(occluders.capacity());
     let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));

@@ -208,21 +208,59 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             let zz = z / 3.2;
             let (cell_a, cell_z) = (floor_int(a), floor_int(zz));
             let (fa, fz) = (a - cell_a.round_float(), zz - cell_z.round_float());
+            // A building with a shop on its ground floor has a second colour, its signs' (see `StaticScene`).
+            let shop = prim.albedo2 != prim.albedo;
+            let ground_floor = if shop {
+                zz.simd_lt(F::ONE)
+            } else {
+                F::ZERO.simd_gt(F::ONE)
+            };
             let window = fa.simd_gt(F::splat(0.22))
                 & fa.simd_lt(F::splat(0.78))
                 & fz.simd_gt(F::splat(0.3))
                 & fz.simd_lt(F::splat(0.82))
-                & z.simd_gt(F::splat(1.2));
+                & z.simd_gt(F::splat(1.2))
+                & !ground_floor;
             let plain = albedo.scale(grain(nz, a * 4.0, z * 2.0, 0.07));
             let floor_line = fz.simd_lt(F::splat(0.04));
             let wall = V3::select(floor_line, albedo.scale(F::splat(0.7)), plain);
             albedo = V3::select(window, V3::splat(Vec3::new(0.03, 0.035, 0.045)), wall);
             gloss = window.select(F::splat(0.35), F::ZERO);
-            if window.any() && l.night > 0.0 {
-                let (ca, cz, win) = (cell_a.to_array(), cell_z.to_array(), window.to_bitmask());
+            // Shop fronts: a display window across each bay (mullions between), a sign band above it.
+            let display = ground_floor
+                & fa.simd_gt(F::splat(0.05))
+                & fa.simd_lt(F::splat(0.95))
+                & fz.simd_gt(F::splat(0.06))
+                & fz.simd_lt(F::splat(0.7));
+            if shop {
+                let sign = ground_floor & fz.simd_gt(F::splat(0.76)) & fz.simd_lt(F::splat(0.95));
+                let sign_colour = V3::splat(prim.albedo2).scale(grain(nz, a * 7.0, z * 5.0, 0.12));
+                albedo = V3::select(sign, sign_colour, albedo);
+                // Goods behind the glass: dim, mottled colours.
+                let goods = F::splat(0.05) + F::splat(0.03) * nz.sample_lanes(a * 9.0, z * 3.0);
+                let glass = V3 {
+                    x: goods,
+                    y: goods * F::splat(0.95),
+                    z: goods * F::splat(1.1),
+                };
+                albedo = V3::select(display, glass, albedo);
+                gloss = display.select(F::splat(0.4), gloss);
+            }
+            let lit_window = window | display;
+            if lit_window.any() && l.night > 0.0 {
+                let (ca, cz, win, shop_lanes) = (
+                    cell_a.to_array(),
+                    cell_z.to_array(),
+                    window.to_bitmask(),
+                    display.to_bitmask(),
+                );
+                // One window in five is lit at night; three shops in five are, a little brighter.
                 let lit = lanes_from(|i| {
-                    if win & (1 << i) != 0 && nz.cell(ca[i], cz[i], prim.aux) < 0.22 {
+                    let on = |share: f32| nz.cell(ca[i], cz[i], prim.aux) < share;
+                    if win & (1 << i) != 0 && on(0.22) {
                         1.0
+                    } else if shop_lanes & (1 << i) != 0 && on(0.6) {
+                        1.3
                     } else {
                         0.0
                     }

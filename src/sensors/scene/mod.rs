@@ -15,6 +15,7 @@
 //! path), which keeps single precision at the millimetre over a town.
 
 mod frame;
+mod furniture;
 mod paint;
 mod town;
 
@@ -32,6 +33,7 @@ use crate::util::mix::splitmix64;
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
 
 pub use frame::*;
+pub use furniture::*;
 pub use paint::*;
 pub use town::*;
 
@@ -61,6 +63,8 @@ pub mod tag {
     pub const RIDER: u8 = 13;
     /// Bicycles.
     pub const BICYCLE: u8 = 19;
+    /// Street furniture that does not move (bins, bollards).
+    pub const STATIC: u8 = 20;
     /// Cars.
     pub const CAR: u8 = 14;
     /// Lane markings and crosswalk stripes.

@@ -220,6 +220,19 @@ pub struct LampPost {
     pub to_road: DVec2,
 }
 
+impl LampPost {
+    /// The box of its pole as the renderer draws it: centre and half extents, world metres (the arm and the light
+    /// are above any line of sight to a pedestrian).
+    pub fn pole_box(&self) -> (DVec3, DVec3) {
+        let half = f64::from(LAMP_POLE_HALF_WIDTH_M);
+        let height_m = f64::from(LAMP_HEIGHT_M + LAMP_POLE_ABOVE_LIGHT_M);
+        (
+            self.foot.extend(self.base_z_m + height_m * 0.5),
+            DVec3::new(half, half, height_m * 0.5),
+        )
+    }
+}
+
 /// Half the width of a (square) lamp pole, metres.
 pub const LAMP_POLE_HALF_WIDTH_M: f32 = 0.07;
 
@@ -468,6 +481,16 @@ impl StaticScene {
         }
 
         // Buildings, trees and poles of the town.
+        const SHOP_SIGNS: [[u8; 3]; 8] = [
+            [160, 30, 34],
+            [24, 70, 140],
+            [30, 110, 60],
+            [220, 180, 40],
+            [30, 30, 32],
+            [230, 230, 224],
+            [200, 90, 30],
+            [110, 40, 110],
+        ];
         const FACADES: [[u8; 3]; 7] = [
             [150, 84, 64],
             [196, 178, 150],
@@ -490,7 +513,12 @@ impl StaticScene {
             match o.kind {
                 ObstacleKind::Building => {
                     let colour = linear(FACADES[(h % FACADES.len() as u64) as usize]);
-                    let wall = flat(Material::Wall, tag::BUILDING, colour, Vec3::Z, i as u32);
+                    let mut wall = flat(Material::Wall, tag::BUILDING, colour, Vec3::Z, i as u32);
+                    // Two buildings in five have shops on the ground floor: display windows under a sign band
+                    // in the second colour (the shader draws them).
+                    if (h >> 24) % 5 < 2 {
+                        wall.albedo2 = linear(SHOP_SIGNS[((h >> 32) % SHOP_SIGNS.len() as u64) as usize]);
+                    }
                     let roof = flat(Material::Roof, tag::BUILDING, linear([84, 80, 78]), Vec3::Z, i as u32);
                     b.mesh
                         .upright_box(c, o.heading_rad as f32, o.half_extents_m.as_vec2(), z, wall, roof);
@@ -523,7 +551,8 @@ impl StaticScene {
         let mut lamps = Vec::new();
         let metal = flat(Material::Metal, tag::POLE, linear([70, 74, 78]), Vec3::Z, 0);
         let head = flat(Material::LampHead, tag::POLE, linear([230, 220, 190]), -Vec3::Z, 0);
-        for post in clip_lamp_posts(trace, town) {
+        let posts = clip_lamp_posts(trace, town);
+        for post in &posts {
             let base = (post.base_z_m - origin.z) as f32;
             let f = (post.foot - origin.truncate()).as_vec2();
             let dir = post.to_road.as_vec2();
@@ -556,6 +585,29 @@ impl StaticScene {
             lamps.push(Lamp {
                 pos: Vec3::new(arm_end.x, arm_end.y, top - 0.15),
             });
+            close_cluster(&b, &mut clusters, &mut cluster_start);
+        }
+
+        // Street furniture (bins, rows of bollards) at the curb, per clip.
+        for item in clip_furniture(trace, town, seed, &posts) {
+            let c = (item.foot - origin.truncate()).as_vec2();
+            let half = item.half_m.truncate().as_vec2();
+            let base = (item.base_z_m - origin.z) as f32;
+            let top = base + 2.0 * item.half_m.z as f32;
+            let body = flat(Material::Metal, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+            match item.kind {
+                FurnitureKind::Bin => {
+                    let lid = flat(Material::Metal, tag::STATIC, linear(item.rgb) * 0.6, Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top], body, lid);
+                }
+                FurnitureKind::Bollard => {
+                    // Dark, with a light reflective band 0.1 m below its top.
+                    let band = flat(Material::Metal, tag::STATIC, linear([200, 200, 196]), Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top - 0.2], body, body);
+                    b.mesh.upright_box(c, 0.0, half, [top - 0.2, top - 0.1], band, band);
+                    b.mesh.upright_box(c, 0.0, half, [top - 0.1, top], body, body);
+                }
+            }
             close_cluster(&b, &mut clusters, &mut cluster_start);
         }
 
