@@ -277,6 +277,8 @@ impl ClipView<'_> {
         images: &mut camera::CameraImages,
     ) {
         shutter.summed = 0;
+        // The rain streaks of the frame's instant in every render (a streak already is the rain's blur).
+        let streaks = camera::streak_seed(self.script.seed, frame, 0);
         for k in (1..shutter.samples).rev() {
             // Sample k of the shutter: k/(samples − 1) of the shutter before the frame (clamped to the clip's start).
             let before = shutter.frames * f64::from(k) / f64::from(shutter.samples - 1);
@@ -289,12 +291,9 @@ impl ClipView<'_> {
                     alpha: t - t.floor(),
                 }
             };
-            // The rain streaks of the frame's instant (a streak already is the rain's blur).
-            let streaks = camera::streak_seed(self.script.seed, frame, 0);
             self.render(renderer, frame_scene, at, streaks, images);
             shutter.add(&images.rgb);
         }
-        let streaks = camera::streak_seed(self.script.seed, frame, 0);
         self.render(renderer, frame_scene, scene::SceneTime::at(frame), streaks, images);
     }
 }

@@ -145,14 +145,14 @@ pub fn linear_pieces(videos: &[RealVideo]) -> Vec<f64> {
 const PAN_LAG_FRAMES: u32 = 15;
 
 /// The camera's heading wobble, degrees: the standard deviation of the simulator's smooth heading offset (two
-/// first-order lags of 1 s, autocorrelation `(1 + τ/T) e^{−τ/T}`) whose change over [`PAN_LAG_FRAMES`] frames explains what pedestrians seen together share of their change of
-/// bearing. In each video, every 15th frame, each pedestrian's bearing `atan((centre − W/2) / f)` is compared with
-/// its bearing 15 frames later; the mean product of two different pedestrians' changes (their own walking and
-/// the annotators' noise are independent and drop out; a turn or wobble of the car moves them all) is the
-/// variance of the common change, `2 σ² (1 − 1.5 e^{−0.5})` (τ = 0.5 s, T = 1 s). The car's forward motion also
-/// moves pedestrians on one side together, so this bounds the wobble from above (a set generated without wobble
-/// measures 1.5°).
-/// `None` with fewer than 100 such pairs.
+/// first-order lags of 1 s, autocorrelation `(1 + τ/T) e^{−τ/T}`) whose change over [`PAN_LAG_FRAMES`] frames
+/// explains what pedestrians seen together share of their change of bearing. In each video, every 15th frame,
+/// each pedestrian's bearing `atan((centre − W/2) / f)` is compared with its bearing 15 frames later; the mean
+/// product of two different pedestrians' changes (their own walking and the annotators' noise are independent
+/// and drop out; a turn or wobble of the car moves them all) is the variance of the common change,
+/// `2 σ² (1 − 1.5 e^{−0.5})` (τ = 0.5 s, T = 1 s). The car's forward motion also moves pedestrians on one side
+/// together, so this bounds the wobble from above (a set generated without wobble measures 1.5°: 0.74° read as an
+/// AR(1)). `None` with fewer than 100 such pairs.
 pub fn pan_sd_deg(videos: &[RealVideo], focal_px: f64) -> Option<f64> {
     let (mut sum, mut pairs) = (0.0, 0.0);
     for v in videos {

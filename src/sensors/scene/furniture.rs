@@ -5,10 +5,10 @@
 
 use glam::{DVec2, DVec3};
 
-use super::{LAMP_CLEARANCE_M, LampPost, scene_bounds};
+use super::{LAMP_CLEARANCE_M, LampPost, for_each_curb_station, scene_bounds};
 use crate::sim::trace::ClipTrace;
 use crate::util::mix::splitmix64;
-use crate::world::{LaneType, RoadNetwork};
+use crate::world::RoadNetwork;
 
 /// What a piece of furniture is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,56 +62,32 @@ pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lam
     let (lo, hi) = scene_bounds(trace);
     let near = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
     let mut out = Vec::new();
-    for (lane_idx, lane) in town.lanes.iter().enumerate() {
-        if lane.lane_type != LaneType::Sidewalk || lane.in_junction {
-            continue;
+    for_each_curb_station(town, SPACING_M, |s| {
+        let foot = s.inner - s.to_road * FROM_CURB_M;
+        if s.width_m < 1.5 || !near(foot) {
+            return;
         }
-        let mut next_m = SPACING_M * 0.5;
-        let mut along = 0.0;
-        let mut place = 0u64;
-        for piece in &town.pieces[lane.pieces.start as usize..lane.pieces.end as usize] {
-            let [c0, c1] = piece.centre();
-            let len = c0.distance(c1);
-            while along + len >= next_m && len > 1e-6 {
-                let t = (next_m - along) / len;
-                next_m += SPACING_M;
-                place += 1;
-                let width = f64::from(piece.width_m[0]);
-                if width < 1.5 {
-                    continue;
-                }
-                let inner = piece.corners[0].lerp(piece.corners[1], t);
-                let to_road = (inner - c0.lerp(c1, t)).normalize_or_zero();
-                let along_dir = (c1 - c0) / len;
-                let foot = inner - to_road * FROM_CURB_M;
-                if !near(foot) {
-                    continue;
-                }
-                let h = splitmix64(clip_seed ^ 0xf00d_5eed ^ splitmix64(((lane_idx as u64) << 24) | place));
-                let u = (h >> 11) as f64 / (1u64 << 53) as f64;
-                let base_z_m = f64::from(piece.z_m);
-                if u < BIN_SHARE {
-                    out.push(Furniture {
-                        kind: FurnitureKind::Bin,
-                        foot,
-                        base_z_m,
-                        half_m: DVec3::new(0.22, 0.22, 0.45),
-                        rgb: BIN_COLOURS[(splitmix64(h) % BIN_COLOURS.len() as u64) as usize],
-                    });
-                } else if u < BIN_SHARE + BOLLARD_SHARE {
-                    let mid = (BOLLARDS_IN_ROW as f64 - 1.0) * 0.5;
-                    out.extend((0..BOLLARDS_IN_ROW).map(|k| Furniture {
-                        kind: FurnitureKind::Bollard,
-                        foot: foot + along_dir * ((k as f64 - mid) * BOLLARD_SPACING_M),
-                        base_z_m,
-                        half_m: DVec3::new(0.07, 0.07, 0.45),
-                        rgb: [44, 46, 50],
-                    }));
-                }
-            }
-            along += len;
+        let h = splitmix64(clip_seed ^ 0xf00d_5eed ^ splitmix64(((s.lane as u64) << 24) | s.place));
+        let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+        if u < BIN_SHARE {
+            out.push(Furniture {
+                kind: FurnitureKind::Bin,
+                foot,
+                base_z_m: s.z_m,
+                half_m: DVec3::new(0.22, 0.22, 0.45),
+                rgb: BIN_COLOURS[(splitmix64(h) % BIN_COLOURS.len() as u64) as usize],
+            });
+        } else if u < BIN_SHARE + BOLLARD_SHARE {
+            let mid = (BOLLARDS_IN_ROW as f64 - 1.0) * 0.5;
+            out.extend((0..BOLLARDS_IN_ROW).map(|k| Furniture {
+                kind: FurnitureKind::Bollard,
+                foot: foot + s.along * ((k as f64 - mid) * BOLLARD_SPACING_M),
+                base_z_m: s.z_m,
+                half_m: DVec3::new(0.07, 0.07, 0.45),
+                rgb: [44, 46, 50],
+            }));
         }
-    }
+    });
     out.retain(|f| {
         let reach = LAMP_CLEARANCE_M + f.half_m.x.max(f.half_m.y);
         lamps.iter().all(|l| l.foot.distance_squared(f.foot) > 1.5 * 1.5)

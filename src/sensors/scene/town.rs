@@ -239,40 +239,71 @@ pub const LAMP_POLE_HALF_WIDTH_M: f32 = 0.07;
 /// How far the pole rises above the light, metres.
 pub const LAMP_POLE_ABOVE_LIGHT_M: f32 = 0.2;
 
-/// The street lamps of `town` whose foot satisfies `near`: one every [`LAMP_SPACING_M`] along each sidewalk
-/// outside junctions, at the curb (a pure function of the town, so the renderer draws and the annotations
-/// test occlusion against the same poles).
-pub fn street_lamp_posts(town: &RoadNetwork, near: impl Fn(DVec2) -> bool) -> Vec<LampPost> {
-    let mut posts = Vec::new();
-    for lane in &town.lanes {
+/// A place at the curb of a sidewalk, where street lamps and street furniture stand.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CurbStation {
+    /// The sidewalk lane (index into the town's lanes).
+    pub lane: usize,
+    /// The place's number along its lane, from 1.
+    pub place: u64,
+    /// The sidewalk's inner (road-side) edge there, world plan view, metres.
+    pub inner: DVec2,
+    /// Unit direction toward the road.
+    pub to_road: DVec2,
+    /// Unit direction along the sidewalk.
+    pub along: DVec2,
+    /// The sidewalk's width there, metres.
+    pub width_m: f64,
+    /// The sidewalk's height there, metres.
+    pub z_m: f64,
+}
+
+/// Calls `f` at places every `spacing_m` along each sidewalk outside junctions, the first half a spacing from
+/// the sidewalk's start (a pure function of the town).
+pub(super) fn for_each_curb_station(town: &RoadNetwork, spacing_m: f64, mut f: impl FnMut(CurbStation)) {
+    for (lane_idx, lane) in town.lanes.iter().enumerate() {
         if lane.lane_type != LaneType::Sidewalk || lane.in_junction {
             continue;
         }
-        let mut next_m = LAMP_SPACING_M * 0.5;
-        let mut along = 0.0;
+        let (mut next_m, mut along, mut place) = (spacing_m * 0.5, 0.0, 0);
         for piece in &town.pieces[lane.pieces.start as usize..lane.pieces.end as usize] {
             let [c0, c1] = piece.centre();
             let len = c0.distance(c1);
             while along + len >= next_m && len > 1e-6 {
                 let t = (next_m - along) / len;
                 let inner = piece.corners[0].lerp(piece.corners[1], t);
-                let centre = c0.lerp(c1, t);
-                let to_road = (inner - centre).normalize_or_zero();
-                let width = f64::from(piece.width_m[0]);
-                let foot = inner - to_road * (0.35f64).min(0.4 * width);
-                next_m += LAMP_SPACING_M;
-                if !near(foot) || width < 1.0 {
-                    continue;
-                }
-                posts.push(LampPost {
-                    foot,
-                    base_z_m: f64::from(piece.z_m),
-                    to_road,
+                next_m += spacing_m;
+                place += 1;
+                f(CurbStation {
+                    lane: lane_idx,
+                    place,
+                    inner,
+                    to_road: (inner - c0.lerp(c1, t)).normalize_or_zero(),
+                    along: (c1 - c0) / len,
+                    width_m: f64::from(piece.width_m[0]),
+                    z_m: f64::from(piece.z_m),
                 });
             }
             along += len;
         }
     }
+}
+
+/// The street lamps of `town` whose foot satisfies `near`: one every [`LAMP_SPACING_M`] along each sidewalk
+/// outside junctions, at the curb (a pure function of the town, so the renderer draws and the annotations
+/// test occlusion against the same poles).
+pub fn street_lamp_posts(town: &RoadNetwork, near: impl Fn(DVec2) -> bool) -> Vec<LampPost> {
+    let mut posts = Vec::new();
+    for_each_curb_station(town, LAMP_SPACING_M, |s| {
+        let foot = s.inner - s.to_road * (0.35f64).min(0.4 * s.width_m);
+        if near(foot) && s.width_m >= 1.0 {
+            posts.push(LampPost {
+                foot,
+                base_z_m: s.z_m,
+                to_road: s.to_road,
+            });
+        }
+    });
     posts
 }
 
