@@ -1,5 +1,6 @@
 //! Domain randomisation per clip (`domain_randomisation`): the clip's draws from its own seed — the sun's
-//! direction (into the clip's weather) and how its light and camera look ([`ClipLook`]). Pure: no IO.
+//! direction (into the clip's weather) and how its light, camera, scenery and textures look ([`ClipLook`]).
+//! Pure: no IO.
 
 use rand::RngExt;
 
@@ -27,6 +28,11 @@ pub(super) fn randomise(
         light_intensity: draw(r.light_intensity),
         white_balance: [draw(r.white_balance), draw(r.white_balance), draw(r.white_balance)],
         exposure_key: draw(r.exposure_key),
+        // Drawn after the light's and the camera's, so that their draws stay what they were before these keys.
+        scenery_hue_deg: draw(r.scenery_hue_deg),
+        scenery_saturation: draw(r.scenery_saturation),
+        scenery_brightness: draw(r.scenery_brightness),
+        texture_contrast: draw(r.texture_contrast),
     };
     (weather, look)
 }
@@ -47,6 +53,10 @@ mod tests {
             sun_altitude_offset_deg: Range(-5.0, 5.0),
             white_balance: Range(0.8, 1.2),
             exposure_key: Range(0.7, 1.3),
+            scenery_hue_deg: Range(-60.0, 60.0),
+            scenery_saturation: Range(0.5, 1.5),
+            scenery_brightness: Range(0.8, 1.2),
+            texture_contrast: Range(0.0, 2.0),
         };
         let mut looks = Vec::new();
         for seed in 0..50 {
@@ -55,6 +65,10 @@ mod tests {
             assert!((0.5..=1.5).contains(&look.light_intensity));
             assert!(look.white_balance.iter().all(|g| (0.8..=1.2).contains(g)));
             assert!((0.7..=1.3).contains(&look.exposure_key));
+            assert!((-60.0..=60.0).contains(&look.scenery_hue_deg));
+            assert!((0.5..=1.5).contains(&look.scenery_saturation));
+            assert!((0.8..=1.2).contains(&look.scenery_brightness));
+            assert!((0.0..=2.0).contains(&look.texture_contrast));
             assert!((w.sun_altitude_deg - weather.sun_altitude_deg).abs() <= 5.0);
             assert!((0.0..360.0).contains(&w.sun_azimuth_deg));
             looks.push(look.light_intensity);
@@ -62,5 +76,20 @@ mod tests {
         looks.sort_by(f64::total_cmp);
         looks.dedup();
         assert_eq!(looks.len(), 50, "every clip draws its own");
+        // The light's and camera's draws do not move when the scenery's and textures' ranges are added.
+        let light_only = DomainRandomisation {
+            scenery_hue_deg: Range(0.0, 0.0),
+            scenery_saturation: Range(1.0, 1.0),
+            scenery_brightness: Range(1.0, 1.0),
+            texture_contrast: Range(1.0, 1.0),
+            ..on
+        };
+        let (w_all, all) = randomise(&on, weather, 3);
+        let (w_light, light) = randomise(&light_only, weather, 3);
+        assert_eq!(w_all, w_light);
+        assert_eq!(
+            (all.light_intensity, all.white_balance, all.exposure_key),
+            (light.light_intensity, light.white_balance, light.exposure_key)
+        );
     }
 }

@@ -148,8 +148,10 @@ pub struct ClipScript {
     pub look: ClipLook,
 }
 
-/// A clip's draws of `domain_randomisation` for its light and camera (all 1 without it).
+/// A clip's draws of `domain_randomisation` for its light, camera, scenery and textures (the identity without
+/// it; a field missing from a plan file is the identity's).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct ClipLook {
     /// Factor on the sun's and the sky's light.
     pub light_intensity: f64,
@@ -157,6 +159,14 @@ pub struct ClipLook {
     pub white_balance: [f64; 3],
     /// Factor on auto-exposure's key.
     pub exposure_key: f64,
+    /// Degrees the scenery's colours turn round the colour wheel.
+    pub scenery_hue_deg: f64,
+    /// Factor on the scenery's colour saturation.
+    pub scenery_saturation: f64,
+    /// Factor on the scenery's albedo.
+    pub scenery_brightness: f64,
+    /// Factor on the procedural textures' contrast.
+    pub texture_contrast: f64,
 }
 
 impl Default for ClipLook {
@@ -165,6 +175,10 @@ impl Default for ClipLook {
             light_intensity: 1.0,
             white_balance: [1.0; 3],
             exposure_key: 1.0,
+            scenery_hue_deg: 0.0,
+            scenery_saturation: 1.0,
+            scenery_brightness: 1.0,
+            texture_contrast: 1.0,
         }
     }
 }
@@ -173,6 +187,11 @@ impl ClipLook {
     /// Whether the look changes nothing.
     pub fn is_identity(&self) -> bool {
         *self == ClipLook::default()
+    }
+
+    /// Whether the scenery's colours stay as they are.
+    pub fn keeps_scenery_colours(&self) -> bool {
+        self.scenery_hue_deg == 0.0 && self.scenery_saturation == 1.0 && self.scenery_brightness == 1.0
     }
 }
 

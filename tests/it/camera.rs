@@ -330,6 +330,7 @@ pub(crate) fn static_scene(mesh: Mesh) -> StaticScene {
         outfits: Vec::new(),
         riders: Vec::new(),
         car_paint: Vec::new(),
+        texture_contrast: 1.0,
     }
 }
 

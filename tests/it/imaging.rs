@@ -187,6 +187,85 @@ fn domain_randomisation_draws_a_look_per_clip_and_the_images_follow_it() {
     }
 }
 
+/// The pixels of a semantic class whose neighbours within two pixels have it too (away from outlines, where an
+/// antialiased pixel mixes the colours on both sides).
+fn inner_pixels(img: &CameraImages, class: u8) -> Vec<usize> {
+    let (w, h) = (img.width, img.height);
+    (2..h - 2)
+        .flat_map(|y| (2..w - 2).map(move |x| (x, y)))
+        .filter(|&(x, y)| (y - 2..=y + 2).all(|v| (x - 2..=x + 2).all(|u| img.semantic[v * w + u] == class)))
+        .map(|(x, y)| y * w + x)
+        .collect()
+}
+
+#[test]
+fn scenery_colours_and_texture_contrast_change_the_scenery_and_leave_people_and_labels() {
+    use pedsynth::sensors::scene::tag;
+    // A fixed exposure: auto-exposure would meter the recoloured scenery and change every pixel's gain. At
+    // 640 × 360, so that people have pixels away from their outlines.
+    let overrides = [
+        "sensors.rgb.exposure.mode=fixed",
+        "sensors.rgb.width_px=640",
+        "sensors.rgb.height_px=360",
+    ];
+    let mut c = clip(&spec("quickstart.yaml"), &overrides);
+    assert!(c.script.look.is_identity());
+    let frame = c.busy_frames(1)[0];
+    let plain = c.render(frame);
+    c.script.look.scenery_hue_deg = 120.0;
+    c.script.look.scenery_saturation = 1.6;
+    c.script.look.scenery_brightness = 0.8;
+    let recoloured = c.render(frame);
+    assert_eq!(plain.semantic, recoloured.semantic);
+    assert_eq!(plain.instance, recoloured.instance);
+    assert_eq!(plain.depth_m, recoloured.depth_m);
+    let rgb = |img: &CameraImages, i: usize| [img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]];
+    let people = inner_pixels(&plain, tag::PEDESTRIAN);
+    assert!(
+        people.len() > 20,
+        "the frame shows people ({} inner pixels)",
+        people.len()
+    );
+    let moved = people
+        .iter()
+        .filter(|&&i| rgb(&plain, i) != rgb(&recoloured, i))
+        .count();
+    assert_eq!(
+        moved,
+        0,
+        "people keep their colours: {moved} of {} pixels changed",
+        people.len()
+    );
+    let walls = inner_pixels(&plain, tag::BUILDING);
+    let changed = walls.iter().filter(|&&i| rgb(&plain, i) != rgb(&recoloured, i)).count();
+    // Every wall but its windows (dark glass, about a third of a facade, keeps its colour).
+    assert!(
+        changed * 5 > walls.len() * 3,
+        "{changed} of {} wall pixels recoloured",
+        walls.len()
+    );
+    // Texture contrast: 0 flattens the asphalt's mottling, 3 strengthens it (the spread of the road's levels).
+    let spread = |img: &CameraImages| {
+        let levels: Vec<f64> = inner_pixels(img, tag::ROAD)
+            .iter()
+            .map(|&i| f64::from(sensors::camera::luminance(&rgb(img, i))))
+            .collect();
+        let mean = levels.iter().sum::<f64>() / levels.len() as f64;
+        (levels.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / levels.len() as f64).sqrt()
+    };
+    c.script.look = Default::default();
+    c.script.look.texture_contrast = 0.0;
+    let flat = c.render(frame);
+    c.script.look.texture_contrast = 3.0;
+    let rough = c.render(frame);
+    assert_eq!(plain.semantic, flat.semantic);
+    let (s_flat, s_plain, s_rough) = (spread(&flat), spread(&plain), spread(&rough));
+    assert!(
+        s_flat < s_plain && s_plain < s_rough,
+        "road spread {s_flat} < {s_plain} < {s_rough}"
+    );
+}
+
 #[test]
 fn motion_blur_smears_the_rgb_of_its_frame_and_leaves_the_labels() {
     let blur = ["sensors.rgb.motion_blur.shutter_ms=2"];

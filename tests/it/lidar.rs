@@ -55,6 +55,7 @@ fn scene_of(tris: Vec<Tri>) -> StaticScene {
         outfits: Vec::new(),
         riders: Vec::new(),
         car_paint: Vec::new(),
+        texture_contrast: 1.0,
     }
 }
 

@@ -147,12 +147,14 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     let mut gloss = F::ZERO;
     let mut ground = false;
     let mut semantic = [prim.tag; LANES];
+    // Domain randomisation's factor on every texture's amplitude (1: as drawn below).
+    let tex = ctx.scene.texture_contrast;
     match prim.material {
         Material::Road => {
             ground = true;
             let g = F::ONE
-                + F::splat(0.16) * nz.sample_lanes(x * 1.3, y * 1.3)
-                + F::splat(0.08) * nz.sample_lanes(x * 6.1 + 37.0, y * 6.1 + 37.0);
+                + F::splat(0.16 * tex) * nz.sample_lanes(x * 1.3, y * 1.3)
+                + F::splat(0.08 * tex) * nz.sample_lanes(x * 6.1 + 37.0, y * 6.1 + 37.0);
             albedo = albedo.scale(g);
             if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
                 && road_paint_near(
@@ -165,7 +167,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 let (painted, paint, paint_tags) = road_paint_lanes(ctx.scene, piece, x, y);
                 if painted != 0 {
                     // The paint's grain: lane by lane `0.92 + 0.08 · noise(9 p)`.
-                    let f = (F::splat(0.92) + F::splat(0.08) * nz.sample_lanes(x * 9.0, y * 9.0)).to_array();
+                    let f = (F::splat(0.92) + F::splat(0.08 * tex) * nz.sample_lanes(x * 9.0, y * 9.0)).to_array();
                     let mut lanes = albedo.lanes();
                     for i in (0..LANES).filter(|&i| painted & (1 << i) != 0) {
                         lanes[i] = paint[i] * f[i];
@@ -186,21 +188,21 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 let joint = fx.simd_lt(F::splat(0.05)) | fy.simd_lt(F::splat(0.05));
                 let (ixs, iys) = (ix.to_array(), iy.to_array());
                 let cell = lanes_from(|i| nz.cell(ixs[i], iys[i], 7));
-                let tile = F::splat(0.88) + F::splat(0.2) * cell;
+                let tile = F::splat(0.88) + F::splat(0.2 * tex) * cell;
                 albedo = albedo.scale(joint.select(F::splat(0.62), tile));
             }
-            albedo = albedo.scale(grain(nz, x * 3.7, y * 3.7, 0.08));
+            albedo = albedo.scale(grain(nz, x * 3.7, y * 3.7, 0.08 * tex));
         }
         Material::Curb => {
             ground = true;
-            albedo = albedo.scale(grain(nz, x * 4.0 + z, y * 4.0 + z, 0.1));
+            albedo = albedo.scale(grain(nz, x * 4.0 + z, y * 4.0 + z, 0.1 * tex));
         }
         Material::Terrain => {
             ground = true;
             let patch = nz.sample_lanes(x * 0.21, y * 0.21);
-            let s = (F::splat(0.5) + F::splat(0.6) * patch).max(F::ZERO).min(one);
+            let s = (F::splat(0.5) + F::splat(0.6 * tex) * patch).max(F::ZERO).min(one);
             albedo = V3::lerp(prim.albedo, Vec3::new(0.11, 0.09, 0.05), s);
-            albedo = albedo.scale(grain(nz, x * 2.9, y * 2.9, 0.2));
+            albedo = albedo.scale(grain(nz, x * 2.9, y * 2.9, 0.2 * tex));
         }
         Material::Wall => {
             let n = prim.normal;
@@ -221,7 +223,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 & fz.simd_lt(F::splat(0.82))
                 & z.simd_gt(F::splat(1.2))
                 & !ground_floor;
-            let plain = albedo.scale(grain(nz, a * 4.0, z * 2.0, 0.07));
+            let plain = albedo.scale(grain(nz, a * 4.0, z * 2.0, 0.07 * tex));
             let floor_line = fz.simd_lt(F::splat(0.04));
             let wall = V3::select(floor_line, albedo.scale(F::splat(0.7)), plain);
             albedo = V3::select(window, V3::splat(Vec3::new(0.03, 0.035, 0.045)), wall);
@@ -234,10 +236,10 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 & fz.simd_lt(F::splat(0.7));
             if shop {
                 let sign = ground_floor & fz.simd_gt(F::splat(0.76)) & fz.simd_lt(F::splat(0.95));
-                let sign_colour = V3::splat(prim.albedo2).scale(grain(nz, a * 7.0, z * 5.0, 0.12));
+                let sign_colour = V3::splat(prim.albedo2).scale(grain(nz, a * 7.0, z * 5.0, 0.12 * tex));
                 albedo = V3::select(sign, sign_colour, albedo);
                 // Goods behind the glass: dim, mottled colours.
-                let goods = F::splat(0.05) + F::splat(0.03) * nz.sample_lanes(a * 9.0, z * 3.0);
+                let goods = F::splat(0.05) + F::splat(0.03 * tex) * nz.sample_lanes(a * 9.0, z * 3.0);
                 let glass = V3 {
                     x: goods,
                     y: goods * F::splat(0.95),
@@ -270,9 +272,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         }
         Material::Roof | Material::Metal | Material::Tyre => {}
         Material::LampHead => emissive = V3::splat(Vec3::new(3.0, 2.5, 1.8) * l.night),
-        Material::Trunk => albedo = albedo.scale(grain(nz, x * 9.0, z * 3.0, 0.2)),
+        Material::Trunk => albedo = albedo.scale(grain(nz, x * 9.0, z * 3.0, 0.2 * tex)),
         Material::Foliage => {
-            let f = F::splat(0.8) + F::splat(0.45) * nz.sample_lanes(x * 2.2 + z, y * 2.2 - z);
+            let f = F::splat(0.8) + F::splat(0.45 * tex) * nz.sample_lanes(x * 2.2 + z, y * 2.2 - z);
             albedo = albedo.scale(f);
         }
         Material::CarPaint => gloss = F::splat(0.18),
@@ -295,7 +297,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 let n_dot_v = -normal.dot(pts.ray) / pts.ray_len.max(F::splat(1.0e-6));
                 albedo = albedo.scale(F::splat(0.6) + F::splat(0.4) * n_dot_v.max(F::ZERO));
             }
-            albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06));
+            albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06 * tex));
         }
     }
     if ground && l.wet > 0.0 {
@@ -553,6 +555,7 @@ mod tests {
             outfits: Vec::new(),
             riders: Vec::new(),
             car_paint: Vec::new(),
+            texture_contrast: 1.0,
         };
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         let (mut lanes_painted, mut crosswalk_painted) = (0, 0);

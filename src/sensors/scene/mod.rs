@@ -17,6 +17,7 @@
 mod frame;
 mod furniture;
 mod paint;
+mod recolour;
 mod town;
 
 use std::collections::BTreeMap;
@@ -35,6 +36,7 @@ use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDir
 pub use frame::*;
 pub use furniture::*;
 pub use paint::*;
+pub use recolour::*;
 pub use town::*;
 
 /// CARLA's semantic tags (CARLA 0.9.14+, `carla.CityObjectLabel`), as written in the `semantic` stream.

@@ -94,6 +94,8 @@ pub struct StaticScene {
     pub riders: Vec<(Outfit, Vec3)>,
     /// Each traffic vehicle's paint (linear RGB), by vehicle index.
     pub car_paint: Vec<Vec3>,
+    /// Factor on the procedural textures' contrast (the clip's `look`; 1 without domain randomisation).
+    pub texture_contrast: f32,
 }
 
 /// What a body wears: the material and colour of each capsule (see [`body::pose`]'s order), and its hair.
@@ -678,7 +680,7 @@ impl StaticScene {
         }
         close_cluster(&b, &mut clusters, &mut cluster_start);
 
-        StaticScene {
+        let mut scene = StaticScene {
             origin,
             tris: b.mesh.tris,
             clusters,
@@ -720,7 +722,12 @@ impl StaticScene {
                     }
                 })
                 .collect(),
+            texture_contrast: script.look.texture_contrast as f32,
+        };
+        if let Some(colours) = SceneryColours::of(&script.look) {
+            colours.apply(&mut scene.prims, &mut scene.car_paint);
         }
+        scene
     }
 
     /// The scene-relative position of a world point.

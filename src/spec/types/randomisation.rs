@@ -1,6 +1,6 @@
 //! `domain_randomisation`: ranges from which each clip draws how it looks — the light's strength and the sun's
-//! direction, the camera's colour balance and exposure — from its own seed. Off (every range a single value
-//! that changes nothing) by default.
+//! direction, the camera's colour balance and exposure, the scenery's colours and the textures' contrast — from
+//! its own seed. Off (every range a single value that changes nothing) by default.
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -24,6 +24,16 @@ pub struct DomainRandomisation {
     pub white_balance: Range,
     /// Factor on auto-exposure's `key` (how bright the camera exposes), `[1, 1]` by default.
     pub exposure_key: Range,
+    /// Degrees the scenery's colours (buildings, shop signs, ground, trees, street furniture, cars' paint; not
+    /// people, road markings or lights) turn round the colour wheel, `[0, 0]` by default.
+    pub scenery_hue_deg: Range,
+    /// Factor on the scenery's colour saturation (0: grey), `[1, 1]` by default.
+    pub scenery_saturation: Range,
+    /// Factor on the scenery's brightness (its albedo), `[1, 1]` by default.
+    pub scenery_brightness: Range,
+    /// Factor on the contrast of every procedural texture (asphalt, tiles, walls, grass, bark, foliage,
+    /// clothes' weave; 0: flat colours), `[1, 1]` by default.
+    pub texture_contrast: Range,
 }
 
 impl Default for DomainRandomisation {
@@ -34,6 +44,10 @@ impl Default for DomainRandomisation {
             sun_altitude_offset_deg: Range(0.0, 0.0),
             white_balance: Range(1.0, 1.0),
             exposure_key: Range(1.0, 1.0),
+            scenery_hue_deg: Range(0.0, 0.0),
+            scenery_saturation: Range(1.0, 1.0),
+            scenery_brightness: Range(1.0, 1.0),
+            texture_contrast: Range(1.0, 1.0),
         }
     }
 }

@@ -158,6 +158,34 @@ impl Validator<'_> {
             20.0,
             "a factor on auto-exposure's key",
         );
+        self.range(
+            &format!("{base}.scenery_hue_deg"),
+            d.scenery_hue_deg,
+            -180.0,
+            180.0,
+            "an angle in degrees round the colour wheel",
+        );
+        self.range(
+            &format!("{base}.scenery_saturation"),
+            d.scenery_saturation,
+            0.0,
+            5.0,
+            "a factor on colour saturation (0: grey)",
+        );
+        self.range(
+            &format!("{base}.scenery_brightness"),
+            d.scenery_brightness,
+            0.05,
+            5.0,
+            "a factor on the scenery's albedo",
+        );
+        self.range(
+            &format!("{base}.texture_contrast"),
+            d.texture_contrast,
+            0.0,
+            5.0,
+            "a factor on the textures' contrast (0: flat colours)",
+        );
     }
 
     /// `sensors.rgb`'s exposure, vignetting, noise and motion blur.
