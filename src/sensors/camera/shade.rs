@@ -130,6 +130,36 @@ fn grain(nz: &Noise, qx: F, qy: F, amp: f32) -> F {
     F::ONE + F::splat(amp) * nz.sample_lanes(qx, qy)
 }
 
+/// Road wear at the lanes' road points: repair patches (darker, newer asphalt: a 3 × 2 m rectangle in one cell
+/// of a 7 × 5 m grid in five or so, drawn from the clip's noise table) and cracks (thin dark lines along the zero
+/// crossings of a noise of 2 m cells, fading out beyond 25 m, where they would be thinner than a pixel and
+/// only flicker); `tex` is domain randomisation's texture contrast. A factor on the albedo.
+#[inline(always)]
+fn road_wear(nz: &Noise, x: F, y: F, ray_len: F, tex: f32) -> F {
+    let (gx, gy) = (x * (1.0 / 7.0), y * (1.0 / 5.0));
+    let (ix, iy) = (floor_int(gx), floor_int(gy));
+    let (cx, cy) = (ix.round_float(), iy.round_float());
+    let (fx, fy) = (gx - cx, gy - cy);
+    let inside = fx.simd_gt(F::splat(0.2))
+        & fx.simd_lt(F::splat(0.63))
+        & fy.simd_gt(F::splat(0.25))
+        & fy.simd_lt(F::splat(0.65));
+    let mut wear = F::ONE;
+    if inside.any() {
+        // The noise table's value at the cell's corner (a sample at integer coordinates), in [-1, 1).
+        let patched = nz.sample_lanes(cx, cy + 91.0).simd_gt(F::splat(0.6));
+        wear = (patched & inside).select(F::splat(1.0 - 0.2 * tex), F::ONE);
+    }
+    let near = (F::ONE - ray_len * (1.0 / 25.0)).max(F::ZERO);
+    if near.simd_gt(F::ZERO).any() {
+        let c = nz.sample_lanes(x * 0.5 + 11.0, y * 0.5 - 5.0).abs();
+        wear *= c
+            .simd_lt(F::splat(0.016))
+            .select(F::ONE - F::splat((0.45 * tex).min(1.0)) * near, F::ONE);
+    }
+    wear
+}
+
 /// The shaded colours of the lanes' points of one primitive, before fog, and their semantic tags (road paint
 /// turns road into road line): textures, then the light each point receives (sun with shadows, sky and
 /// ground ambient, street lamps, headlights) and reflections where the surface is glossy.
@@ -155,7 +185,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             let g = F::ONE
                 + F::splat(0.16 * tex) * nz.sample_lanes(x * 1.3, y * 1.3)
                 + F::splat(0.08 * tex) * nz.sample_lanes(x * 6.1 + 37.0, y * 6.1 + 37.0);
-            albedo = albedo.scale(g);
+            albedo = albedo.scale(road_wear(nz, x, y, pts.ray_len, tex) * g);
             if let Some(piece) = ctx.scene.pieces.get(prim.aux as usize)
                 && road_paint_near(
                     ctx.scene,
