@@ -26,6 +26,7 @@ mod plan_file;
 mod planner;
 mod realise;
 mod report;
+mod scenery;
 mod shard;
 mod signals;
 mod sim_determinism;

@@ -1,5 +1,5 @@
-//! Street furniture: litter bins and rows of bollards at the curb of sidewalks outside junctions, drawn per clip
-//! from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace (nothing is
+//! Street furniture: litter bins, rows of bollards and traffic signs at the curb of sidewalks outside junctions,
+//! drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace (nothing is
 //! placed where a pedestrian of the clip walks: the simulation does not steer around furniture), so the
 //! renderer draws, the LiDAR sees and the annotations test occlusion against the same boxes.
 
@@ -17,6 +17,11 @@ pub enum FurnitureKind {
     Bin,
     /// A bollard (0.14 m square, 0.9 m tall, a light band near its top).
     Bollard,
+    /// A traffic sign's post (7 cm square, 2.4 m tall; semantic `Pole`).
+    SignPost,
+    /// A traffic sign's plate (0.6 m square, 4 cm thick, facing along the road, its bottom 1.8 m above the
+    /// sidewalk; semantic `TrafficSign`) in one of [`SIGN_COLOURS`], on a face of the post before it in the list.
+    SignPlate,
 }
 
 /// One piece of street furniture: an upright, axis-aligned box standing on the sidewalk.
@@ -26,7 +31,7 @@ pub struct Furniture {
     pub kind: FurnitureKind,
     /// Centre of its footprint, world plan view, metres.
     pub foot: DVec2,
-    /// Height of the sidewalk at its foot, metres.
+    /// Height of its bottom: the sidewalk's at its foot (a sign's plate: 1.8 m above it), metres.
     pub base_z_m: f64,
     /// Half its extents along x and y (world axes) and half its height, metres.
     pub half_m: DVec3,
@@ -46,6 +51,16 @@ const SPACING_M: f64 = 9.0;
 /// Share of candidate places with a bin, and with a row of bollards.
 const BIN_SHARE: f64 = 0.16;
 const BOLLARD_SHARE: f64 = 0.10;
+/// Share of candidate places with a traffic sign (drawn after the bins' and bollards' shares, so that adding signs
+/// left those where they were).
+const SIGN_SHARE: f64 = 0.07;
+/// A sign's post height, and its plate's half side and height of its bottom above the sidewalk, metres.
+const SIGN_POST_M: f64 = 2.4;
+const SIGN_POST_HALF_M: f64 = 0.035;
+const SIGN_PLATE_HALF_M: f64 = 0.3;
+const SIGN_PLATE_BOTTOM_M: f64 = 1.8;
+/// Sign plate colours (sRGB): information blue, prohibition red, warning yellow, white.
+pub const SIGN_COLOURS: [[u8; 3]; 4] = [[28, 74, 160], [182, 30, 32], [236, 190, 34], [226, 226, 220]];
 /// Bollards in a row, and their spacing along the curb, metres.
 const BOLLARDS_IN_ROW: usize = 3;
 const BOLLARD_SPACING_M: f64 = 1.5;
@@ -55,7 +70,7 @@ const FROM_CURB_M: f64 = 0.4;
 pub const BIN_COLOURS: [[u8; 3]; 5] = [[34, 64, 40], [26, 26, 28], [98, 102, 104], [30, 56, 110], [96, 40, 30]];
 
 /// The street furniture of a clip: candidate places every [`SPACING_M`] along each sidewalk outside junctions
-/// within [`scene_bounds`], each holding a bin or a row of bollards with the shares above (drawn from the clip's
+/// within [`scene_bounds`], each holding a bin, a row of bollards or a sign with the shares above (drawn from the clip's
 /// seed, the lane and the place), leaving out any piece within 1.5 m of a lamp post or within
 /// [`LAMP_CLEARANCE_M`] (plus its half width) of a pedestrian of the clip in any frame.
 pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lamps: &[LampPost]) -> Vec<Furniture> {
@@ -86,10 +101,44 @@ pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lam
                 half_m: DVec3::new(0.07, 0.07, 0.45),
                 rgb: [44, 46, 50],
             }));
+        } else if u < BIN_SHARE + BOLLARD_SHARE + SIGN_SHARE {
+            out.push(Furniture {
+                kind: FurnitureKind::SignPost,
+                foot,
+                base_z_m: s.z_m,
+                half_m: DVec3::new(SIGN_POST_HALF_M, SIGN_POST_HALF_M, SIGN_POST_M * 0.5),
+                rgb: [120, 122, 124],
+            });
+            // The plate faces along the road: thin along the world axis nearer the sidewalk's direction, and
+            // mounted on the post's face towards `-along` (the post shows behind it from the other side).
+            let (thin, wide) = (0.02, SIGN_PLATE_HALF_M);
+            let (half_m, face) = if s.along.x.abs() >= s.along.y.abs() {
+                (
+                    DVec3::new(thin, wide, SIGN_PLATE_HALF_M),
+                    DVec2::new(-s.along.x.signum(), 0.0),
+                )
+            } else {
+                (
+                    DVec3::new(wide, thin, SIGN_PLATE_HALF_M),
+                    DVec2::new(0.0, -s.along.y.signum()),
+                )
+            };
+            out.push(Furniture {
+                kind: FurnitureKind::SignPlate,
+                foot: foot + face * (SIGN_POST_HALF_M + thin + 0.005),
+                base_z_m: s.z_m + SIGN_PLATE_BOTTOM_M,
+                half_m,
+                rgb: SIGN_COLOURS[(splitmix64(h) % SIGN_COLOURS.len() as u64) as usize],
+            });
         }
     });
     out.retain(|f| {
-        let reach = LAMP_CLEARANCE_M + f.half_m.x.max(f.half_m.y);
+        // A sign's post and plate go or stay together: both keep the plate's clearance.
+        let half_width_m = match f.kind {
+            FurnitureKind::SignPost | FurnitureKind::SignPlate => SIGN_PLATE_HALF_M,
+            FurnitureKind::Bin | FurnitureKind::Bollard => f.half_m.x.max(f.half_m.y),
+        };
+        let reach = LAMP_CLEARANCE_M + half_width_m;
         lamps.iter().all(|l| l.foot.distance_squared(f.foot) > 1.5 * 1.5)
             && trace
                 .pedestrians

@@ -53,6 +53,8 @@ pub mod tag {
     pub const POLE: u8 = 6;
     /// Traffic light heads.
     pub const TRAFFIC_LIGHT: u8 = 7;
+    /// Traffic signs' plates.
+    pub const TRAFFIC_SIGN: u8 = 8;
     /// Trees.
     pub const VEGETATION: u8 = 9;
     /// Grass and soil beside the roads.

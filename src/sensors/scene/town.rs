@@ -621,7 +621,7 @@ impl StaticScene {
             close_cluster(&b, &mut clusters, &mut cluster_start);
         }
 
-        // Street furniture (bins, rows of bollards) at the curb, per clip.
+        // Street furniture (bins, rows of bollards, signs) at the curb, per clip.
         for item in clip_furniture(trace, town, seed, &posts) {
             let c = (item.foot - origin.truncate()).as_vec2();
             let half = item.half_m.truncate().as_vec2();
@@ -632,6 +632,14 @@ impl StaticScene {
                 FurnitureKind::Bin => {
                     let lid = flat(Material::Metal, tag::STATIC, linear(item.rgb) * 0.6, Vec3::Z, 0);
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, lid);
+                }
+                FurnitureKind::SignPost => {
+                    let post = flat(Material::Metal, tag::POLE, linear(item.rgb), Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top], post, post);
+                }
+                FurnitureKind::SignPlate => {
+                    let plate = flat(Material::Metal, tag::TRAFFIC_SIGN, linear(item.rgb), Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top], plate, plate);
                 }
                 FurnitureKind::Bollard => {
                     // Dark, with a light reflective band 0.1 m below its top.
