@@ -1,11 +1,11 @@
 //! Street furniture: litter bins, rows of bollards and traffic signs at the curb of sidewalks outside junctions,
-//! drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace (nothing is
-//! placed where a pedestrian of the clip walks: the simulation does not steer around furniture), so the
-//! renderer draws, the LiDAR sees and the annotations test occlusion against the same boxes.
+//! drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace
+//! (nothing is placed where a pedestrian of the clip walks: the simulation does not steer around furniture), so
+//! the renderer draws, the LiDAR sees and the annotations test occlusion against the same boxes.
 
 use glam::{DVec2, DVec3};
 
-use super::{LAMP_CLEARANCE_M, LampPost, for_each_curb_station, scene_bounds};
+use super::{LAMP_CLEARANCE_M, LampPost, for_each_curb_station, scene_bounds, tag};
 use crate::sim::trace::ClipTrace;
 use crate::util::mix::splitmix64;
 use crate::world::RoadNetwork;
@@ -24,7 +24,19 @@ pub enum FurnitureKind {
     SignPlate,
 }
 
-/// One piece of street furniture: an upright, axis-aligned box standing on the sidewalk.
+impl FurnitureKind {
+    /// CARLA's semantic tag of its pixels (a bin's lid and a bollard's band are tagged alike).
+    pub fn semantic_tag(self) -> u8 {
+        match self {
+            FurnitureKind::Bin | FurnitureKind::Bollard => tag::STATIC,
+            FurnitureKind::SignPost => tag::POLE,
+            FurnitureKind::SignPlate => tag::TRAFFIC_SIGN,
+        }
+    }
+}
+
+/// One piece of street furniture: an upright, axis-aligned box standing on the sidewalk (a sign's plate too: on a
+/// diagonal street it faces along the world axis nearer the street's direction).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Furniture {
     /// What it is.
@@ -70,8 +82,8 @@ const FROM_CURB_M: f64 = 0.4;
 pub const BIN_COLOURS: [[u8; 3]; 5] = [[34, 64, 40], [26, 26, 28], [98, 102, 104], [30, 56, 110], [96, 40, 30]];
 
 /// The street furniture of a clip: candidate places every [`SPACING_M`] along each sidewalk outside junctions
-/// within [`scene_bounds`], each holding a bin, a row of bollards or a sign with the shares above (drawn from the clip's
-/// seed, the lane and the place), leaving out any piece within 1.5 m of a lamp post or within
+/// within [`scene_bounds`], each holding a bin, a row of bollards or a sign with the shares above (drawn from the
+/// clip's seed, the lane and the place), leaving out any piece within 1.5 m of a lamp post or within
 /// [`LAMP_CLEARANCE_M`] (plus its half width) of a pedestrian of the clip in any frame.
 pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lamps: &[LampPost]) -> Vec<Furniture> {
     let (lo, hi) = scene_bounds(trace);

@@ -627,19 +627,14 @@ impl StaticScene {
             let half = item.half_m.truncate().as_vec2();
             let base = (item.base_z_m - origin.z) as f32;
             let top = base + 2.0 * item.half_m.z as f32;
-            let body = flat(Material::Metal, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+            let body = flat(Material::Metal, item.kind.semantic_tag(), linear(item.rgb), Vec3::Z, 0);
             match item.kind {
                 FurnitureKind::Bin => {
                     let lid = flat(Material::Metal, tag::STATIC, linear(item.rgb) * 0.6, Vec3::Z, 0);
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, lid);
                 }
-                FurnitureKind::SignPost => {
-                    let post = flat(Material::Metal, tag::POLE, linear(item.rgb), Vec3::Z, 0);
-                    b.mesh.upright_box(c, 0.0, half, [base, top], post, post);
-                }
-                FurnitureKind::SignPlate => {
-                    let plate = flat(Material::Metal, tag::TRAFFIC_SIGN, linear(item.rgb), Vec3::Z, 0);
-                    b.mesh.upright_box(c, 0.0, half, [base, top], plate, plate);
+                FurnitureKind::SignPost | FurnitureKind::SignPlate => {
+                    b.mesh.upright_box(c, 0.0, half, [base, top], body, body);
                 }
                 FurnitureKind::Bollard => {
                     // Dark, with a light reflective band 0.1 m below its top.
