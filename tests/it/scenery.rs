@@ -150,3 +150,100 @@ fn traffic_signs_stand_where_the_furniture_list_puts_them() {
     }
     assert!(plates_seen >= 3, "only {plates_seen} sign plates checked in view");
 }
+
+#[test]
+fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
+    use scene::{FurnitureKind, tag};
+    let overrides = [
+        "sensors.rgb.width_px=640",
+        "sensors.rgb.height_px=360",
+        "dataset.clips={count: 4, per: weather}",
+    ];
+    let is_shelter = |f: &&scene::Furniture| {
+        matches!(
+            f.kind,
+            FurnitureKind::ShelterFrame | FurnitureKind::ShelterGlass | FurnitureKind::ShelterPoster
+        )
+    };
+    let (mut shelters, mut seen) = (0, 0);
+    for index in 0..4 {
+        let c = clip_at(&spec("quickstart.yaml"), &overrides, index);
+        let net = &c.towns[&c.script.town].network;
+        let posts = scene::clip_lamp_posts(&c.trace, net);
+        let furniture = scene::clip_furniture(&c.trace, net, c.script.seed, &posts);
+        let walls: Vec<&scene::Furniture> = furniture
+            .iter()
+            .filter(|f| f.kind == FurnitureKind::ShelterGlass)
+            .collect();
+        shelters += walls.len();
+        // Six parts per shelter (roof, two posts, glass, bench, poster), each within 2 m (plan view) of its
+        // wall and standing on the sidewalk's surface or above it, none higher than the roof's top at 2.4 m.
+        assert_eq!(furniture.iter().filter(is_shelter).count(), 6 * walls.len());
+        for part in furniture.iter().filter(is_shelter) {
+            let wall = walls
+                .iter()
+                .min_by(|a, b| a.foot.distance(part.foot).total_cmp(&b.foot.distance(part.foot)))
+                .expect("a wall");
+            assert!(part.foot.distance(wall.foot) < 2.0, "{part:?} away from {wall:?}");
+            assert!(part.base_z_m >= wall.base_z_m - 0.1 - 1e-9);
+            assert!(part.base_z_m + 2.0 * part.half_m.z <= wall.base_z_m - 0.1 + 2.4 + 1e-9);
+            // Nothing of a shelter stands on the road: its footprint's corners lie on a sidewalk.
+            for (sx, sy) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+                let corner = part.foot + glam::DVec2::new(sx * part.half_m.x, sy * part.half_m.y) * 0.99;
+                let lane = net.lane_at(corner).map(|hit| hit.lane_type);
+                assert_eq!(
+                    lane,
+                    Some(pedsynth::world::LaneType::Sidewalk),
+                    "{part:?}: corner {corner} on {lane:?}"
+                );
+            }
+        }
+        // Where a point of a wall (its middle, and 1.3 m to each side at the same height) or a poster's centre is
+        // 3–25 m ahead and in the image, its pixel is Static unless something more than 2 m nearer covers it
+        // (seen along the road, a shelter's own poster end and posts may come first); some points are seen
+        // directly.
+        let posters: Vec<&scene::Furniture> = furniture
+            .iter()
+            .filter(|f| f.kind == FurnitureKind::ShelterPoster)
+            .collect();
+        let mut probes = Vec::new();
+        for wall in &walls {
+            let side = if wall.half_m.x > wall.half_m.y {
+                glam::DVec3::X
+            } else {
+                glam::DVec3::Y
+            };
+            probes.extend([-1.3, 0.0, 1.3].map(|offset_m| (wall.centre() + side * offset_m, wall.foot)));
+        }
+        probes.extend(posters.iter().map(|p| (p.centre(), p.foot)));
+        for frame in (0..c.trace.frame_count as usize).step_by(5) {
+            let ego = c.trace.ego[frame];
+            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+            let eye = cam.centre.truncate();
+            let img = c.render(frame as u32);
+            for &(point, foot) in &probes {
+                let at = cam.project(point);
+                if !(3.0..25.0).contains(&foot.distance(eye)) || at.depth_m <= 0.0 || !cam.in_image(at.px) {
+                    continue;
+                }
+                let i = at.px.y as usize * img.width + at.px.x as usize;
+                let nearer_m = at.depth_m as f32 - img.depth_m[i];
+                if nearer_m > 2.0 {
+                    continue;
+                }
+                assert_eq!(
+                    img.semantic[i],
+                    tag::STATIC,
+                    "clip {index} frame {frame}: {point} at {:?}",
+                    at.px
+                );
+                seen += usize::from(nearer_m.abs() < 0.1);
+            }
+        }
+    }
+    eprintln!("{shelters} shelters, {seen} of their points seen directly");
+    assert!(
+        shelters >= 2 && seen >= 3,
+        "{shelters} shelters, {seen} of their points seen directly"
+    );
+}

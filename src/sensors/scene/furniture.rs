@@ -1,4 +1,5 @@
-//! Street furniture: litter bins, rows of bollards and traffic signs at the curb of sidewalks outside junctions,
+//! Street furniture: litter bins, rows of bollards, traffic signs and bus shelters at the curb of sidewalks outside
+//! junctions,
 //! drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace
 //! (nothing is placed where a pedestrian of the clip walks: the simulation does not steer around furniture), so
 //! the renderer draws, the LiDAR sees and the annotations test occlusion against the same boxes.
@@ -22,13 +23,24 @@ pub enum FurnitureKind {
     /// A traffic sign's plate (0.6 m square, 4 cm thick, facing along the road, its bottom 1.8 m above the
     /// sidewalk; semantic `TrafficSign`) in one of [`SIGN_COLOURS`], on a face of the post before it in the list.
     SignPlate,
+    /// A bus shelter's frame: its roof, front posts and bench (grey metal; semantic `Static`).
+    ShelterFrame,
+    /// A bus shelter's back wall of tinted glass, along the road (semantic `Static`; opaque to cameras, LiDAR and
+    /// the occlusion labels alike).
+    ShelterGlass,
+    /// The poster at one end of a bus shelter, in one of [`POSTER_COLOURS`] (semantic `Static`).
+    ShelterPoster,
 }
 
 impl FurnitureKind {
     /// CARLA's semantic tag of its pixels (a bin's lid and a bollard's band are tagged alike).
     pub fn semantic_tag(self) -> u8 {
         match self {
-            FurnitureKind::Bin | FurnitureKind::Bollard => tag::STATIC,
+            FurnitureKind::Bin
+            | FurnitureKind::Bollard
+            | FurnitureKind::ShelterFrame
+            | FurnitureKind::ShelterGlass
+            | FurnitureKind::ShelterPoster => tag::STATIC,
             FurnitureKind::SignPost => tag::POLE,
             FurnitureKind::SignPlate => tag::TRAFFIC_SIGN,
         }
@@ -73,6 +85,18 @@ const SIGN_PLATE_HALF_M: f64 = 0.3;
 const SIGN_PLATE_BOTTOM_M: f64 = 1.8;
 /// Sign plate colours (sRGB): information blue, prohibition red, warning yellow, white.
 pub const SIGN_COLOURS: [[u8; 3]; 4] = [[28, 74, 160], [182, 30, 32], [236, 190, 34], [226, 226, 220]];
+/// Share of candidate places with a bus shelter (drawn after the signs' share), where the sidewalk is at least
+/// [`SHELTER_MIN_SIDEWALK_M`] wide.
+const SHELTER_SHARE: f64 = 0.04;
+const SHELTER_MIN_SIDEWALK_M: f64 = 2.4;
+/// A bus shelter's half length (along the road) and half depth, its height, and the gap between its open front
+/// and the curb, metres.
+const SHELTER_HALF_LENGTH_M: f64 = 1.5;
+const SHELTER_HALF_DEPTH_M: f64 = 0.6;
+const SHELTER_HEIGHT_M: f64 = 2.4;
+const SHELTER_FROM_CURB_M: f64 = 0.5;
+/// Poster colours (sRGB): a bright white-blue, warm orange, green, magenta.
+pub const POSTER_COLOURS: [[u8; 3]; 4] = [[214, 226, 240], [236, 150, 60], [90, 176, 96], [200, 70, 150]];
 /// Bollards in a row, and their spacing along the curb, metres.
 const BOLLARDS_IN_ROW: usize = 3;
 const BOLLARD_SPACING_M: f64 = 1.5;
@@ -142,13 +166,31 @@ pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lam
                 half_m,
                 rgb: SIGN_COLOURS[(splitmix64(h) % SIGN_COLOURS.len() as u64) as usize],
             });
+        } else if u < BIN_SHARE + BOLLARD_SHARE + SIGN_SHARE + SHELTER_SHARE && s.width_m >= SHELTER_MIN_SIDEWALK_M {
+            let centre = s.inner - s.to_road * (SHELTER_FROM_CURB_M + SHELTER_HALF_DEPTH_M);
+            // Clear of the lamps and of the clip's pedestrians as a whole (the parts go or stay together).
+            let reach = LAMP_CLEARANCE_M + SHELTER_HALF_LENGTH_M;
+            let clear = lamps
+                .iter()
+                .all(|l| l.foot.distance_squared(centre) > (1.5 + SHELTER_HALF_LENGTH_M).powi(2))
+                && trace
+                    .pedestrians
+                    .iter()
+                    .flatten()
+                    .all(|p| p.pos.truncate().distance_squared(centre) > reach * reach);
+            if clear {
+                let poster = POSTER_COLOURS[(splitmix64(h) % POSTER_COLOURS.len() as u64) as usize];
+                shelter(&mut out, centre, s.z_m, s.along, s.to_road, poster);
+            }
         }
     });
     out.retain(|f| {
-        // A sign's post and plate go or stay together: both keep the plate's clearance.
+        // A sign's post and plate go or stay together: both keep the plate's clearance. A shelter was placed
+        // clear.
         let half_width_m = match f.kind {
             FurnitureKind::SignPost | FurnitureKind::SignPlate => SIGN_PLATE_HALF_M,
             FurnitureKind::Bin | FurnitureKind::Bollard => f.half_m.x.max(f.half_m.y),
+            FurnitureKind::ShelterFrame | FurnitureKind::ShelterGlass | FurnitureKind::ShelterPoster => return true,
         };
         let reach = LAMP_CLEARANCE_M + half_width_m;
         lamps.iter().all(|l| l.foot.distance_squared(f.foot) > 1.5 * 1.5)
@@ -159,4 +201,74 @@ pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lam
                 .all(|p| p.pos.truncate().distance_squared(f.foot) > reach * reach)
     });
     out
+}
+
+/// Pushes the parts of a bus shelter centred (plan view) at `centre` on a sidewalk at height `z_m`, its length along
+/// the world axis nearer `along` and its open front towards `to_road`: a roof, two front posts, a glass back wall,
+/// a bench against it and a poster closing the end towards `+along`.
+fn shelter(out: &mut Vec<Furniture>, centre: DVec2, z_m: f64, along: DVec2, to_road: DVec2, poster: [u8; 3]) {
+    // Axis-aligned like every piece: the length runs along x or y, the depth along the other.
+    let along_x = along.x.abs() >= along.y.abs();
+    let (ax, ay) = if along_x {
+        (DVec2::new(along.x.signum(), 0.0), DVec2::new(0.0, to_road.y.signum()))
+    } else {
+        (DVec2::new(0.0, along.y.signum()), DVec2::new(to_road.x.signum(), 0.0))
+    };
+    // A box's half extents in world axes from its half length (along the road), half depth and half height.
+    let half = |length: f64, depth: f64, height: f64| {
+        if along_x {
+            DVec3::new(length, depth, height)
+        } else {
+            DVec3::new(depth, length, height)
+        }
+    };
+    let (l, d, top) = (SHELTER_HALF_LENGTH_M, SHELTER_HALF_DEPTH_M, SHELTER_HEIGHT_M);
+    let frame = [150, 154, 158];
+    let mut part = |kind, foot: DVec2, base_m: f64, half_m: DVec3, rgb| {
+        out.push(Furniture {
+            kind,
+            foot,
+            base_z_m: z_m + base_m,
+            half_m,
+            rgb,
+        })
+    };
+    part(
+        FurnitureKind::ShelterFrame,
+        centre,
+        top - 0.08,
+        half(l + 0.05, d + 0.05, 0.04),
+        frame,
+    );
+    for end in [-1.0, 1.0] {
+        let foot = centre + ax * (end * (l - 0.04)) + ay * (d - 0.04);
+        part(
+            FurnitureKind::ShelterFrame,
+            foot,
+            0.0,
+            half(0.035, 0.035, (top - 0.08) * 0.5),
+            frame,
+        );
+    }
+    part(
+        FurnitureKind::ShelterGlass,
+        centre - ay * (d - 0.02),
+        0.1,
+        half(l - 0.05, 0.02, (top - 0.2) * 0.5),
+        [52, 62, 70],
+    );
+    part(
+        FurnitureKind::ShelterFrame,
+        centre - ay * (d - 0.25),
+        0.0,
+        half(l * 0.6, 0.2, 0.23),
+        frame,
+    );
+    part(
+        FurnitureKind::ShelterPoster,
+        centre + ax * (l - 0.03) - ay * 0.1,
+        0.3,
+        half(0.03, d - 0.15, 0.8),
+        poster,
+    );
 }

@@ -621,7 +621,7 @@ impl StaticScene {
             close_cluster(&b, &mut clusters, &mut cluster_start);
         }
 
-        // Street furniture (bins, rows of bollards, signs) at the curb, per clip.
+        // Street furniture (bins, rows of bollards, signs, bus shelters) at the curb, per clip.
         for item in clip_furniture(trace, town, seed, &posts) {
             let c = (item.foot - origin.truncate()).as_vec2();
             let half = item.half_m.truncate().as_vec2();
@@ -633,8 +633,15 @@ impl StaticScene {
                     let lid = flat(Material::Metal, tag::STATIC, linear(item.rgb) * 0.6, Vec3::Z, 0);
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, lid);
                 }
-                FurnitureKind::SignPost | FurnitureKind::SignPlate => {
+                FurnitureKind::SignPost
+                | FurnitureKind::SignPlate
+                | FurnitureKind::ShelterFrame
+                | FurnitureKind::ShelterPoster => {
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, body);
+                }
+                FurnitureKind::ShelterGlass => {
+                    let glass = flat(Material::CarGlass, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top], glass, glass);
                 }
                 FurnitureKind::Bollard => {
                     // Dark, with a light reflective band 0.1 m below its top.
