@@ -1,6 +1,7 @@
 //! The scenery: domain randomisation's colours and texture contrast change the scenery and leave people and
 //! every label stream alone, and the street furniture's traffic signs are drawn where `clip_furniture` puts
-//! them (a plate tagged `TrafficSign` on a post tagged `Pole`).
+//! them (a plate tagged `TrafficSign` on a post tagged `Pole`), as are its bus shelters (on the sidewalk, tagged
+//! `Static`).
 
 use pedsynth::sensors::{self, camera::CameraImages, scene};
 
@@ -201,7 +202,8 @@ fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
         // Where a point of a wall (its middle, and 1.3 m to each side at the same height) or a poster's centre is
         // 3–25 m ahead and in the image, its pixel is Static unless something more than 2 m nearer covers it
         // (seen along the road, a shelter's own poster end and posts may come first); some points are seen
-        // directly.
+        // directly. (In these clips the camera meets the shelters mostly from their poster's end, so the direct
+        // hits are posters and the walls' points are checked where the poster does not cover them.)
         let posters: Vec<&scene::Furniture> = furniture
             .iter()
             .filter(|f| f.kind == FurnitureKind::ShelterPoster)
