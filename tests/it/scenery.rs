@@ -218,6 +218,32 @@ fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
             probes.extend([-1.3, 0.0, 1.3].map(|offset_m| (wall.centre() + side * offset_m, wall.foot)));
         }
         probes.extend(posters.iter().map(|p| (p.centre(), p.foot)));
+        // Each wall seen square-on from the road, 6 m in front of it (the static scene alone, clear noon): its
+        // centre's pixel is the glass, tagged Static, at its depth.
+        let stat = scene::StaticScene::build(&c.script, &c.trace, net);
+        for (k, wall) in furniture
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.kind == FurnitureKind::ShelterGlass)
+        {
+            let roof = &furniture[k - 3];
+            assert_eq!(roof.kind, FurnitureKind::ShelterFrame);
+            let out = (roof.foot - wall.foot).normalize();
+            let pos = (wall.foot + out * 6.0).extend(wall.base_z_m - 0.1);
+            let yaw = (-out.y).atan2(-out.x);
+            let cam = c.rig.camera.at(pos, yaw);
+            let img = crate::camera::render_static(&stat, &c.rig.camera, pos, yaw);
+            let at = cam.project(wall.centre());
+            assert!(cam.in_image(at.px), "wall {wall:?} not in view");
+            let i = at.px.y as usize * img.width + at.px.x as usize;
+            assert_eq!(img.semantic[i], tag::STATIC, "clip {index}: wall {wall:?}");
+            assert!(
+                (img.depth_m[i] - at.depth_m as f32).abs() < 0.1,
+                "{} against {}",
+                img.depth_m[i],
+                at.depth_m
+            );
+        }
         for frame in (0..c.trace.frame_count as usize).step_by(5) {
             let ego = c.trace.ego[frame];
             let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
