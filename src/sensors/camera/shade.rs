@@ -312,6 +312,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         Material::HeadLamp => emissive = V3::splat(Vec3::new(4.0, 3.9, 3.5) * (0.08 + l.night)),
         Material::TailLamp => emissive = V3::splat(Vec3::new(2.5, 0.1, 0.08) * (0.05 + l.night)),
         Material::Beacon => emissive = V3::splat(prim.albedo * (1.5 + 2.0 * l.night)),
+        Material::Poster => emissive = V3::splat(prim.albedo * (0.8 * l.night)),
         Material::Body | Material::Head => {
             if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
                 normal = capsule_normals(c, p);

@@ -28,7 +28,7 @@ pub enum FurnitureKind {
     /// A bus shelter's back wall of tinted glass, along the road (semantic `Static`; opaque to cameras, LiDAR and
     /// the occlusion labels alike).
     ShelterGlass,
-    /// The poster at one end of a bus shelter, in one of [`POSTER_COLOURS`] (semantic `Static`).
+    /// The poster at one end of a bus shelter, in one of [`POSTER_COLOURS`], backlit at night (semantic `Static`).
     ShelterPoster,
 }
 

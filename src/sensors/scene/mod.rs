@@ -204,6 +204,8 @@ pub enum Material {
     TailLamp,
     /// An emergency vehicle's flashing light (emits its albedo, by day too).
     Beacon,
+    /// A backlit poster (a bus shelter's): lit like any surface by day, and glowing in its colour at night.
+    Poster,
     /// Skin or clothing of a body part; `aux` is the capsule's index in [`FrameScene::capsules`] (smooth
     /// normals).
     Body,

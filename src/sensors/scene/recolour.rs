@@ -73,7 +73,8 @@ fn is_scenery(m: Material) -> bool {
         | Material::Metal
         | Material::Trunk
         | Material::Foliage
-        | Material::CarPaint => true,
+        | Material::CarPaint
+        | Material::Poster => true,
         Material::LampHead
         | Material::CarGlass
         | Material::Tyre

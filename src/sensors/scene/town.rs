@@ -633,11 +633,12 @@ impl StaticScene {
                     let lid = flat(Material::Metal, tag::STATIC, linear(item.rgb) * 0.6, Vec3::Z, 0);
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, lid);
                 }
-                FurnitureKind::SignPost
-                | FurnitureKind::SignPlate
-                | FurnitureKind::ShelterFrame
-                | FurnitureKind::ShelterPoster => {
+                FurnitureKind::SignPost | FurnitureKind::SignPlate | FurnitureKind::ShelterFrame => {
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, body);
+                }
+                FurnitureKind::ShelterPoster => {
+                    let poster = flat(Material::Poster, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+                    b.mesh.upright_box(c, 0.0, half, [base, top], poster, poster);
                 }
                 FurnitureKind::ShelterGlass => {
                     let glass = flat(Material::CarGlass, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
