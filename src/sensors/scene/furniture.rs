@@ -1,6 +1,5 @@
 //! Street furniture: litter bins, rows of bollards, traffic signs and bus shelters at the curb of sidewalks outside
-//! junctions,
-//! drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace
+//! junctions, drawn per clip from its seed. [`clip_furniture`] is a pure function of the town, the clip's seed and its trace
 //! (nothing is placed where a pedestrian of the clip walks: the simulation does not steer around furniture), so
 //! the renderer draws, the LiDAR sees and the annotations test occlusion against the same boxes.
 
@@ -106,9 +105,10 @@ const FROM_CURB_M: f64 = 0.4;
 pub const BIN_COLOURS: [[u8; 3]; 5] = [[34, 64, 40], [26, 26, 28], [98, 102, 104], [30, 56, 110], [96, 40, 30]];
 
 /// The street furniture of a clip: candidate places every [`SPACING_M`] along each sidewalk outside junctions
-/// within [`scene_bounds`], each holding a bin, a row of bollards or a sign with the shares above (drawn from the
-/// clip's seed, the lane and the place), leaving out any piece within 1.5 m of a lamp post or within
-/// [`LAMP_CLEARANCE_M`] (plus its half width) of a pedestrian of the clip in any frame.
+/// within [`scene_bounds`], each holding a bin, a row of bollards, a sign or (where the sidewalk is wide enough) a
+/// bus shelter with the shares above (drawn from the clip's seed, the lane and the place), leaving out any piece
+/// within 1.5 m of a lamp post (a shelter: 1.5 m plus its half length) or within [`LAMP_CLEARANCE_M`] (plus its half
+/// width) of a pedestrian of the clip in any frame.
 pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lamps: &[LampPost]) -> Vec<Furniture> {
     let (lo, hi) = scene_bounds(trace);
     let near = |p: DVec2| p.x >= lo.x && p.y >= lo.y && p.x <= hi.x && p.y <= hi.y;
@@ -168,39 +168,36 @@ pub fn clip_furniture(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64, lam
             });
         } else if u < BIN_SHARE + BOLLARD_SHARE + SIGN_SHARE + SHELTER_SHARE && s.width_m >= SHELTER_MIN_SIDEWALK_M {
             let centre = s.inner - s.to_road * (SHELTER_FROM_CURB_M + SHELTER_HALF_DEPTH_M);
-            // Clear of the lamps and of the clip's pedestrians as a whole (the parts go or stay together).
-            let reach = LAMP_CLEARANCE_M + SHELTER_HALF_LENGTH_M;
-            let clear = lamps
-                .iter()
-                .all(|l| l.foot.distance_squared(centre) > (1.5 + SHELTER_HALF_LENGTH_M).powi(2))
-                && trace
-                    .pedestrians
-                    .iter()
-                    .flatten()
-                    .all(|p| p.pos.truncate().distance_squared(centre) > reach * reach);
-            if clear {
+            // Its parts go or stay together: the shelter as a whole keeps clear, by its half length.
+            if clear(trace, lamps, centre, SHELTER_HALF_LENGTH_M, 1.5 + SHELTER_HALF_LENGTH_M) {
                 let poster = POSTER_COLOURS[(splitmix64(h) % POSTER_COLOURS.len() as u64) as usize];
                 shelter(&mut out, centre, s.z_m, s.along, s.to_road, poster);
             }
         }
     });
-    out.retain(|f| {
-        // A sign's post and plate go or stay together: both keep the plate's clearance. A shelter was placed
-        // clear.
-        let half_width_m = match f.kind {
-            FurnitureKind::SignPost | FurnitureKind::SignPlate => SIGN_PLATE_HALF_M,
-            FurnitureKind::Bin | FurnitureKind::Bollard => f.half_m.x.max(f.half_m.y),
-            FurnitureKind::ShelterFrame | FurnitureKind::ShelterGlass | FurnitureKind::ShelterPoster => return true,
-        };
-        let reach = LAMP_CLEARANCE_M + half_width_m;
-        lamps.iter().all(|l| l.foot.distance_squared(f.foot) > 1.5 * 1.5)
-            && trace
-                .pedestrians
-                .iter()
-                .flatten()
-                .all(|p| p.pos.truncate().distance_squared(f.foot) > reach * reach)
+    out.retain(|f| match f.kind {
+        // A sign's post and plate go or stay together: both keep the plate's clearance.
+        FurnitureKind::SignPost | FurnitureKind::SignPlate => clear(trace, lamps, f.foot, SIGN_PLATE_HALF_M, 1.5),
+        FurnitureKind::Bin | FurnitureKind::Bollard => clear(trace, lamps, f.foot, f.half_m.x.max(f.half_m.y), 1.5),
+        // Placed clear as a whole.
+        FurnitureKind::ShelterFrame | FurnitureKind::ShelterGlass | FurnitureKind::ShelterPoster => true,
     });
     out
+}
+
+/// Whether a piece standing at `foot` (plan view) of half width `half_width_m` is more than `lamp_gap_m` from every
+/// lamp's foot and more than [`LAMP_CLEARANCE_M`] plus its half width from every pedestrian of the clip in every
+/// frame.
+fn clear(trace: &ClipTrace, lamps: &[LampPost], foot: DVec2, half_width_m: f64, lamp_gap_m: f64) -> bool {
+    let reach = LAMP_CLEARANCE_M + half_width_m;
+    lamps
+        .iter()
+        .all(|l| l.foot.distance_squared(foot) > lamp_gap_m * lamp_gap_m)
+        && trace
+            .pedestrians
+            .iter()
+            .flatten()
+            .all(|p| p.pos.truncate().distance_squared(foot) > reach * reach)
 }
 
 /// Pushes the parts of a bus shelter centred (plan view) at `centre` on a sidewalk at height `z_m`, its length along

@@ -637,11 +637,17 @@ impl StaticScene {
                     b.mesh.upright_box(c, 0.0, half, [base, top], body, body);
                 }
                 FurnitureKind::ShelterPoster => {
-                    let poster = flat(Material::Poster, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+                    let poster = flat(Material::Poster, item.kind.semantic_tag(), linear(item.rgb), Vec3::Z, 0);
                     b.mesh.upright_box(c, 0.0, half, [base, top], poster, poster);
                 }
                 FurnitureKind::ShelterGlass => {
-                    let glass = flat(Material::CarGlass, tag::STATIC, linear(item.rgb), Vec3::Z, 0);
+                    let glass = flat(
+                        Material::CarGlass,
+                        item.kind.semantic_tag(),
+                        linear(item.rgb),
+                        Vec3::Z,
+                        0,
+                    );
                     b.mesh.upright_box(c, 0.0, half, [base, top], glass, glass);
                 }
                 FurnitureKind::Bollard => {
