@@ -56,7 +56,10 @@ pub(super) fn plan_clip(
             first_ped,
             archetype_names,
             duration_s,
-            basics.seed,
+            (
+                basics.seed,
+                identity::umbrella_share(weather.params().precipitation_pct),
+            ),
             &mut rng,
         )
         .and_then(|pedestrians| {

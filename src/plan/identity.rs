@@ -96,9 +96,37 @@ fn rgb_distance(a: [u8; 3], b: [u8; 3]) -> f64 {
 /// Largest jitter of a clothing colour channel, so that no two pedestrians share an exact colour.
 const CLOTHING_JITTER: i32 = 14;
 
+/// Colours of umbrellas' canopies (sRGB): mostly black and dark, some bright.
+const UMBRELLAS: [[u8; 3]; 8] = [
+    [18, 18, 20],
+    [18, 18, 20],
+    [22, 28, 58],
+    [60, 62, 66],
+    [150, 24, 30],
+    [30, 80, 150],
+    [226, 190, 40],
+    [48, 96, 62],
+];
+
+/// Share of pedestrians (not children) who hold an open umbrella in a weather with `precipitation_pct` of rain:
+/// none in dry weather, `0.6 · min(1, p / 60)` in rain (30 % in soft rain's 30, 60 % from 60 up). Of those
+/// without one (children included) the same share wear a hood up. pedsynth's choice: no dataset we have counts
+/// umbrellas or hoods.
+pub fn umbrella_share(precipitation_pct: f64) -> f64 {
+    (0.6 * precipitation_pct.max(0.0) / 60.0).min(0.6)
+}
+
 /// The identity of pedestrian `id` of a clip (an `archetype` with `body`) and, for a parent with a child, the
-/// child's.
-pub fn identities(clip_seed: u64, id: u32, archetype: &str, body: Body) -> (Identity, Option<Identity>) {
+/// child's; `umbrella_share`: the probability that the (grown-up) pedestrian holds an umbrella
+/// ([`umbrella_share`]), and that one without an umbrella (or the child) wears a hood up, drawn from the stream
+/// `ped/<id>/identity/umbrella` so that it shifts no other draw.
+pub fn identities(
+    clip_seed: u64,
+    id: u32,
+    archetype: &str,
+    body: Body,
+    umbrella_share: f64,
+) -> (Identity, Option<Identity>) {
     let (adult_m, child_m) = heights_m(clip_seed, id);
     let age = match (body, archetype) {
         (Body::Child, _) => AgeGroup::Child,
@@ -111,8 +139,35 @@ pub fn identities(clip_seed: u64, id: u32, archetype: &str, body: Body) -> (Iden
         let identity = looks(&mut seeds::clip_rng(clip_seed, stream), height_m, age);
         with_figure(identity, clip_seed, stream, true)
     };
-    let main = person(&format!("ped/{id}/identity"), height_m, age);
-    let child = (body == Body::AdultWithChild).then(|| person(&format!("ped/{id}/child"), child_m, AgeGroup::Child));
+    let mut main = person(&format!("ped/{id}/identity"), height_m, age);
+    let mut child =
+        (body == Body::AdultWithChild).then(|| person(&format!("ped/{id}/child"), child_m, AgeGroup::Child));
+    if umbrella_share > 0.0 {
+        let share = umbrella_share.min(1.0);
+        let mut rng = seeds::clip_rng(clip_seed, &format!("ped/{id}/identity/umbrella"));
+        let (umbrella, colour, hood, child_hood) = (
+            rng.random_bool(share),
+            *UMBRELLAS.choose(&mut rng).unwrap_or(&UMBRELLAS[0]),
+            rng.random_bool(share),
+            rng.random_bool(share),
+        );
+        if umbrella && age != AgeGroup::Child {
+            main.figure.umbrella = Some(colour);
+        } else if hood {
+            main.figure = Figure {
+                hood: true,
+                headwear: None,
+                ..main.figure
+            };
+        }
+        if let Some(c) = child.as_mut().filter(|_| child_hood) {
+            c.figure = Figure {
+                hood: true,
+                headwear: None,
+                ..c.figure
+            };
+        }
+    }
     (main, child)
 }
 
@@ -212,6 +267,8 @@ fn figure(rng: &mut ChaCha20Rng, age: AgeGroup, gender: Gender, skirts: bool) ->
         headwear,
         garment,
         carry,
+        umbrella: None,
+        hood: false,
     }
 }
 
@@ -260,23 +317,26 @@ mod tests {
 
     #[test]
     fn identities_are_deterministic_and_in_range() {
-        let (a, c) = identities(7, 3, "parent_with_child", Body::AdultWithChild);
-        assert_eq!((a, c), identities(7, 3, "parent_with_child", Body::AdultWithChild));
+        let (a, c) = identities(7, 3, "parent_with_child", Body::AdultWithChild, 0.0);
+        assert_eq!((a, c), identities(7, 3, "parent_with_child", Body::AdultWithChild, 0.0));
         assert!((1.55..=1.95).contains(&a.height_m));
         let c = c.expect("a child");
         assert!((1.0..=1.3).contains(&c.height_m) && c.age == AgeGroup::Child);
-        assert!(identities(7, 3, "casual_person", Body::Child).1.is_none());
-        assert_eq!(identities(7, 3, "elderly_person", Body::Adult).0.age, AgeGroup::Senior);
+        assert!(identities(7, 3, "casual_person", Body::Child, 0.0).1.is_none());
+        assert_eq!(
+            identities(7, 3, "elderly_person", Body::Adult, 0.0).0.age,
+            AgeGroup::Senior
+        );
     }
 
     #[test]
     fn looks_vary_between_pedestrians_of_one_archetype() {
         let tops: std::collections::BTreeSet<[u8; 3]> = (0..40)
-            .map(|id| identities(11, id, "business_person", Body::Adult).0.top_rgb)
+            .map(|id| identities(11, id, "business_person", Body::Adult, 0.0).0.top_rgb)
             .collect();
         assert!(tops.len() > 30, "{} distinct tops of 40", tops.len());
         let genders: std::collections::BTreeSet<Gender> = (0..40)
-            .map(|id| identities(11, id, "business_person", Body::Adult).0.gender)
+            .map(|id| identities(11, id, "business_person", Body::Adult, 0.0).0.gender)
             .collect();
         assert_eq!(genders.len(), 2);
     }
@@ -286,7 +346,7 @@ mod tests {
         // The jitter moves a colour by at most CLOTHING_JITTER per channel.
         let least = MIN_TOP_SKIN_DISTANCE - f64::from(CLOTHING_JITTER) * 3f64.sqrt();
         for id in 0..600 {
-            let a = identities(5, id, "casual_person", Body::Adult).0;
+            let a = identities(5, id, "casual_person", Body::Adult, 0.0).0;
             let d = rgb_distance(a.top_rgb, a.skin_rgb);
             assert!(
                 d >= least,
@@ -295,5 +355,49 @@ mod tests {
                 a.skin_rgb
             );
         }
+    }
+
+    /// Umbrellas and hoods come from a stream of their own: with or without rain a pedestrian is the same person
+    /// (a hood takes a hat's place), and in rain about the share's fraction of grown-ups hold an umbrella (none of
+    /// the children) and the same share of the others wear a hood.
+    #[test]
+    fn umbrellas_change_nothing_else_and_follow_the_share() {
+        let (mut held, mut hooded, mut grown_ups) = (0, 0, 0);
+        for id in 0..600 {
+            let dry = identities(13, id, "casual_person", Body::AdultWithChild, 0.0);
+            let (mut wet, wet_child) = identities(13, id, "casual_person", Body::AdultWithChild, 0.6);
+            assert!(dry.0.figure.umbrella.is_none() && !dry.0.figure.hood);
+            let mut wet_child = wet_child.expect("a child");
+            assert!(wet_child.figure.umbrella.is_none(), "a child holds an umbrella");
+            grown_ups += 1;
+            held += usize::from(wet.figure.umbrella.is_some());
+            hooded += usize::from(wet.figure.hood);
+            assert!(
+                !(wet.figure.hood && wet.figure.umbrella.is_some()),
+                "a hood under an umbrella"
+            );
+            assert!(!wet.figure.hood || wet.figure.headwear.is_none(), "a hat over a hood");
+            // Without the umbrella, the hood and the hat the hood replaced, the same person.
+            for (person, before) in [(&mut wet, dry.0), (&mut wet_child, dry.1.expect("a child"))] {
+                person.figure.umbrella = None;
+                if person.figure.hood {
+                    person.figure.hood = false;
+                    person.figure.headwear = before.figure.headwear;
+                }
+                assert_eq!(*person, before, "pedestrian {id}");
+            }
+            assert!(
+                identities(13, id, "casual_person", Body::Child, 1.0)
+                    .0
+                    .figure
+                    .umbrella
+                    .is_none()
+            );
+        }
+        let share = held as f64 / f64::from(grown_ups);
+        assert!((share - 0.6).abs() < 0.06, "{held} of {grown_ups} hold an umbrella");
+        // Of the 40 % without one, 60 % wear a hood: 24 %.
+        let hoods = hooded as f64 / f64::from(grown_ups);
+        assert!((hoods - 0.24).abs() < 0.05, "{hooded} of {grown_ups} wear a hood");
     }
 }

@@ -36,7 +36,7 @@ pub(super) fn plan_pedestrians(
     first_ped: usize,
     archetype_names: &[&String],
     duration_s: f64,
-    clip_seed: u64,
+    (clip_seed, umbrella_share): (u64, f64),
     rng: &mut ChaCha20Rng,
 ) -> Result<Vec<PedestrianScript>, String> {
     let p = &spec.pedestrians;
@@ -188,7 +188,7 @@ pub(super) fn plan_pedestrians(
         if keeps_crossing && crossing.is_none() {
             return Err(format!("pedestrian {id} is a crosser but has no road to cross"));
         }
-        let (identity, child) = identity::identities(clip_seed, id, name, a.body);
+        let (identity, child) = identity::identities(clip_seed, id, name, a.body, umbrella_share);
         scripts.push(PedestrianScript {
             id,
             archetype: name.to_owned(),

@@ -626,6 +626,14 @@ pub struct Figure {
     pub garment: Garment,
     /// What the person carries, and its colour (sRGB).
     pub carry: Option<(Carry, [u8; 3])>,
+    /// An open umbrella held in the left hand, and its canopy's colour (sRGB): drawn only in rain (plans
+    /// written before umbrellas existed read as none, and a figure without one writes no key).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub umbrella: Option<[u8; 3]>,
+    /// A hood up over the head, in the top's colour (in rain, for some of those without an umbrella; it takes a
+    /// hat's place). Plans written before hoods existed read as none, and a figure without one writes no key.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub hood: bool,
 }
 
 impl Figure {
@@ -636,6 +644,8 @@ impl Figure {
         headwear: None,
         garment: Garment::Trousers,
         carry: None,
+        umbrella: None,
+        hood: false,
     };
 }
 

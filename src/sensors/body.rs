@@ -132,6 +132,30 @@ pub struct BodyPose {
     pub yaw_rad: f64,
     /// The head's forward direction in the world (unit): where the pedestrian looks.
     pub gaze: DVec3,
+    /// An open umbrella held in the left hand ([`Figure::umbrella`]): not part of the body (its capsules, box and
+    /// keypoints leave it out).
+    pub umbrella: Option<Umbrella>,
+}
+
+/// An open umbrella in the world: a shaft from the hand's grip up to the canopy's centre, and a canopy (a low
+/// cone of `radius_m`) around the shaft's axis, its rim [`Umbrella::RIM_DROP_M`] below the top.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Umbrella {
+    /// Where the hand holds the shaft (the left hand's knuckles).
+    pub grip: DVec3,
+    /// The shaft's top: the canopy's centre, where its ribs meet.
+    pub top: DVec3,
+    /// The canopy's radius, metres.
+    pub radius_m: f64,
+}
+
+impl Umbrella {
+    /// How far the canopy's rim hangs below its top along the shaft, metres.
+    pub const RIM_DROP_M: f64 = 0.13;
+    /// How far the canopy's peak stands above its top along the shaft, metres.
+    pub const PEAK_M: f64 = 0.05;
+    /// The canopy's radius: a common 95–105 cm umbrella's.
+    pub const RADIUS_M: f64 = 0.5;
 }
 
 /// A capsule's mesh (`sensors::scene`) puts its vertices this many radii from its axis (so that the polygon's
@@ -203,6 +227,10 @@ pub(crate) fn head_scale(h: f64) -> f64 {
     1.0 + 0.25 * ((1.5 - h) / 0.5).clamp(0.0, 1.0)
 }
 
+/// A hand's length from the wrist along the forearm to the knuckles (the fingers' length again is not drawn), a
+/// fraction of the body height.
+const HAND_LENGTH: f64 = 0.05;
+
 /// The head: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and half-length (its
 /// height with the radius: 23 cm), fractions of the body height (an adult's).
 const HEAD_RADIUS: f64 = 0.047;
@@ -241,8 +269,7 @@ pub(crate) fn silhouette(
     to_world: impl Fn(DVec3) -> DVec3,
 ) -> [Capsule; CAPSULES] {
     let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
-    // A hand: on from the wrist along the forearm (to the knuckles; the fingers' length again is not drawn).
-    let hand = |elbow: DVec3, wrist: DVec3| wrist + (wrist - elbow).normalize_or_zero() * (0.05 * h);
+    let hand = |elbow: DVec3, wrist: DVec3| wrist + (wrist - elbow).normalize_or_zero() * (HAND_LENGTH * h);
     let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
         a: to_world(a),
         b: to_world(b),
@@ -273,10 +300,16 @@ pub(crate) fn silhouette(
         HairStyle::Bun => cap(in_head(-0.062, 0.03), in_head(-0.062, 0.03), 0.026 * head_s),
         HairStyle::Short | HairStyle::Bald => Capsule::ABSENT,
     };
-    // A hat: a dome a little larger than the head's top, down to above the eyebrows.
-    let headwear = match figure.headwear {
-        Some(_) => cap(in_head(0.0, 0.032), in_head(0.0, 0.032), 0.049 * head_s),
-        None => Capsule::ABSENT,
+    // A hat: a dome a little larger than the head's top, down to above the eyebrows. A hood: a capsule a little
+    // larger than the head, set back so that the face shows, down over the back of the neck.
+    let headwear = match (figure.hood, figure.headwear) {
+        (true, _) => cap(
+            in_head(-0.012, 0.015),
+            in_head(-0.025, -0.045),
+            (HEAD_RADIUS + 0.006) * head_s,
+        ),
+        (false, Some(_)) => cap(in_head(0.0, 0.032), in_head(0.0, 0.032), 0.049 * head_s),
+        (false, None) => Capsule::ABSENT,
     };
     let carry = match figure.carry {
         Some((Carry::Backpack, _)) => {
@@ -376,7 +409,17 @@ pub fn pose(frame: &PedFrame, height_m: f64, figure: &Figure, offset_body: DVec3
         let wrist = elbow + DVec3::new(fore_angle.sin(), side * 0.16, -fore_angle.cos()).normalize() * fore;
         (shoulder, elbow, wrist)
     };
-    let (l_shoulder, l_elbow, l_wrist) = arm(1.0, -0.8 * theta);
+    let (l_shoulder, mut l_elbow, mut l_wrist) = arm(1.0, -0.8 * theta);
+    // An umbrella: the left arm holds it still (no swing), the upper arm hanging a little forward, the forearm
+    // raised forward and across to a grip in front of the chest; the shaft leans back from the grip to a top
+    // above and just ahead of the head's centre, so the canopy's rim clears the head.
+    let umbrella = figure.umbrella.map(|_| {
+        l_elbow = l_shoulder + DVec3::new(0.15, 0.1, -1.0).normalize() * upper;
+        let fore_dir = DVec3::new(0.45, -0.35, 0.8).normalize();
+        l_wrist = l_elbow + fore_dir * fore;
+        let grip = l_wrist + fore_dir * (HAND_LENGTH * h);
+        (grip, DVec3::new(0.07 * h, 0.3 * grip.y, h + 0.33))
+    });
     let (r_shoulder, r_elbow, mut r_wrist) = arm(-1.0, 0.8 * theta);
     let mut head_pitch = 0.0;
     if frame.on_phone {
@@ -440,6 +483,11 @@ pub fn pose(frame: &PedFrame, height_m: f64, figure: &Figure, offset_body: DVec3
         ground: to_world(DVec3::ZERO),
         yaw_rad: frame.yaw_rad,
         gaze: rot * head_rot * DVec3::X,
+        umbrella: umbrella.map(|(grip, top)| Umbrella {
+            grip: to_world(grip),
+            top: to_world(top),
+            radius_m: Umbrella::RADIUS_M,
+        }),
     }
 }
 
@@ -512,6 +560,8 @@ mod tests {
                 headwear: Some([10, 10, 10]),
                 garment,
                 carry: Some((carry, [20, 20, 20])),
+                umbrella: None,
+                hood: false,
             };
             let p = pose(&f, 1.75, &figure, DVec3::ZERO);
             let average = pose(&f, 1.75, &Figure { build: 1.0, ..figure }, DVec3::ZERO);
@@ -636,5 +686,68 @@ mod tests {
         out.clear();
         push_keypoints(&coco, PoseFormat::Coco17, true, &mut out);
         assert_eq!(out, coco);
+    }
+
+    /// An umbrella is held in the left hand: only the left elbow and wrist move (the arm stops swinging), the
+    /// shaft starts at the hand's end, and the canopy's rim stays at least 3 cm above the top of the head (hat,
+    /// hood and bun included) for every height and gait, so that a camera below it sees the face; the canopy is over the
+    /// head, and it is not part of the body's box.
+    #[test]
+    fn an_umbrella_is_held_in_the_left_hand_above_the_head() {
+        use crate::plan::HairStyle;
+        for h in [1.55, 1.75, 1.95] {
+            for (speed, phase) in [(0.0, 0.0), (1.3, 0.2), (1.3, 0.7), (3.0, 0.4)] {
+                let f = frame(speed, phase);
+                let dressed = Figure {
+                    hair: HairStyle::Bun,
+                    headwear: Some([10, 10, 10]),
+                    ..Figure::PLAIN
+                };
+                // A hood stands higher than a hat.
+                let dressed = if speed > 2.0 {
+                    Figure {
+                        hood: true,
+                        headwear: None,
+                        ..dressed
+                    }
+                } else {
+                    dressed
+                };
+                let with = Figure {
+                    umbrella: Some([20, 20, 20]),
+                    ..dressed
+                };
+                let (p, bare) = (pose(&f, h, &with, DVec3::ZERO), pose(&f, h, &dressed, DVec3::ZERO));
+                assert!(bare.umbrella.is_none());
+                let u = p.umbrella.expect("an umbrella");
+                for k in (0..17).filter(|k| ![7, 9].contains(k)) {
+                    assert_eq!(p.joints[k], bare.joints[k], "joint {k}");
+                }
+                assert!(
+                    p.capsules[14].b.distance(u.grip) < 1e-9,
+                    "the grip is the left hand's end"
+                );
+                let axis = (u.top - u.grip).normalize();
+                let lowest_rim_z =
+                    u.top.z - Umbrella::RIM_DROP_M * axis.z - u.radius_m * (1.0 - axis.z * axis.z).sqrt();
+                let scale = f64::from(CAPSULE_MESH_SCALE);
+                let head_top_z = [2, 18, 19]
+                    .iter()
+                    .map(|&k| &p.capsules[k])
+                    .filter(|c| c.is_present())
+                    .map(|c| c.a.z.max(c.b.z) + c.radius_m * scale)
+                    .fold(f64::MIN, f64::max);
+                assert!(
+                    lowest_rim_z >= head_top_z + 0.03,
+                    "h {h}, speed {speed}: rim {lowest_rim_z:.3} m, head top {head_top_z:.3} m"
+                );
+                let head = (p.capsules[2].a + p.capsules[2].b) * 0.5;
+                assert!(
+                    (u.top - head).truncate().length() < 0.5 * u.radius_m,
+                    "h {h}: canopy beside the head"
+                );
+                assert!(p.box3d().1.z < h + 0.05, "h {h}: the umbrella is in the box");
+            }
+        }
     }
 }

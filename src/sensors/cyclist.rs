@@ -106,6 +106,7 @@ pub fn rider_pose(frame: &CyclistFrame, height_m: f64, figure: &Figure) -> BodyP
         ground: frame.pos,
         yaw_rad: frame.yaw_rad,
         gaze: rot * DVec3::X,
+        umbrella: None,
     }
 }
 

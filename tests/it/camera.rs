@@ -105,6 +105,11 @@ pub(crate) struct MaskReport {
     pub(crate) worst_iou: f64,
     pub(crate) failures: Vec<String>,
     pub(crate) partly_hidden: usize,
+    /// Pedestrians of the clip holding an umbrella, and the pixels tagged `Dynamic` (umbrellas) over every frame,
+    /// and how many of those carry an instance id.
+    pub(crate) umbrellas: usize,
+    pub(crate) dynamic_px: usize,
+    pub(crate) dynamic_px_with_instance: usize,
 }
 
 /// Whether `test` holds for a pixel within one pixel of the image point (`x`, `y`) (the label sample of pixel
@@ -224,11 +229,25 @@ pub(crate) fn masks_match_boxes_and_keypoints(overrides: &[&str]) -> MaskReport 
     all.extend_from_slice(overrides);
     let c = clip(&spec("quickstart.yaml"), &all);
     let net = &c.towns[&c.script.town].network;
-    let mut report = MaskReport::default();
+    let mut report = MaskReport {
+        umbrellas: c
+            .script
+            .pedestrians
+            .iter()
+            .filter(|p| p.identity.figure.umbrella.is_some())
+            .count(),
+        ..MaskReport::default()
+    };
     let mut frames = 0;
     let stat = StaticScene::build(&c.script, &c.trace, net);
     sensors::render_cameras(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
         check_masks(&c, f.frame, f.images, &mut report);
+        for (&tag_id, &instance) in f.images.semantic.iter().zip(&f.images.instance) {
+            if tag_id == tag::DYNAMIC {
+                report.dynamic_px += 1;
+                report.dynamic_px_with_instance += usize::from(instance != 0);
+            }
+        }
         frames += 1;
         Ok::<(), ()>(())
     })

@@ -36,6 +36,7 @@ mod spec_diagnostics;
 mod spec_keys;
 mod spec_roundtrip;
 mod spec_schema;
+mod umbrellas;
 mod verify;
 mod world_builtin;
 mod world_carla_maps;

@@ -142,7 +142,7 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
         in_view_before_crossing_s: None,
         step_out_ego_within_m: None,
         curb_wait_s: None,
-        identity: pedsynth::plan::identity::identities(1, id, "casual_person", Body::Adult).0,
+        identity: pedsynth::plan::identity::identities(1, id, "casual_person", Body::Adult, 0.0).0,
         child: None,
         red_light_violator: false,
     }

@@ -71,6 +71,10 @@ pub struct Pedestrian {
     pub garment: String,
     /// `backpack`, `shoulder_bag`, or "" (nothing carried).
     pub carry: String,
+    /// Holds an open umbrella.
+    pub umbrella: bool,
+    /// Wears a hood up.
+    pub hood: bool,
     pub frames: Vec<AnnotatedFrame>,
 }
 
@@ -412,6 +416,8 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         "headwear",
         "garment",
         "carry",
+        "umbrella",
+        "hood",
     ];
     for b in tables::read(&file("pedestrians"), &cols)? {
         let (id, age, gender) = (b.u32s("pedestrian")?, b.strings("age_group")?, b.strings("gender")?);
@@ -419,6 +425,7 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         let (behaviour, first_c) = (b.strings("behaviour")?, b.u32s("first_crossing_frame")?);
         let (height, body) = (b.f32s("height_m")?, b.strings("body")?);
         let (headwear, garment, carry) = (b.bools("headwear")?, b.strings("garment")?, b.strings("carry")?);
+        let (umbrella, hood) = (b.bools("umbrella")?, b.bools("hood")?);
         for i in 0..b.rows() {
             clip.pedestrians.insert(
                 id.value(i),
@@ -436,6 +443,8 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                     headwear: headwear.value(i),
                     garment: garment[i].to_owned(),
                     carry: carry[i].to_owned(),
+                    umbrella: umbrella.value(i),
+                    hood: hood.value(i),
                     frames: Vec::new(),
                 },
             );

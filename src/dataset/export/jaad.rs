@@ -107,13 +107,16 @@ const APPEARANCE: [&str; 24] = [
 ];
 
 /// Whether a pedestrian's figure shows JAAD's appearance label `label` (a hat is a `cap`; a shoulder bag hangs
-/// on the left; a coat reaches below the knee); the pose labels come from the facing.
+/// on the left; a coat reaches below the knee; an open umbrella is `umbrella`, a hood up `hood`); the pose labels come from the
+/// facing.
 fn worn(p: &Pedestrian, label: &str) -> bool {
     match label {
         "backpack" => p.carry == "backpack",
         "bag_shoulder" | "bag_left_side" => p.carry == "shoulder_bag",
         "cap" => p.headwear,
         "clothes_below_knee" => p.garment == "coat",
+        "umbrella" => p.umbrella,
+        "hood" => p.hood,
         _ => false,
     }
 }

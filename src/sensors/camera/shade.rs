@@ -300,7 +300,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 emissive = V3::splat(Vec3::new(0.9, 0.7, 0.42) * (0.35 * l.night)).scale(lit);
             }
         }
-        Material::Roof | Material::Metal | Material::Tyre => {}
+        Material::Roof | Material::Metal | Material::Tyre | Material::Fabric => {}
         Material::LampHead => emissive = V3::splat(Vec3::new(3.0, 2.5, 1.8) * l.night),
         Material::Trunk => albedo = albedo.scale(grain(nz, x * 9.0, z * 3.0, 0.2 * tex)),
         Material::Foliage => {

@@ -379,5 +379,39 @@ impl FrameScene {
             });
             self.mesh.capsule(&sc, prim);
         }
+        if let (Some(u), Some(colour)) = (&pose.umbrella, outfit.umbrella) {
+            self.push_umbrella(stat, u, colour, forward);
+        }
+    }
+
+    /// An umbrella: a dark metal shaft and a canopy of `colour`, semantic `Dynamic` with instance 0 (not an
+    /// annotated object: the holder's mask, box and keypoints leave it out).
+    fn push_umbrella(&mut self, stat: &StaticScene, u: &body::Umbrella, colour: Vec3, forward: Vec3) {
+        let part = |material, albedo, normal| Prim {
+            material,
+            tag: tag::DYNAMIC,
+            instance: 0,
+            albedo,
+            albedo2: albedo,
+            normal,
+            aux: 0,
+        };
+        let shaft = self.mesh.prim(part(Material::Metal, linear([40, 40, 42]), forward));
+        let (grip, top) = (stat.rel(u.grip), stat.rel(u.top));
+        self.mesh.capsule(
+            &SceneCapsule {
+                a: grip,
+                b: top,
+                radius_m: 0.011,
+            },
+            shaft,
+        );
+        self.mesh.canopy(
+            top,
+            (top - grip).normalize_or(Vec3::Z),
+            u.radius_m as f32,
+            [body::Umbrella::PEAK_M as f32, body::Umbrella::RIM_DROP_M as f32],
+            part(Material::Fabric, colour, Vec3::Z),
+        );
     }
 }

@@ -69,6 +69,8 @@ pub mod tag {
     pub const BICYCLE: u8 = 19;
     /// Street furniture that does not move (bins, bollards).
     pub const STATIC: u8 = 20;
+    /// Things that move but are not annotated objects (CARLA: bags, buggies, animals): a pedestrian's umbrella.
+    pub const DYNAMIC: u8 = 21;
     /// Cars.
     pub const CAR: u8 = 14;
     /// Lane markings and crosswalk stripes.
@@ -206,6 +208,8 @@ pub enum Material {
     Beacon,
     /// A backlit poster (a bus shelter's): lit like any surface by day, and glowing in its colour at night.
     Poster,
+    /// An umbrella's canopy (plain diffuse cloth; its two sides are separate primitives with their own normals).
+    Fabric,
     /// Skin or clothing of a body part; `aux` is the capsule's index in [`FrameScene::capsules`] (smooth
     /// normals).
     Body,
@@ -306,6 +310,36 @@ impl Mesh {
         }
         let id = self.prim(Prim { normal: Vec3::Z, ..top });
         self.quad(corners.map(|c| Vec3::new(c.x, c.y, z[1])), id);
+    }
+
+    /// Adds a canopy (an umbrella's): a low cone of `ribs` facets around `axis` (unit), its peak `peak_m` above
+    /// `top` and its rim of `radius_m` `drop_m` below it along the axis. Each facet is two primitives of `cloth`
+    /// with their own flat normals: the outer side, and an inner one 1.5 cm below it along the axis facing
+    /// down (a camera below the canopy sees its inside, shaded as such).
+    pub fn canopy(&mut self, top: Vec3, axis: Vec3, radius_m: f32, [peak_m, drop_m]: [f32; 2], cloth: Prim) {
+        const RIBS: usize = 8;
+        const INNER_M: f32 = 0.015;
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        let peak = top + axis * peak_m;
+        let rim = |k: usize| {
+            let (s, c) = (k as f32 * std::f32::consts::TAU / RIBS as f32).sin_cos();
+            top - axis * drop_m + (u * c + v * s) * radius_m
+        };
+        for k in 0..RIBS {
+            let (a, b) = (rim(k), rim(k + 1));
+            let mut n = (a - peak).cross(b - peak).normalize_or(axis);
+            if n.dot(axis) < 0.0 {
+                n = -n;
+            }
+            for (side, shift) in [(n, Vec3::ZERO), (-n, -axis * INNER_M)] {
+                let prim = self.prim(Prim { normal: side, ..cloth });
+                self.tris.push(Tri {
+                    v: [peak + shift, a + shift, b + shift],
+                    prim,
+                });
+            }
+        }
     }
 
     /// Adds a capsule as a closed polyhedron (8 sides, two rings per cap) of one primitive.

@@ -81,6 +81,7 @@ fn is_scenery(m: Material) -> bool {
         | Material::HeadLamp
         | Material::TailLamp
         | Material::Beacon
+        | Material::Fabric
         | Material::Body
         | Material::Head => false,
     }

@@ -105,6 +105,8 @@ pub struct Outfit {
     pub parts: [(Material, Vec3); CAPSULES],
     /// Hair colour, linear RGB.
     pub hair: Vec3,
+    /// The umbrella's canopy colour, linear RGB (none: no umbrella).
+    pub umbrella: Option<Vec3>,
 }
 
 impl Outfit {
@@ -146,12 +148,14 @@ impl Outfit {
                 }
                 Wear::Leg => (Material::Body, bottom),
                 Wear::Hair => (Material::Body, hair),
+                Wear::Headwear if figure.hood => (Material::Body, top),
                 Wear::Headwear => (Material::Body, accessory(figure.headwear)),
                 Wear::Carry => (Material::Body, accessory(figure.carry.map(|c| c.1))),
                 Wear::Garment => (Material::Body, skirt),
             }),
             // A bald head shows its scalp where hair would be.
             hair: if figure.hair == HairStyle::Bald { skin } else { hair },
+            umbrella: figure.umbrella.map(linear),
         }
     }
 }

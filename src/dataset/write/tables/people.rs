@@ -64,6 +64,20 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             )),
         )
         .column(
+            "umbrella",
+            false,
+            Arc::new(BooleanArray::from_iter(
+                peds.iter().map(|p| Some(p.identity.figure.umbrella.is_some())),
+            )),
+        )
+        .column(
+            "hood",
+            false,
+            Arc::new(BooleanArray::from_iter(
+                peds.iter().map(|p| Some(p.identity.figure.hood)),
+            )),
+        )
+        .column(
             "crosser",
             false,
             Arc::new(BooleanArray::from_iter((0..n).map(|i| Some(label(i).crosser)))),
