@@ -634,6 +634,30 @@ pub struct Figure {
     /// hat's place). Plans written before hoods existed read as none, and a figure without one writes no key.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub hood: bool,
+    /// A pattern on the top (and on a dress or coat) in a second colour (sRGB). Plans written before patterns
+    /// existed read as none, and a plain top writes no key.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<(Pattern, [u8; 3])>,
+}
+
+/// A cloth pattern.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pattern {
+    /// Horizontal stripes, 9 cm from one stripe to the next.
+    Stripes,
+    /// Checks of 8 cm squares (a plaid shirt).
+    Checks,
+}
+
+impl Pattern {
+    /// The pattern's name (the pedestrians table's `pattern` column).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Stripes => "stripes",
+            Self::Checks => "checks",
+        }
+    }
 }
 
 impl Figure {
@@ -646,6 +670,7 @@ impl Figure {
         carry: None,
         umbrella: None,
         hood: false,
+        pattern: None,
     };
 }
 

@@ -562,6 +562,7 @@ mod tests {
                 carry: Some((carry, [20, 20, 20])),
                 umbrella: None,
                 hood: false,
+                pattern: None,
             };
             let p = pose(&f, 1.75, &figure, DVec3::ZERO);
             let average = pose(&f, 1.75, &Figure { build: 1.0, ..figure }, DVec3::ZERO);

@@ -1185,6 +1185,7 @@ fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
                     ray,
                     ray_len: ray.length_squared().sqrt(),
                     shadow: lanes_from(|i| shadow[at(i)]),
+                    depth_m: ray.length_squared().sqrt(),
                 }
             };
             let shaded = |pts: &Points| {

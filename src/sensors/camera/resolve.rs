@@ -277,6 +277,7 @@ impl Renderer {
             ray,
             ray_len,
             shadow,
+            depth_m: z,
         };
         let (colour, semantic) = shade::surface(ctx, prim, &pts);
         (shade::fog(&self.light, colour, ray_len * z), semantic)

@@ -10,8 +10,8 @@ use super::lanes::{F, LANES, V3, exp_lanes, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use super::round::{floor_i32, floor_int};
 use crate::sensors::scene::{
-    CROSSWALK_PAINT, FrameScene, Mark, Material, PieceSurface, Prim, SceneCapsule, StaticScene, crosswalk_across,
-    road_marking, road_paint_near, tag,
+    CROSSWALK_PAINT, FrameScene, Mark, Material, PATTERN_PLAIN, PATTERN_STRIPES, PieceSurface, Prim, SceneCapsule,
+    StaticScene, body_capsule, body_pattern, crosswalk_across, road_marking, road_paint_near, tag,
 };
 use crate::util::mix::splitmix64;
 
@@ -122,6 +122,37 @@ pub struct Points {
     pub ray_len: F,
     /// The sun's visibility at each (0–1).
     pub shadow: F,
+    /// The points' depths along the optical axis, metres.
+    pub depth_m: F,
+}
+
+/// Period of a striped top, metres (stripes 4.5 cm wide).
+const STRIPE_PERIOD_M: f32 = 0.09;
+/// Period of a checked top, metres.
+const CHECK_PERIOD_M: f32 = 0.08;
+
+/// How much of the second colour a patterned cloth shows at the lanes' points (0–1): soft-edged stripes of half
+/// the period along the height (and across the body, `right` the body's right, for checks), faded to their mean
+/// (0.5) from 10 m to 22 m deep, where a period spans under three pixels of a 1280-pixel-wide 90° camera and
+/// would alias (labels never see it).
+#[inline(always)]
+fn pattern_share(pattern: u32, p: V3, right: Vec3, depth_m: F) -> F {
+    let band = |q: F, period: f32| {
+        let t = q * (1.0 / period);
+        let f = t - floor_int(t).round_float();
+        // A triangle wave (0 at the stripe's middle, 1 at the gap's), edges soft over a sixth of the period.
+        let tri = (f * 2.0 - F::ONE).abs();
+        (tri * 3.0 - F::ONE).max(F::ZERO).min(F::ONE)
+    };
+    let m = match pattern {
+        PATTERN_STRIPES => band(p.z, STRIPE_PERIOD_M),
+        _ => {
+            let across = p.x * right.x + p.y * right.y;
+            (band(p.z, CHECK_PERIOD_M) + band(across, CHECK_PERIOD_M)) * 0.5
+        }
+    };
+    let fade = ((F::splat(22.0) - depth_m) * (1.0 / 12.0)).max(F::ZERO).min(F::ONE);
+    F::splat(0.5) + (m - F::splat(0.5)) * fade
 }
 
 /// A noise value per lane, scaled: `1 + amp × noise(q)`.
@@ -314,7 +345,13 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         Material::Beacon => emissive = V3::splat(prim.albedo * (1.5 + 2.0 * l.night)),
         Material::Poster => emissive = V3::splat(prim.albedo * (0.8 * l.night)),
         Material::Body | Material::Head => {
-            if let Some(c) = ctx.frame.capsules.get(prim.aux as usize) {
+            let pattern = body_pattern(prim.aux);
+            if pattern != PATTERN_PLAIN {
+                let right = Vec3::new(prim.normal.y, -prim.normal.x, 0.0);
+                let m = pattern_share(pattern, p, right, pts.depth_m);
+                albedo = albedo.add(V3::splat(prim.albedo2).sub(albedo).scale(m));
+            }
+            if let Some(c) = ctx.frame.capsules.get(body_capsule(prim.aux)) {
                 normal = capsule_normals(c, p);
                 if prim.material == Material::Head {
                     // The face is placed by the directions from the head's centre (a sphere's normals).
@@ -632,5 +669,48 @@ mod tests {
             "{crosswalk_painted} {lanes_painted}"
         );
         assert!(lanes_painted < 3 * 2 * 400 * LANES / 2, "{lanes_painted}");
+    }
+
+    /// A striped top shows its second colour in the gaps between stripes, 4.5 cm on and 4.5 cm off along the
+    /// height; checks mix both directions; beyond 22 m deep both are their mean (no aliasing), and between 10
+    /// and 22 m they fade towards it.
+    #[test]
+    fn cloth_patterns_alternate_with_their_period_and_fade_with_depth() {
+        use crate::sensors::scene::PATTERN_CHECKS;
+        let at = |pattern: u32, x: f32, z: f32, depth_m: f32| {
+            let p = V3::splat(Vec3::new(x, 0.0, z));
+            pattern_share(pattern, p, Vec3::X, F::splat(depth_m)).to_array()[0]
+        };
+        let period = STRIPE_PERIOD_M;
+        // 0 at a stripe's middle (f = 0.5), 1 in the middle of the gap (f = 0), at every period.
+        for k in 10..20 {
+            let z = k as f32 * period;
+            assert!(at(PATTERN_STRIPES, 0.0, z + 0.5 * period, 3.0) < 1e-4, "stripe at {z}");
+            assert!(at(PATTERN_STRIPES, 0.0, z + 0.01 * period, 3.0) > 0.9, "gap at {z}");
+            assert!(
+                (at(PATTERN_STRIPES, 0.0, z + 0.5 * period, 16.0) - 0.25).abs() < 1e-3,
+                "half faded"
+            );
+            assert!((at(PATTERN_STRIPES, 0.0, z, 30.0) - 0.5).abs() < 1e-6, "faded at 30 m");
+        }
+        // Stripes do not change across the body; checks do.
+        let z = 1.2 + 0.5 * CHECK_PERIOD_M;
+        assert_eq!(
+            at(PATTERN_STRIPES, 0.0, 12.0 * period, 3.0),
+            at(PATTERN_STRIPES, 0.37, 12.0 * period, 3.0)
+        );
+        let across: Vec<f32> = (0..8)
+            .map(|i| at(PATTERN_CHECKS, i as f32 * 0.25 * CHECK_PERIOD_M, z, 3.0))
+            .collect();
+        assert!(
+            across.iter().any(|&m| m < 0.05) && across.iter().any(|&m| m > 0.45),
+            "{across:?}"
+        );
+        // The mean over a period is one half.
+        let mean = (0..900)
+            .map(|i| at(PATTERN_STRIPES, 0.0, i as f32 * period / 900.0 + 1.0, 3.0))
+            .sum::<f32>()
+            / 900.0;
+        assert!((mean - 0.5).abs() < 0.01, "{mean}");
     }
 }

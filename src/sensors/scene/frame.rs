@@ -358,7 +358,7 @@ impl FrameScene {
         let gaze = Vec3::new(pose.gaze.x as f32, pose.gaze.y as f32, 0.0)
             .try_normalize()
             .unwrap_or(forward);
-        for (cap, &(material, albedo)) in pose.capsules.iter().zip(&outfit.parts) {
+        for ((cap, &(material, albedo)), &patterned) in pose.capsules.iter().zip(&outfit.parts).zip(&outfit.patterned) {
             if !cap.is_present() {
                 continue;
             }
@@ -368,14 +368,19 @@ impl FrameScene {
                 radius_m: cap.radius_m as f32,
             };
             self.capsules.push(sc);
+            let (pattern, albedo2) = match material {
+                Material::Head => (PATTERN_PLAIN, outfit.hair),
+                _ if patterned => outfit.pattern,
+                _ => (PATTERN_PLAIN, albedo),
+            };
             let prim = self.mesh.prim(Prim {
                 material,
                 tag,
                 instance,
                 albedo,
-                albedo2: outfit.hair,
+                albedo2,
                 normal: if material == Material::Head { gaze } else { forward },
-                aux: (self.capsules.len() - 1) as u32,
+                aux: body_aux(self.capsules.len() - 1, pattern),
             });
             self.mesh.capsule(&sc, prim);
         }

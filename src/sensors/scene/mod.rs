@@ -27,7 +27,7 @@ use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::body::{self, CAPSULES, CHILD_OFFSET_M};
 use super::cyclist;
-use crate::plan::{ClipScript, EmergencyKind, Garment, HairStyle, Identity};
+use crate::plan::{ClipScript, EmergencyKind, Garment, HairStyle, Identity, Pattern};
 use crate::sim::trace::{ClipTrace, LightState, PedFrame, VehicleFrame};
 use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::util::mix::splitmix64;
@@ -210,13 +210,34 @@ pub enum Material {
     Poster,
     /// An umbrella's canopy (plain diffuse cloth; its two sides are separate primitives with their own normals).
     Fabric,
-    /// Skin or clothing of a body part; `aux` is the capsule's index in [`FrameScene::capsules`] (smooth
-    /// normals).
+    /// Skin or clothing of a body part; `aux` holds the capsule's index in [`FrameScene::capsules`] (smooth
+    /// normals) and the cloth's pattern ([`body_aux`]; its second colour is `albedo2`).
     Body,
     /// A head: skin in front, hair on top and at the back (`albedo2`); `aux` as for [`Material::Body`],
     /// `normal` is the body's forward axis.
     Head,
 }
+
+/// A body primitive's `aux`: its capsule's index in [`FrameScene::capsules`] in the low 24 bits, and its cloth
+/// pattern above them ([`PATTERN_PLAIN`], [`PATTERN_STRIPES`], [`PATTERN_CHECKS`]; the pattern's second colour is
+/// the primitive's `albedo2`).
+pub fn body_aux(capsule: usize, pattern: u32) -> u32 {
+    (capsule as u32 & 0x00ff_ffff) | (pattern << 24)
+}
+/// The capsule index of a body primitive's `aux` ([`body_aux`]).
+pub fn body_capsule(aux: u32) -> usize {
+    (aux & 0x00ff_ffff) as usize
+}
+/// The cloth pattern of a body primitive's `aux` ([`body_aux`]).
+pub fn body_pattern(aux: u32) -> u32 {
+    aux >> 24
+}
+/// Plain cloth or skin.
+pub const PATTERN_PLAIN: u32 = 0;
+/// Horizontal stripes ([`crate::plan::Pattern::Stripes`]).
+pub const PATTERN_STRIPES: u32 = 1;
+/// Checks ([`crate::plan::Pattern::Checks`]).
+pub const PATTERN_CHECKS: u32 = 2;
 
 /// One primitive: everything the shading and the label streams need of a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]

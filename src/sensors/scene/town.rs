@@ -107,6 +107,10 @@ pub struct Outfit {
     pub hair: Vec3,
     /// The umbrella's canopy colour, linear RGB (none: no umbrella).
     pub umbrella: Option<Vec3>,
+    /// The cloth pattern ([`body_aux`]'s code) and its second colour (linear RGB), and which capsules wear it
+    /// (the top, long sleeves, a dress or coat).
+    pub pattern: (u32, Vec3),
+    pub patterned: [bool; CAPSULES],
 }
 
 impl Outfit {
@@ -156,6 +160,17 @@ impl Outfit {
             // A bald head shows its scalp where hair would be.
             hair: if figure.hair == HairStyle::Bald { skin } else { hair },
             umbrella: figure.umbrella.map(linear),
+            pattern: match figure.pattern {
+                Some((Pattern::Stripes, c)) => (PATTERN_STRIPES, linear(c)),
+                Some((Pattern::Checks, c)) => (PATTERN_CHECKS, linear(c)),
+                None => (PATTERN_PLAIN, top),
+            },
+            patterned: WEAR.map(|w| match w {
+                Wear::Top => true,
+                Wear::Sleeve => !short_sleeves,
+                Wear::Garment => matches!(figure.garment, Garment::Dress | Garment::Coat),
+                _ => false,
+            }),
         }
     }
 }

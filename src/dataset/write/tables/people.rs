@@ -78,6 +78,13 @@ pub fn pedestrians_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBa
             )),
         )
         .column(
+            "pattern",
+            true,
+            Arc::new(StringArray::from_iter(
+                peds.iter().map(|p| p.identity.figure.pattern.map(|c| c.0.name())),
+            )),
+        )
+        .column(
             "crosser",
             false,
             Arc::new(BooleanArray::from_iter((0..n).map(|i| Some(label(i).crosser)))),
