@@ -66,6 +66,8 @@ def main():
                 "bag_left_side": ped["carry"] == "shoulder_bag",
                 "cap": bool(ped["headwear"]),
                 "clothes_below_knee": ped["garment"] == "coat",
+                "umbrella": bool(ped["umbrella"]),
+                "hood": bool(ped["hood"]),
             }
             for label, want in worn.items():
                 if set(a["appearance"][label]) != {str(int(want))}:

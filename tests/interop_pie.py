@@ -182,7 +182,7 @@ def setup(name, formats):
     peds = {
         (r["clip_id"], r["pedestrian"]): r
         for r in table(args.dataset, "pedestrians", ["clip_id", "pedestrian", "crosser", "age_group", "gender",
-                                                     "headwear", "garment", "carry"])
+                                                     "headwear", "garment", "carry", "umbrella", "hood"])
     }
     ann_cols = ["clip_id", "frame", "pedestrian", "bbox_x_min", "bbox_y_min", "bbox_x_max", "bbox_y_max",
                 "crossing", "state", "occlusion", "on_crosswalk"] + BEHAVIOUR_COLUMNS + (["keypoints"] if poses_too else [])
