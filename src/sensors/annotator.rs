@@ -1,6 +1,6 @@
 //! The annotator box: the tight box of the projected body redrawn as a person draws it in JAAD or PIE — looser
 //! than the silhouette (a margin, and never narrower than a drawn aspect), on whole pixels, with a little noise
-//! from frame to frame (`annotations.annotator_box`). A pure function of (clip seed, pedestrian, frame): the
+//! from frame to frame (`annotations.annotator_box`); small boxes drawn relatively wider (`width_pad_px`). A pure function of (clip seed, pedestrian, frame): the
 //! per-pedestrian draws and the per-frame noise come from SplitMix64 of those, so any thread computes the same.
 //!
 //! With `keyframe_every` above one frame, [`keyframe_track`] redraws a pedestrian's boxes as an annotation tool
@@ -38,7 +38,7 @@ pub fn annotator_box(
     let h = (y1 - y0).max(0.0);
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let h_drawn = h * (1.0 + margin);
-    let w_drawn = ((x1 - x0).max(0.0) + margin * h).max(min_aspect * h_drawn);
+    let w_drawn = ((x1 - x0).max(0.0) + margin * h).max(min_aspect * h_drawn + params.width_pad_px);
     let at = splitmix64(who ^ splitmix64(u64::from(frame) + 1));
     let noise = |edge: u64| params.noise_px * normal(splitmix64(at ^ edge), splitmix64(at ^ (edge + 16)));
     let mut b = [
@@ -135,6 +135,7 @@ mod tests {
         let params = AnnotatorBox {
             margin_frac: Range(0.1, 0.1),
             min_aspect: Range(0.4, 0.4),
+            width_pad_px: 0.0,
             noise_px: 0.0,
             whole_pixels: true,
             keyframe_every: crate::spec::types::CountRange(1, 1),
@@ -142,6 +143,26 @@ mod tests {
         let b = annotator_box([100.2, 200.0, 120.2, 300.0], &params, (7, 3, 0), (1920, 1080));
         // Height 100 → 110 (5 above, 5 below); width max(20 + 10, 0.4 × 110 = 44) = 44 around x 110.2.
         assert_eq!(b, [88.0, 195.0, 132.0, 305.0]);
+    }
+
+    #[test]
+    fn the_width_pad_widens_small_boxes_relatively_more_than_large_ones() {
+        let params = AnnotatorBox {
+            margin_frac: Range(0.0, 0.0),
+            min_aspect: Range(0.4, 0.4),
+            width_pad_px: 4.0,
+            noise_px: 0.0,
+            whole_pixels: false,
+            keyframe_every: crate::spec::types::CountRange(1, 1),
+        };
+        // Narrow silhouettes 40 and 400 px tall: the narrowest width is 0.4 × height + 4 px.
+        let small = annotator_box([100.0, 200.0, 105.0, 240.0], &params, (7, 3, 0), (1920, 1080));
+        let large = annotator_box([100.0, 200.0, 150.0, 600.0], &params, (7, 3, 0), (1920, 1080));
+        assert_eq!(small, [102.5 - 10.0, 200.0, 102.5 + 10.0, 240.0]);
+        assert_eq!(large, [125.0 - 82.0, 200.0, 125.0 + 82.0, 600.0]);
+        // A silhouette wider than that keeps its own width: the pad widens only the narrowest box.
+        let wide = annotator_box([100.0, 200.0, 130.0, 240.0], &params, (7, 3, 0), (1920, 1080));
+        assert_eq!(wide[2] - wide[0], 30.0);
     }
 
     #[test]
@@ -176,6 +197,7 @@ mod tests {
         let params = AnnotatorBox {
             margin_frac: Range(0.0, 0.0),
             min_aspect: Range(0.0, 0.0),
+            width_pad_px: 0.0,
             noise_px: 0.0,
             whole_pixels: true,
             keyframe_every: crate::spec::types::CountRange(10, 10),

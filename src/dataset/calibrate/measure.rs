@@ -325,6 +325,49 @@ impl Spread {
     }
 }
 
+/// How wide people draw boxes of a given height: benchmark windows' mean aspect (width / height) against their
+/// mean height in pixels, fitted as `aspect = a + pad_px / height` by least squares (a width of
+/// `a × height + pad_px`); `None` for fewer than 10 windows or heights that do not vary.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AspectFit {
+    /// The pixels people add to a box's width whatever its height.
+    pub pad_px: f64,
+    /// The spread of the windows' aspect less `pad_px / height`: the aspect a box of any height is drawn with.
+    pub residual: Spread,
+}
+
+/// [`AspectFit`] of the windows of `videos`.
+pub fn aspect_fit(videos: &[RealVideo], pab: &PabOptions) -> Option<AspectFit> {
+    let pairs: Vec<(f64, f64)> = videos
+        .iter()
+        .flat_map(|v| {
+            windows(std::slice::from_ref(v), pab)
+                .into_iter()
+                .map(move |w| (w.quantities[0] * v.height_px, w.quantities[2]))
+        })
+        .filter(|&(h, a)| h >= 1.0 && a.is_finite())
+        .collect();
+    if pairs.len() < 10 {
+        return None;
+    }
+    let n = pairs.len() as f64;
+    let (mean_x, mean_y) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(sx, sy), &(h, a)| (sx + 1.0 / h / n, sy + a / n));
+    let (sxy, sxx) = pairs.iter().fold((0.0, 0.0), |(sxy, sxx), &(h, a)| {
+        let dx = 1.0 / h - mean_x;
+        (sxy + dx * (a - mean_y), sxx + dx * dx)
+    });
+    if sxx <= 0.0 {
+        return None;
+    }
+    let pad_px = (sxy / sxx).max(0.0);
+    Some(AspectFit {
+        pad_px,
+        residual: Spread::of(pairs.iter().map(|&(h, a)| a - pad_px / h).collect()),
+    })
+}
+
 /// What one class's windows look like.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct ClassSummary {

@@ -103,8 +103,11 @@ pub struct Fit {
     /// the box's distance through the mean height), the same tracks as `walker_ahead_m`.
     pub walker_lateral_m: (f64, f64),
     /// `annotations.annotator_box.min_aspect`: the 10th and 90th percentiles of the windows' box aspect
-    /// (width / height), both classes.
+    /// (width / height) less `width_pad_px` / height, both classes ([`measure::aspect_fit`]).
     pub min_aspect: (f64, f64),
+    /// `annotations.annotator_box.width_pad_px`: the pixels the real boxes' width has on top of a share of
+    /// their height (small boxes are drawn relatively wider; [`measure::aspect_fit`]).
+    pub width_pad_px: f64,
     /// `annotations.annotator_box.keyframe_every`: the 25th and 75th percentiles of the lengths of the pieces
     /// over which the real boxes' left edge moves linearly ([`measure::linear_pieces`]), frames.
     pub keyframe_every: (u32, u32),
@@ -214,12 +217,14 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     }
     let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
     let walkers_aside = measure::Spread::of(walkers_aside);
-    let aspect = measure::Spread::of(
-        measure::windows(videos, &options.pab)
-            .iter()
-            .map(|w| w.quantities[2])
-            .collect(),
-    );
+    let aspect = measure::aspect_fit(videos, &options.pab).unwrap_or(measure::AspectFit {
+        pad_px: 0.0,
+        residual: measure::Spread {
+            p10: 0.3,
+            p50: 0.4,
+            p90: 0.45,
+        },
+    });
     let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
     let lo = round(seen.p10.clamp(0.5, 30.0), 1);
     let fit = Fit {
@@ -250,9 +255,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
             (lo, round(walkers_aside.p90.clamp(lo, 100.0), 1))
         },
         min_aspect: (
-            round(aspect.p10.clamp(0.0, 2.0), 2),
-            round(aspect.p90.clamp(0.0, 2.0), 2),
+            round(aspect.residual.p10.clamp(0.0, 2.0), 2),
+            round(aspect.residual.p90.clamp(0.0, 2.0), 2),
         ),
+        width_pad_px: round(aspect.pad_px.clamp(0.0, 200.0), 1),
         sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
         heading_wobble_sd_deg: measure::pan_sd_deg(videos, focal_px).map(|sd| round(sd.clamp(0.0, 10.0), 1)),
         keyframe_every: {
@@ -356,8 +362,8 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     }
     let _ = writeln!(
         out,
-        "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows (p10, p90)\n    keyframe_every: [{}, {}]  # frames over which the real boxes move linearly (p25, p75): keyframes, interpolated",
-        f.min_aspect.0, f.min_aspect.1, f.keyframe_every.0, f.keyframe_every.1
+        "annotations:\n  export_box: annotator  # exports and comparisons read the hand-drawn-like box\n  annotator_box:\n    min_aspect: [{}, {}]  # the real boxes' width / height in benchmark windows, less width_pad_px / height (p10, p90)\n    width_pad_px: {}  # the real boxes' width = aspect x height + this (least squares over the windows)\n    keyframe_every: [{}, {}]  # frames over which the real boxes move linearly (p25, p75): keyframes, interpolated",
+        f.min_aspect.0, f.min_aspect.1, f.width_pad_px, f.keyframe_every.0, f.keyframe_every.1
     );
     out
 }

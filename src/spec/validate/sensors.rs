@@ -472,6 +472,13 @@ impl Validator<'_> {
             "a width / height ratio",
         );
         self.num(
+            "annotations.annotator_box.width_pad_px",
+            b.width_pad_px,
+            0.0,
+            200.0,
+            "pixels added to the narrowest box's width",
+        );
+        self.num(
             "annotations.annotator_box.noise_px",
             b.noise_px,
             0.0,
