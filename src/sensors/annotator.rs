@@ -1,7 +1,8 @@
 //! The annotator box: the tight box of the projected body redrawn as a person draws it in JAAD or PIE — looser
-//! than the silhouette (a margin, and never narrower than a drawn aspect), on whole pixels, with a little noise
-//! from frame to frame (`annotations.annotator_box`); small boxes drawn relatively wider (`width_pad_px`). A pure function of (clip seed, pedestrian, frame): the
-//! per-pedestrian draws and the per-frame noise come from SplitMix64 of those, so any thread computes the same.
+//! than the silhouette (a margin, and never narrower than a drawn aspect plus a few pixels, so small boxes are
+//! relatively wider), on whole pixels, with a little noise from frame to frame (`annotations.annotator_box`). A
+//! pure function of (clip seed, pedestrian, frame): the per-pedestrian draws and the per-frame noise come from
+//! SplitMix64 of those, so any thread computes the same.
 //!
 //! With `keyframe_every` above one frame, [`keyframe_track`] redraws a pedestrian's boxes as an annotation tool
 //! does between a person's keyframes: the keyframes' boxes as above, and between them the corner, width and

@@ -327,7 +327,7 @@ impl Spread {
 
 /// How wide people draw boxes of a given height: benchmark windows' mean aspect (width / height) against their
 /// mean height in pixels, fitted as `aspect = a + pad_px / height` by least squares (a width of
-/// `a × height + pad_px`); `None` for fewer than 10 windows or heights that do not vary.
+/// `a × height + pad_px`; `pad_px` is 0 for fewer than 10 windows or heights that do not vary).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct AspectFit {
     /// The pixels people add to a box's width whatever its height.
@@ -337,7 +337,7 @@ pub struct AspectFit {
 }
 
 /// [`AspectFit`] of the windows of `videos`.
-pub fn aspect_fit(videos: &[RealVideo], pab: &PabOptions) -> Option<AspectFit> {
+pub fn aspect_fit(videos: &[RealVideo], pab: &PabOptions) -> AspectFit {
     let pairs: Vec<(f64, f64)> = videos
         .iter()
         .flat_map(|v| {
@@ -347,9 +347,6 @@ pub fn aspect_fit(videos: &[RealVideo], pab: &PabOptions) -> Option<AspectFit> {
         })
         .filter(|&(h, a)| h >= 1.0 && a.is_finite())
         .collect();
-    if pairs.len() < 10 {
-        return None;
-    }
     let n = pairs.len() as f64;
     let (mean_x, mean_y) = pairs
         .iter()
@@ -358,14 +355,15 @@ pub fn aspect_fit(videos: &[RealVideo], pab: &PabOptions) -> Option<AspectFit> {
         let dx = 1.0 / h - mean_x;
         (sxy + dx * (a - mean_y), sxx + dx * dx)
     });
-    if sxx <= 0.0 {
-        return None;
-    }
-    let pad_px = (sxy / sxx).max(0.0);
-    Some(AspectFit {
+    let pad_px = if pairs.len() >= 10 && sxx > 0.0 {
+        (sxy / sxx).max(0.0)
+    } else {
+        0.0
+    };
+    AspectFit {
         pad_px,
         residual: Spread::of(pairs.iter().map(|&(h, a)| a - pad_px / h).collect()),
-    })
+    }
 }
 
 /// What one class's windows look like.

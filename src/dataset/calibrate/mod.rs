@@ -217,14 +217,7 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     }
     let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
     let walkers_aside = measure::Spread::of(walkers_aside);
-    let aspect = measure::aspect_fit(videos, &options.pab).unwrap_or(measure::AspectFit {
-        pad_px: 0.0,
-        residual: measure::Spread {
-            p10: 0.3,
-            p50: 0.4,
-            p90: 0.45,
-        },
-    });
+    let aspect = measure::aspect_fit(videos, &options.pab);
     let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
     let lo = round(seen.p10.clamp(0.5, 30.0), 1);
     let fit = Fit {
