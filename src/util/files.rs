@@ -1,10 +1,13 @@
-//! File-system helpers shared by every writer: atomic writes (a complete file or none at the target path).
+//! File-system helpers shared by every writer: atomic writes (a complete file or none at the target path;
+//! written straight to a device or FIFO, such as `--out /dev/null`, which a rename would replace).
 
 use std::io::Write;
 use std::path::Path;
 
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename, creating the
-/// directory if needed, so that a complete file or nothing appears at `path`.
+/// directory if needed, so that a complete file or nothing appears at `path`. A `path` that is a device, a FIFO
+/// or a socket (`/dev/null`, `/dev/stdout`, a pipe) is written to directly: a rename would put a regular file in
+/// its place.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     write_atomically_with(path, bytes, true)
 }
@@ -41,7 +44,8 @@ pub fn read_capped(path: &Path, cap_bytes: u64) -> std::io::Result<Vec<u8>> {
 #[derive(Debug)]
 pub struct AtomicFile {
     path: std::path::PathBuf,
-    tmp: std::path::PathBuf,
+    /// The temporary name; `None` where `path` is a device or FIFO, written directly ([`is_special`]).
+    tmp: Option<std::path::PathBuf>,
     file: Option<std::io::BufWriter<std::fs::File>>,
     hasher: sha2::Sha256,
     bytes: u64,
@@ -50,11 +54,11 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts writing the file at `path` (creating its directory).
     pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
-        let tmp = temporary_path(path);
-        if let Some(dir) = tmp.parent() {
+        let tmp = (!is_special(path)).then(|| temporary_path(path));
+        if let Some(dir) = tmp.as_deref().and_then(Path::parent) {
             std::fs::create_dir_all(dir)?;
         }
-        let file = std::fs::File::create(&tmp)?;
+        let file = std::fs::File::create(tmp.as_deref().unwrap_or(path))?;
         Ok(AtomicFile {
             path: path.to_path_buf(),
             tmp,
@@ -84,8 +88,10 @@ impl AtomicFile {
         }
         // Closed before the rename; on failure the temporary file goes too.
         self.file = None;
-        if let Err(e) = std::fs::rename(&self.tmp, &self.path) {
-            std::fs::remove_file(&self.tmp).ok();
+        if let Some(tmp) = &self.tmp
+            && let Err(e) = std::fs::rename(tmp, &self.path)
+        {
+            std::fs::remove_file(tmp).ok();
             return Err(e);
         }
         let hasher = std::mem::take(&mut self.hasher);
@@ -112,8 +118,10 @@ impl Write for AtomicFile {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.file.take().is_some() {
-            std::fs::remove_file(&self.tmp).ok();
+        if self.file.take().is_some()
+            && let Some(tmp) = &self.tmp
+        {
+            std::fs::remove_file(tmp).ok();
         }
     }
 }
@@ -131,7 +139,16 @@ pub(crate) fn temporary_path(path: &Path) -> std::path::PathBuf {
     dir.join(format!(".{name}.tmp-{}", std::process::id()))
 }
 
+/// Whether `path` (followed through links) is neither a regular file nor a directory: a device, a FIFO or a
+/// socket, which is written to in place.
+fn is_special(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| !m.is_file() && !m.is_dir())
+}
+
 fn write_atomically_with(path: &Path, bytes: &[u8], sync: bool) -> std::io::Result<()> {
+    if is_special(path) {
+        return std::fs::OpenOptions::new().write(true).open(path)?.write_all(bytes);
+    }
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -152,4 +169,77 @@ fn write_atomically_with(path: &Path, bytes: &[u8], sync: bool) -> std::io::Resu
         std::fs::remove_file(&tmp).ok();
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A FIFO in a fresh directory, made with `mkfifo` (no unsafe code here), and its read end opened without
+    /// blocking, so that writers can open it and a regression (a rename over it) fails instead of hanging.
+    fn fifo(name: &str) -> (std::path::PathBuf, std::fs::File) {
+        use std::os::unix::fs::OpenOptionsExt;
+        let dir = std::env::temp_dir().join(format!("pedsynth-fifo-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("out");
+        std::fs::remove_file(&path).ok();
+        let made = std::process::Command::new("mkfifo")
+            .arg(&path)
+            .status()
+            .expect("runs mkfifo");
+        assert!(made.success(), "mkfifo");
+        // O_NONBLOCK (Linux's value): the open returns at once with no writer.
+        let reader = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(0o4000)
+            .open(&path)
+            .expect("opens the read end");
+        (path, reader)
+    }
+
+    fn drain(mut reader: std::fs::File) -> Vec<u8> {
+        use std::io::Read;
+        let mut out = Vec::new();
+        reader.read_to_end(&mut out).ok();
+        out
+    }
+
+    fn is_fifo(path: &Path) -> bool {
+        use std::os::unix::fs::FileTypeExt;
+        std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+    }
+
+    #[test]
+    fn a_fifo_or_device_is_written_in_place_not_replaced_by_a_file() {
+        // `--out /dev/null` as root once replaced the device with a regular file (a rename over it); a FIFO
+        // stands in for the device here, so that a regression cannot break the machine's /dev/null.
+        let (path, reader) = fifo("whole");
+        write_atomically(&path, b"profile").expect("writes");
+        assert_eq!(drain(reader), b"profile");
+        assert!(is_fifo(&path), "the FIFO is still a FIFO");
+
+        let (path, reader) = fifo("pieces");
+        let mut file = AtomicFile::create(&path).expect("opens");
+        file.write_all(b"two ").expect("writes");
+        file.write_all(b"pieces").expect("writes");
+        let (bytes, _) = file.commit().expect("commits");
+        assert_eq!((bytes, drain(reader)), (10, b"two pieces".to_vec()));
+        assert!(is_fifo(&path), "the FIFO is still a FIFO");
+        std::fs::remove_dir_all(path.parent().expect("dir")).ok();
+    }
+
+    #[test]
+    fn a_regular_file_is_replaced_whole_and_leaves_no_temporary_file() {
+        let dir = std::env::temp_dir().join(format!("pedsynth-atomic-{}", std::process::id()));
+        let path = dir.join("out.txt");
+        write_atomically(&path, b"first").expect("writes");
+        write_atomically(&path, b"second").expect("writes");
+        assert_eq!(std::fs::read(&path).expect("reads"), b"second");
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("out.txt")]);
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }
