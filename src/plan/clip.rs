@@ -47,6 +47,7 @@ pub(super) fn plan_clip(
             courtesy_lateral_m: ego_spec.courtesy_lateral_m,
             courtesy_stop_short_m: ego_spec.courtesy_stop_short_m,
             courtesy_patience_s: draw(&mut rng, ego_spec.courtesy_patience_s),
+            courtesy_roll_up: ego_spec.courtesy_roll_up,
         };
         let placed = plan_pedestrians(
             spec,

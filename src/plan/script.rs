@@ -253,6 +253,9 @@ pub struct EgoScript {
     pub courtesy_stop_short_m: f64,
     /// ... for at most this long, seconds.
     pub courtesy_patience_s: f64,
+    /// It rolls up to a crosser that waits for it to come near (`traffic.ego.courtesy_roll_up`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub courtesy_roll_up: bool,
 }
 
 /// Driving profiles.

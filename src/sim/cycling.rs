@@ -288,6 +288,7 @@ mod tests {
             crossing: velocity != DVec2::ZERO,
             approaching_curb: false,
             waiting_at_curb: false,
+            steps_out_ego_within_m: None,
         }
     }
 

@@ -551,6 +551,7 @@ impl<'a> Sim<'a> {
             crossing: p.activity.crossing_motion(),
             approaching_curb: p.heading_for_curb(),
             waiting_at_curb: p.waiting_at_curb(),
+            steps_out_ego_within_m: p.traits.step_out_ego_within_m,
         }));
         // Vehicles closing in on an emergency vehicle stop for it.
         if self.sirens {

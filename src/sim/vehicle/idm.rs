@@ -15,6 +15,10 @@ const PED_CORRIDOR_MARGIN_M: f64 = 0.6;
 /// The ego stops at least this many metres short of a waiting pedestrian per metre it stands to the side (1.4:
 /// about 35° off the heading, inside the camera's 45° half field of view).
 const COURTESY_STOP_PER_LATERAL: f64 = 1.4;
+/// A yielding ego rolls up to this fraction of the distance a waiting crosser waits for it to come within.
+const COURTESY_INVITE_FRACTION: f64 = 0.7;
+/// ... but its front stops at least this far short of the pedestrian (along its path), metres.
+const COURTESY_MIN_STOP_SHORT_M: f64 = 2.0;
 /// A vehicle stopping for a light aims this far short of the stop line, metres.
 const STOP_LINE_MARGIN_M: f64 = 1.0;
 /// Time constant of the ego's easing off to its courtesy speed, seconds.
@@ -187,9 +191,25 @@ pub(crate) fn accel_for(i: usize, vehicles: &[Vehicle], zones: &[ConflictZone], 
             }
             approaching = true;
             if p.waiting_at_curb && !c.patience_spent() {
-                // Far enough back that the pedestrian stays in the driver's (and the camera's) view.
-                let stop_short = c.stop_short_m.max(COURTESY_STOP_PER_LATERAL * lateral);
-                let gap = s_p - me.s_m - me.half_length_m - stop_short;
+                // Far enough back that the pedestrian stays in the driver's (and the camera's) view (IDM's
+                // minimum gap short of that); for one that waits for the ego to come near, near enough for it to
+                // go: the ego's centre rolls up to within `COURTESY_INVITE_FRACTION` of that distance, its front
+                // at least `COURTESY_MIN_STOP_SHORT_M` short of the pedestrian.
+                let gap = match p.steps_out_ego_within_m.filter(|_| c.roll_up) {
+                    Some(d) => {
+                        let along_m = ((COURTESY_INVITE_FRACTION * d).powi(2) - lateral * lateral)
+                            .max(0.0)
+                            .sqrt();
+                        let stop_short = (along_m - me.half_length_m)
+                            .min(c.stop_short_m)
+                            .max(COURTESY_MIN_STOP_SHORT_M);
+                        s_p - me.s_m - me.half_length_m - stop_short + me.min_gap_m
+                    }
+                    None => {
+                        let stop_short = c.stop_short_m.max(COURTESY_STOP_PER_LATERAL * lateral);
+                        s_p - me.s_m - me.half_length_m - stop_short
+                    }
+                };
                 accel = accel.min(idm_to(gap.max(0.0), 0.0));
             }
         }

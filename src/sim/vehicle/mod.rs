@@ -148,6 +148,7 @@ impl Vehicle {
             lateral_m: script.courtesy_lateral_m,
             stop_short_m: script.courtesy_stop_short_m,
             patience_s: script.courtesy_patience_s,
+            roll_up: script.courtesy_roll_up,
             yielded_s: 0.0,
         })
     }
@@ -431,6 +432,8 @@ pub(crate) struct Courtesy {
     pub lateral_m: f64,
     pub stop_short_m: f64,
     pub patience_s: f64,
+    /// It rolls up to a crosser that waits for it to come near.
+    pub roll_up: bool,
     /// Time it has yielded (a waiting pedestrian ahead), seconds.
     pub yielded_s: f64,
 }
@@ -453,4 +456,7 @@ pub(crate) struct PedView {
     pub approaching_curb: bool,
     /// Waiting at the curb attentively (looking, checking the traffic, hesitating): the ego stops short.
     pub waiting_at_curb: bool,
+    /// How near the ego must come before it steps out (`crossing.scenario.crosser_ego_within_m`), metres from
+    /// the ego's centre: a yielding ego rolls up to within that rather than stop short of it.
+    pub steps_out_ego_within_m: Option<f64>,
 }

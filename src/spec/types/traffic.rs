@@ -247,6 +247,12 @@ pub struct Ego {
     /// ... and waits at most this long, seconds `[min, max]` drawn per clip; then it drives on at its eased speed
     /// (the pedestrian still may cross: the ego brakes for anyone crossing in its path).
     pub courtesy_patience_s: Range,
+    /// For a crosser that waits for the ego to come near before it steps out
+    /// (`crossing.scenario.crosser_ego_within_m`), the ego rolls up to within 0.7 of that distance (its front at
+    /// least 2 m short of the pedestrian) instead of stopping `courtesy_stop_short_m` short, where the two would
+    /// otherwise wait for each other: off by default.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub courtesy_roll_up: bool,
     /// The ego's heading about its path as a real car's wanders (lane-keeping corrections, the road's camber
     /// and curves a lane does not have): off by default.
     #[serde(skip_serializing_if = "super::is_default")]
@@ -288,6 +294,7 @@ impl Default for Ego {
             courtesy_lateral_m: 10.0,
             courtesy_stop_short_m: 8.0,
             courtesy_patience_s: Range(5.0, 12.0),
+            courtesy_roll_up: false,
             heading_wobble: HeadingWobble::default(),
         }
     }
