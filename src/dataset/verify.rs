@@ -9,7 +9,8 @@
 //!   metadata, and all files of a table have one Arrow schema (names, types, nullability).
 //! - Rows and joins: `clips` has one row; `frames` has `frame_count` rows numbered 0..; `pedestrians` has the
 //!   clip's pedestrians; `tracks` one row per pedestrian and frame; `annotations` the clip's annotated samples,
-//!   each on a `tracks` row marked annotated and no other; `vehicles` one row per vehicle and frame.
+//!   each on a `tracks` row marked annotated and no other; `vehicles` one row per vehicle and frame;
+//!   `parked_cars` numbered 0.. with their instance ids.
 //!
 //! Problems are collected, never panicked on: a dataset is input (another tool may have written or changed it).
 
@@ -243,6 +244,22 @@ fn check_rows(layout: &Layout, id: &str, rows: &BTreeMap<&str, u64>, p: &mut Vec
             p.push(format!(
                 "tables/frames/{id}.parquet: a frame index beyond frame_count {frames}"
             ));
+        }
+    }
+    let mut next_car = 0u32;
+    for b in tables::read(&file("parked_cars"), &["parked_car", "instance"])? {
+        let (car, instance) = (b.u32s("parked_car")?, b.u32s("instance")?);
+        for i in 0..b.rows() {
+            let want = u32::from(crate::sensors::scene::parked_instance(next_car));
+            if car.value(i) != next_car || instance.value(i) != want {
+                p.push(format!(
+                    "tables/parked_cars/{id}.parquet: row {next_car} is parked car {} with instance {} (expected \
+                     {next_car}, {want})",
+                    car.value(i),
+                    instance.value(i)
+                ));
+            }
+            next_car += 1;
         }
     }
     let mut marked = BTreeSet::new();

@@ -137,6 +137,7 @@ pub(super) fn plan_clip(
         timeline_extension_s: f64::from(frame_count - basics.frame_count) / f64::from(fps),
         labelled_crossers: basics.labelled_crossers,
         look,
+        parked_car_share: spec.traffic.parked_cars.share,
     })
 }
 

@@ -146,6 +146,15 @@ pub struct ClipScript {
     /// How the clip's light and camera look under `domain_randomisation` (absent from the plan file without it).
     #[serde(default, skip_serializing_if = "ClipLook::is_identity")]
     pub look: ClipLook,
+    /// Share of the curb's candidate places that hold a parked car (`traffic.parked_cars.share`; absent from
+    /// the plan file, and no parked cars, when 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub parked_car_share: f64,
+}
+
+/// Whether a share is 0 (left out of the plan file).
+fn is_zero(share: &f64) -> bool {
+    *share == 0.0
 }
 
 /// A clip's draws of `domain_randomisation` for its light, camera, scenery and textures (the identity without

@@ -16,12 +16,12 @@ use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M, Capsule};
 use super::cyclist;
-use super::scene;
+use super::occlusion::{Occluder, may_block, occluded, static_occluders};
+use super::scene::ParkedCar;
 use crate::plan::{ClipScript, Figure};
 use crate::sim::gate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px, min_box, too_small};
 use crate::sim::rig::{Camera, CameraPose};
 use crate::sim::trace::{ClipTrace, Event, Gesture, PedFrame, PedState, Reaction, WalkSignal};
-use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::spec::types::Annotations;
 use crate::world::{LaneType, RoadNetwork};
 
@@ -132,6 +132,8 @@ pub struct ClipAnnotations {
     /// Every cyclist-frame in front of the camera whose box reaches at least a pixel into the image, ordered by
     /// (frame, cyclist).
     pub cyclists: Vec<CyclistRow>,
+    /// The clip's parked cars (scenery the occlusion labels test against), by id.
+    pub parked_cars: Vec<ParkedCar>,
 }
 
 /// A cyclist seen by the camera in one frame: the box of rider and bicycle, the rider's keypoints.
@@ -183,81 +185,6 @@ pub fn crossing_labels(frames: &[PedFrame], smoothing_frames: u32) -> Vec<bool> 
         out.push(label);
     }
     out
-}
-
-/// An obstacle for occlusion rays in one frame.
-#[derive(Clone, Copy, Debug)]
-enum Occluder {
-    /// A vehicle: ground centre and `yaw.sin_cos()` (computed once per frame, not once per ray).
-    Vehicle { centre: DVec3, sin_cos: (f64, f64) },
-    /// A pedestrian body as an upright cylinder: ground point, radius, height, owner id.
-    Person {
-        ground: DVec3,
-        radius_m: f64,
-        height_m: f64,
-        owner: u32,
-    },
-    /// A street lamp's pole or a piece of street furniture (the axis-aligned box the renderer draws): its centre
-    /// and half extents.
-    Pole { centre: DVec3, half_m: DVec3 },
-}
-
-/// Whether the segment `from + t·d`, t ∈ (0, t_max), passes through the occluder.
-fn blocks(occ: &Occluder, from: DVec3, d: DVec3, t_max: f64) -> bool {
-    match *occ {
-        Occluder::Vehicle { centre, sin_cos } => crate::world::segment_hits_box(
-            from,
-            d,
-            t_max,
-            centre + DVec3::new(0.0, 0.0, VEHICLE_HEIGHT_M * 0.5),
-            sin_cos,
-            DVec3::new(VEHICLE_LENGTH_M * 0.5, VEHICLE_WIDTH_M * 0.5, VEHICLE_HEIGHT_M * 0.5),
-        ),
-        Occluder::Person {
-            ground,
-            radius_m,
-            height_m,
-            ..
-        } => crate::world::segment_hits_cylinder(from, d, t_max, ground, radius_m, height_m),
-        Occluder::Pole { centre, half_m } => crate::world::segment_hits_box(from, d, t_max, centre, (0.0, 1.0), half_m),
-    }
-}
-
-/// The lamp poles and the street furniture of the clip's scene, as the renderer draws them
-/// ([`scene::clip_lamp_posts`], [`scene::clip_furniture`]; a lamp's arm and light are above any line of sight to a
-/// pedestrian), as boxes.
-fn static_occluders(trace: &ClipTrace, town: &RoadNetwork, clip_seed: u64) -> Vec<Occluder> {
-    let posts = scene::clip_lamp_posts(trace, town);
-    let furniture = scene::clip_furniture(trace, town, clip_seed, &posts);
-    let boxes = posts
-        .iter()
-        .map(scene::LampPost::pole_box)
-        .chain(furniture.iter().map(|f| (f.centre(), f.half_m)));
-    boxes
-        .map(|(centre, half_m)| Occluder::Pole { centre, half_m })
-        .collect()
-}
-
-/// Whether the line of sight from the camera to `target` is blocked by one of `occluders` (already stripped of
-/// the target pedestrian's own body) or by a static obstacle.
-fn occluded(town: &RoadNetwork, occluders: &[Occluder], camera: DVec3, target: DVec3) -> bool {
-    let d = target - camera;
-    let t_max = 1.0 - 0.05 / d.length().max(0.05);
-    occluders.iter().any(|occ| blocks(occ, camera, d, t_max))
-        || town.first_obstacle_hit(camera, camera + d * t_max).is_some()
-}
-
-/// Whether `occ` could block any line of sight from `camera` to a point within `reach_m` (in plan view) of
-/// `target`: such a line stays within `reach_m` of the segment `camera → target` in plan view, and an
-/// occluder lies within its bounding circle, so one farther than both radii from that segment blocks none.
-fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f64) -> bool {
-    let (centre, radius_m) = match *occ {
-        Occluder::Vehicle { centre, .. } => (centre.truncate(), VEHICLE_LENGTH_M.hypot(VEHICLE_WIDTH_M) * 0.5),
-        Occluder::Person { ground, radius_m, .. } => (ground.truncate(), radius_m),
-        Occluder::Pole { centre, half_m } => (centre.truncate(), half_m.truncate().length()),
-    };
-    let r = radius_m + reach_m + 1e-6;
-    crate::world::segment_projection(camera, target, centre).1 <= r * r
 }
 
 /// The image interval `[lo, hi]` covered by a sphere along one image axis, exactly (perspective included):
@@ -380,12 +307,14 @@ pub fn annotate(
         .iter()
         .map(|l| l.iter().position(|c| *c).map(|f| f as u32))
         .collect();
+    let (statics, parked_cars) = static_occluders(script, trace, town);
     let mut out = ClipAnnotations {
         rows: Vec::new(),
         pedestrians: vec![PedestrianLabels::default(); n_peds],
         rejections: Rejections::default(),
         crossing: Vec::new(),
         cyclists: Vec::new(),
+        parked_cars,
     };
     for (i, p) in out.pedestrians.iter_mut().enumerate() {
         p.first_crossing_frame = first_crossing[i];
@@ -399,15 +328,14 @@ pub fn annotate(
         }
     }
 
-    let poles = static_occluders(trace, town, script.seed);
-    let mut occluders: Vec<Occluder> = Vec::with_capacity(poles.len() + trace.vehicles.len() + 2 * n_peds);
+    let mut occluders: Vec<Occluder> = Vec::with_capacity(statics.len() + trace.vehicles.len() + 2 * n_peds);
     let mut near: Vec<Occluder> = Vec::with_capacity(occluders.capacity());
     let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
     for frame in 0..trace.frame_count as usize {
         let Some(ego) = trace.ego.get(frame) else { break };
         let cam = camera.at(ego.pos, ego.yaw_rad);
         occluders.clear();
-        occluders.extend_from_slice(&poles);
+        occluders.extend_from_slice(&statics);
         for v in &trace.vehicles {
             if let Some(f) = v.get(frame) {
                 occluders.push(Occluder::Vehicle {
@@ -769,32 +697,5 @@ mod tests {
                 "{x} {z} {r}: {lo} {hi} vs {dlo} {dhi}"
             );
         }
-    }
-
-    #[test]
-    fn occluders_block_only_what_they_cover() {
-        let car = Occluder::Vehicle {
-            centre: DVec3::new(10.0, 0.0, 0.0),
-            sin_cos: 0.3_f64.sin_cos(),
-        };
-        let from = DVec3::new(0.0, 0.0, 1.0);
-        assert!(blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 1.0));
-        assert!(
-            !blocks(&car, from, DVec3::new(20.0, 0.0, 0.0), 0.3),
-            "target in front of the car"
-        );
-        assert!(
-            !blocks(&car, from, DVec3::new(20.0, 0.0, 3.0), 1.0),
-            "the ray passes over the roof"
-        );
-        let person = Occluder::Person {
-            ground: DVec3::new(5.0, 0.0, 0.0),
-            radius_m: 0.25,
-            height_m: 1.7,
-            owner: 1,
-        };
-        assert!(blocks(&person, from, DVec3::new(10.0, 0.0, 0.0), 1.0));
-        assert!(!blocks(&person, from, DVec3::new(10.0, 1.0, 0.0), 1.0));
-        assert!(!blocks(&person, from, DVec3::new(10.0, 0.0, 4.0), 1.0), "over the head");
     }
 }

@@ -16,6 +16,7 @@ pub mod body;
 pub mod camera;
 pub mod cyclist;
 pub mod lidar;
+mod occlusion;
 pub mod realise;
 pub mod scene;
 

@@ -38,7 +38,7 @@ pub(crate) struct Clip {
     pub(crate) towns: BTreeMap<String, TownContext>,
     pub(crate) script: ClipScript,
     pub(crate) trace: ClipTrace,
-    ann: ClipAnnotations,
+    pub(crate) ann: ClipAnnotations,
     pub(crate) rig: Rig,
 }
 
@@ -253,8 +253,9 @@ pub(crate) fn masks_match_boxes_and_keypoints(overrides: &[&str]) -> MaskReport 
     })
     .expect("rendered");
     assert_eq!(frames, c.trace.frame_count);
+    // Parked cars hide some pedestrian-frames (the heavy-rain quickstart clip: 591 checked without them, 245 with).
     assert!(
-        report.rows >= 300,
+        report.rows >= 200,
         "only {} unoccluded pedestrian-frames checked",
         report.rows
     );
@@ -306,7 +307,14 @@ fn label_streams_agree_with_each_other_and_with_the_scene() {
                 "pixel {i}: tag {sem} without an instance"
             ),
             i if i < scene::VEHICLE_INSTANCE_BASE => assert_eq!(sem, tag::PEDESTRIAN),
-            _ => assert_eq!(sem, tag::CAR),
+            // Traffic vehicles and parked cars.
+            i if !(scene::CYCLIST_INSTANCE_BASE..scene::PARKED_INSTANCE_BASE).contains(&i) => {
+                assert_eq!(sem, tag::CAR)
+            }
+            _ => assert!(
+                sem == tag::RIDER || sem == tag::BICYCLE,
+                "pixel {i}: cyclist instance, tag {sem}"
+            ),
         }
         if sem == tag::SKY {
             assert_eq!(img.depth_m[i], SKY_DEPTH_M);

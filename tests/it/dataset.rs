@@ -142,7 +142,7 @@ fn read_table(dir: &Path, table: &str, spec_hash: &str) -> Vec<RecordBatch> {
         assert_eq!(kv["pedsynth.table"], table, "{}", path.display());
         assert_eq!(kv["pedsynth.clip_id"], clip_id, "{}", path.display());
         assert_eq!(kv["pedsynth.spec_hash"], spec_hash, "{}", path.display());
-        assert_eq!(kv["pedsynth.schema_version"], "10", "{}", path.display());
+        assert_eq!(kv["pedsynth.schema_version"], "11", "{}", path.display());
         assert_eq!(kv["pedsynth.version"], env!("CARGO_PKG_VERSION"), "{}", path.display());
         for batch in builder.build().expect("reader") {
             let batch = batch.expect("batch");

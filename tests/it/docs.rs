@@ -122,7 +122,7 @@ fn dataset_md_documents_every_arrow_field_the_writer_declares() {
         }
     }
     assert!(
-        schemas.len() == 14 && fields > 200,
+        schemas.len() == 15 && fields > 200,
         "{} schemas, {fields} fields",
         schemas.len()
     );

@@ -22,6 +22,7 @@ mod imaging;
 mod intention;
 mod lens;
 mod lidar;
+mod parked;
 mod plan_file;
 mod planner;
 mod realise;

@@ -177,6 +177,7 @@ fn clip(
         timeline_extension_s: 0.0,
         labelled_crossers: None,
         look: Default::default(),
+        parked_car_share: 0.0,
     }
 }
 

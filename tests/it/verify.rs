@@ -38,7 +38,7 @@ fn verify_passes_a_fresh_dataset_and_names_every_kind_of_damage() {
     assert_eq!(code, 0, "{stderr}");
     let (code, stdout, stderr) = verify(&ds);
     assert_eq!(code, Some(0), "{stderr}");
-    assert!(stdout.contains("OK — 2 clips complete; 22 table files"), "{stdout}");
+    assert!(stdout.contains("OK — 2 clips complete; 24 table files"), "{stdout}");
     assert!(stdout.contains("sensor files"), "{stdout}");
 
     let damage = |what: &str, path: &Path, change: &dyn Fn(&Path), expect: &str| {

@@ -153,6 +153,7 @@ impl DatasetWriter {
                 "cyclists",
                 tables::cyclists_batch(script, trace, ann, plan.spec.annotations.pose_format),
             ),
+            ("parked_cars", tables::parked_cars_batch(script, ann)),
             ("events", tables::events_batch(script, trace)),
             ("traffic_lights", tables::traffic_lights_batch(script, trace)),
             (

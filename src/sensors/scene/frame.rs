@@ -206,7 +206,7 @@ impl FrameScene {
                 dp -= dp.round();
                 frame.crank_phase = (a.crank_phase + dp * t.alpha).rem_euclid(1.0);
             }
-            let instance = CYCLIST_INSTANCE_BASE.saturating_add(cs.id.min(16_383) as u16);
+            let instance = CYCLIST_INSTANCE_BASE.saturating_add(cs.id.min(8_191) as u16);
             let rider = cyclist::rider_pose(&frame, cs.rider.height_m, &cs.rider.figure);
             self.push_body(stat, &rider, outfit, instance, tag::RIDER);
             let tyre = linear([22, 22, 22]);
@@ -269,82 +269,15 @@ impl FrameScene {
         }
     }
 
-    /// Pushes a car; `light_bar`: an emergency vehicle's light bar on the roof, with its red half lit (`true`)
-    /// or its blue half.
+    /// Pushes a traffic vehicle (lamps lit; `light_bar`: an emergency vehicle's, see [`Mesh::car`]) and its head
+    /// lamps' light.
     fn push_vehicle(&mut self, pos: Vec3, yaw: f32, paint: Vec3, instance: u16, light_bar: Option<bool>) {
-        let (l, w, h) = (VEHICLE_LENGTH_M as f32, VEHICLE_WIDTH_M as f32, VEHICLE_HEIGHT_M as f32);
+        self.mesh.car(pos, yaw, paint, instance, CarLamps::Lit { light_bar });
+        let l = VEHICLE_LENGTH_M as f32;
         let (s, c) = yaw.sin_cos();
         let fwd = Vec2::new(c, s);
-        let centre = pos.truncate();
-        let base = pos.z;
-        let car = |material, albedo| Prim {
-            material,
-            tag: tag::CAR,
-            instance,
-            albedo,
-            albedo2: albedo,
-            normal: Vec3::Z,
-            aux: 0,
-        };
-        let body = car(Material::CarPaint, paint);
-        let glass = car(Material::CarGlass, linear([14, 16, 20]));
-        let tyre = car(Material::Tyre, linear([20, 20, 20]));
-        // Lower body, cabin (glass sides, painted roof), four wheels.
-        self.mesh.upright_box(
-            centre,
-            yaw,
-            Vec2::new(l * 0.5, w * 0.5),
-            [base + 0.3, base + 0.55 * h + 0.15],
-            body,
-            body,
-        );
-        self.mesh.upright_box(
-            centre - fwd * (0.08 * l),
-            yaw,
-            Vec2::new(l * 0.26, w * 0.45),
-            [base + 0.55 * h + 0.15, base + h],
-            glass,
-            body,
-        );
-        for (fx, sy) in [(0.32f32, 1.0f32), (0.32, -1.0), (-0.32, 1.0), (-0.32, -1.0)] {
-            let wc = centre + fwd * (fx * l) + fwd.perp() * (sy * (w * 0.5 - 0.14));
-            self.mesh
-                .upright_box(wc, yaw, Vec2::new(0.33, 0.13), [base, base + 0.64], tyre, tyre);
-        }
-        // Lamps: small boxes standing just out of the front and rear faces.
-        for (fx, mat, albedo) in [
-            (0.5f32, Material::HeadLamp, linear([240, 240, 230])),
-            (-0.5, Material::TailLamp, linear([160, 10, 10])),
-        ] {
-            for sy in [1.0f32, -1.0] {
-                let lc = centre + fwd * (fx * l + fx.signum() * 0.01) + fwd.perp() * (sy * w * 0.33);
-                self.mesh.upright_box(
-                    lc,
-                    yaw,
-                    Vec2::new(0.03, 0.16),
-                    [base + 0.6, base + 0.75],
-                    car(mat, albedo),
-                    car(mat, albedo),
-                );
-            }
-        }
-        if let Some(red_lit) = light_bar {
-            let roof = centre - fwd * (0.08 * l);
-            for (sy, lit, colour) in [(1.0f32, red_lit, [255, 20, 20]), (-1.0, !red_lit, [30, 60, 255])] {
-                let albedo = if lit { linear(colour) } else { linear(colour) * 0.15 };
-                let lamp = car(Material::Beacon, albedo);
-                self.mesh.upright_box(
-                    roof + fwd.perp() * (sy * 0.3),
-                    yaw,
-                    Vec2::new(0.12, 0.28),
-                    [base + h, base + h + 0.14],
-                    lamp,
-                    lamp,
-                );
-            }
-        }
         self.head_lamps.push((
-            Vec3::new(centre.x + fwd.x * 0.5 * l, centre.y + fwd.y * 0.5 * l, base + 0.7),
+            Vec3::new(pos.x + fwd.x * 0.5 * l, pos.y + fwd.y * 0.5 * l, pos.z + 0.7),
             Vec3::new(fwd.x, fwd.y, -0.05).normalize(),
         ));
     }

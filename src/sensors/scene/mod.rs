@@ -4,7 +4,8 @@
 //!
 //! - Static part ([`StaticScene`]): the lane pieces near the ego's path (roads at their elevation, sidewalks
 //!   raised by the world's curb, curb faces), a terrain plane, buildings (walls and roofs), trees, poles and
-//!   street lamps (synthesised along sidewalks; towns and maps rarely carry them). Lane markings and crosswalk
+//!   street lamps (synthesised along sidewalks; towns and maps rarely carry them), street furniture and parked
+//!   cars (per clip, [`clip_furniture`], [`clip_parked_cars`]). Lane markings and crosswalk
 //!   stripes are not geometry: they are painted by the surface functions ([`road_paint`]) from the lane
 //!   piece a road pixel belongs to, so the label streams and the image agree exactly.
 //! - Dynamic part ([`FrameScene`]): traffic vehicles (body, cabin, wheels, lamps) and pedestrians (the
@@ -14,9 +15,11 @@
 //! Positions are `f32` metres relative to the clip's [`StaticScene::origin`] (a world point near the ego's
 //! path), which keeps single precision at the millimetre over a town.
 
+mod car;
 mod frame;
 mod furniture;
 mod paint;
+mod parked;
 mod recolour;
 mod town;
 
@@ -33,9 +36,11 @@ use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::util::mix::splitmix64;
 use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDirection};
 
+pub use car::*;
 pub use frame::*;
 pub use furniture::*;
 pub use paint::*;
+pub use parked::*;
 pub use recolour::*;
 pub use town::*;
 
@@ -146,12 +151,22 @@ pub mod tag {
 /// Instance ids of the `instance` stream (16-bit): 0 for static scenery and sky, `1 + pedestrian` for a
 /// pedestrian (its id in the tables), [`CHILD_INSTANCE_BASE`]` + parent` for the child walking beside a parent,
 /// [`VEHICLE_INSTANCE_BASE`]` + vehicle` for a traffic vehicle (its id in the `vehicles` table),
-/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist.
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist, [`PARKED_INSTANCE_BASE`]` + car` for a parked car (its id
+/// in the `parked_cars` table).
 pub const CHILD_INSTANCE_BASE: u16 = 16_384;
 /// See [`CHILD_INSTANCE_BASE`].
 pub const VEHICLE_INSTANCE_BASE: u16 = 32_768;
-/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist (rider and bicycle; its id in the `cyclists` table).
+/// [`CYCLIST_INSTANCE_BASE`]` + cyclist` for a cyclist (rider and bicycle; its id in the `cyclists` table; ids beyond
+/// 8,191 share the last instance).
 pub const CYCLIST_INSTANCE_BASE: u16 = 49_152;
+/// [`PARKED_INSTANCE_BASE`]` + car` for a parked car (its id in the `parked_cars` table; ids beyond 8,191 share the
+/// last instance).
+pub const PARKED_INSTANCE_BASE: u16 = 57_344;
+
+/// The instance id of parked car `id`.
+pub fn parked_instance(id: u32) -> u16 {
+    PARKED_INSTANCE_BASE.saturating_add(id.min(u32::from(u16::MAX - PARKED_INSTANCE_BASE)) as u16)
+}
 
 /// The instance id of pedestrian `id`.
 pub fn pedestrian_instance(id: u32) -> u16 {
@@ -159,11 +174,13 @@ pub fn pedestrian_instance(id: u32) -> u16 {
 }
 
 /// The actor an instance id belongs to, as the tables number it: the pedestrian id (for a pedestrian and the
-/// child walking with it), the vehicle id or the cyclist id; `None` for the static scene. Undoes
-/// [`pedestrian_instance`], [`CHILD_INSTANCE_BASE`], [`VEHICLE_INSTANCE_BASE`] and [`CYCLIST_INSTANCE_BASE`].
+/// child walking with it), the vehicle id, the cyclist id or the parked car's id; `None` for the static scene.
+/// Undoes [`pedestrian_instance`], [`CHILD_INSTANCE_BASE`], [`VEHICLE_INSTANCE_BASE`], [`CYCLIST_INSTANCE_BASE`]
+/// and [`parked_instance`].
 pub fn actor_of_instance(instance: u16) -> Option<u32> {
     match instance {
         0 => None,
+        i if i >= PARKED_INSTANCE_BASE => Some(u32::from(i - PARKED_INSTANCE_BASE)),
         i if i >= CYCLIST_INSTANCE_BASE => Some(u32::from(i - CYCLIST_INSTANCE_BASE)),
         i if i >= VEHICLE_INSTANCE_BASE => Some(u32::from(i - VEHICLE_INSTANCE_BASE)),
         i if i >= CHILD_INSTANCE_BASE => Some(u32::from(i - CHILD_INSTANCE_BASE)),
@@ -493,6 +510,10 @@ mod tests {
         assert_eq!(actor_of_instance(CHILD_INSTANCE_BASE + 7), Some(7));
         assert_eq!(actor_of_instance(VEHICLE_INSTANCE_BASE + 3), Some(3));
         assert_eq!(actor_of_instance(CYCLIST_INSTANCE_BASE + 2), Some(2));
+        assert_eq!(actor_of_instance(parked_instance(5)), Some(5));
+        // The last cyclist instance (ids are clamped to 8,191) is still a cyclist's, not a parked car's.
+        assert_eq!(actor_of_instance(CYCLIST_INSTANCE_BASE + 8_191), Some(8_191));
+        assert_eq!(parked_instance(u32::MAX), u16::MAX);
     }
 
     #[test]

@@ -643,7 +643,8 @@ impl StaticScene {
         }
 
         // Street furniture (bins, rows of bollards, signs, bus shelters) at the curb, per clip.
-        for item in clip_furniture(trace, town, seed, &posts) {
+        let furniture = clip_furniture(trace, town, seed, &posts);
+        for item in &furniture {
             let c = (item.foot - origin.truncate()).as_vec2();
             let half = item.half_m.truncate().as_vec2();
             let base = (item.base_z_m - origin.z) as f32;
@@ -679,6 +680,22 @@ impl StaticScene {
                     b.mesh.upright_box(c, 0.0, half, [top - 0.1, top], body, body);
                 }
             }
+            close_cluster(&b, &mut clusters, &mut cluster_start);
+        }
+
+        // Parked cars along the curbs, per clip, their lamps dark.
+        for (id, car) in clip_parked_cars(script, trace, town, &posts, &furniture)
+            .iter()
+            .enumerate()
+        {
+            let (paint, instance) = (linear(car.rgb), parked_instance(id as u32));
+            b.mesh.car(
+                stat_rel(origin, car.centre),
+                car.yaw_rad as f32,
+                paint,
+                instance,
+                CarLamps::Off,
+            );
             close_cluster(&b, &mut clusters, &mut cluster_start);
         }
 

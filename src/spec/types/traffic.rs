@@ -26,6 +26,8 @@ pub struct Traffic {
     pub signals: Signals,
     /// Cyclists: a third class of road user, riding at the right edge of the driving lanes.
     pub cyclists: Cyclists,
+    /// Cars parked along the curbs: scenery that hides pedestrians, as on real streets.
+    pub parked_cars: ParkedCars,
 }
 
 impl Default for Traffic {
@@ -43,7 +45,29 @@ impl Default for Traffic {
             emergency: Emergency::default(),
             signals: Signals::default(),
             cyclists: Cyclists::default(),
+            parked_cars: ParkedCars::default(),
         }
+    }
+}
+
+/// Cars parked along the curbs, parallel to the road and facing its traffic, outside junctions and away from
+/// crosswalks. They are scenery, as the parked cars CARLA's maps place are: semantic `Car` in the camera and
+/// LiDAR streams, instance 0, no row in the `vehicles` table; the occlusion labels test against them. The
+/// simulation does not steer around them, so a clip's parked cars stand only where none of its vehicles,
+/// cyclists or pedestrians passes (each clip keeps the candidate places its traffic leaves free): on a street
+/// with one lane each way they line the side that no vehicle of the clip drives along.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct ParkedCars {
+    /// Share of the candidate places along each curb (one every 7 m) that hold a car, drawn per clip and place
+    /// from the clip's seed; 0 turns parked cars off. Default 0.4 (pedsynth's choice: every other car length
+    /// or so, as on the residential streets of JAAD's videos).
+    pub share: f64,
+}
+
+impl Default for ParkedCars {
+    fn default() -> Self {
+        ParkedCars { share: 0.4 }
     }
 }
 

@@ -179,6 +179,7 @@ impl Validator<'_> {
             60.0,
             "an all-red time in seconds",
         );
+        self.probability("traffic.parked_cars.share", t.parked_cars.share);
         let c = &t.cyclists;
         self.count_range(
             "traffic.cyclists.per_clip",

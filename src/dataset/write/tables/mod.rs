@@ -34,16 +34,17 @@ pub use people::*;
 pub use traffic::*;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 10;
+pub const SCHEMA_VERSION: u32 = 11;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
-pub const TABLES: [&str; 11] = [
+pub const TABLES: [&str; 12] = [
     "frames",
     "pedestrians",
     "annotations",
     "tracks",
     "vehicles",
     "cyclists",
+    "parked_cars",
     "events",
     "traffic_lights",
     "sensor_poses",

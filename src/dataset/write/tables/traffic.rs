@@ -1,5 +1,5 @@
-//! The other road users' tables: `vehicles`, `cyclists` (with the rider's box and keypoints where seen) and
-//! `traffic_lights` near the ego.
+//! The other road users' tables: `vehicles`, `cyclists` (with the rider's box and keypoints where seen),
+//! `parked_cars` and `traffic_lights` near the ego.
 
 use super::*;
 
@@ -178,6 +178,46 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
             Arc::new(StringArray::from_iter(
                 rows.iter().map(|r| r.2.light.map(LightState::name)),
             )),
+        )
+        .finish()
+}
+
+/// The `parked_cars` table: one row per parked car of the clip (scenery: it stands still for the whole clip),
+/// with its id, its instance in the `instance` stream, its footprint's centre, heading and size, and whether it
+/// stands with two wheels up on the curb.
+pub fn parked_cars_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
+    use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
+    let cars = &ann.parked_cars;
+    let n = cars.len();
+    let f32c = |get: &dyn Fn(&crate::sensors::scene::ParkedCar) -> f64| -> ArrayRef {
+        Arc::new(Float32Array::from_iter_values(cars.iter().map(|c| get(c) as f32)))
+    };
+    let size = |v: f64| -> ArrayRef { Arc::new(Float32Array::from_iter_values((0..n).map(|_| v as f32))) };
+    Table::new()
+        .column("clip_id", false, repeated_utf8(n, &script.clip_id))
+        .column(
+            "parked_car",
+            false,
+            Arc::new(UInt32Array::from_iter_values(0..n as u32)),
+        )
+        .column(
+            "instance",
+            false,
+            Arc::new(UInt32Array::from_iter_values(
+                (0..n as u32).map(|id| u32::from(crate::sensors::scene::parked_instance(id))),
+            )),
+        )
+        .column("x_m", false, f32c(&|c| c.centre.x))
+        .column("y_m", false, f32c(&|c| c.centre.y))
+        .column("z_m", false, f32c(&|c| c.centre.z))
+        .column("yaw_rad", false, f32c(&|c| c.yaw_rad))
+        .column("length_m", false, size(VEHICLE_LENGTH_M))
+        .column("width_m", false, size(VEHICLE_WIDTH_M))
+        .column("height_m", false, size(VEHICLE_HEIGHT_M))
+        .column(
+            "on_curb",
+            false,
+            Arc::new(BooleanArray::from_iter(cars.iter().map(|c| Some(c.on_curb)))),
         )
         .finish()
 }
