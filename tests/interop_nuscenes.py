@@ -19,6 +19,8 @@ Usage: interop_nuscenes.py DATASET --pedsynth BIN [--out DIR]
   projection (within a pixel), with a median IoU of at least 0.5 between the two.
 - Every annotated pedestrian of a keyframe has one box, with nuScenes' pedestrian attributes; `splits.json`
   lists the clips by split.
+- Every parked car's box is a `vehicle.car` with `vehicle.parked`, of its `parked_cars` row's size and place, and
+  holds every LiDAR point of its instance.
 """
 import argparse
 import json
@@ -62,6 +64,7 @@ def main():
     clips = table(args.dataset, "clips").set_index("clip_id")
     ann = table(args.dataset, "annotations")
     frames_t = table(args.dataset, "frames")
+    parked = table(args.dataset, "parked_cars").set_index(["clip_id", "parked_car"])
     if len(nusc.scene) != len(clips):
         fail(f"{len(nusc.scene)} scenes for {len(clips)} clips")
 
@@ -92,7 +95,8 @@ def main():
     log_map = {log["token"]: log["map_token"] for log in nusc.log}
     lidar_cache = {}
 
-    checked = {"boxes": 0, "points": 0, "keypoints": 0, "velocities": 0, "lidar_files": 0, "images": 0}
+    checked = {"boxes": 0, "points": 0, "keypoints": 0, "velocities": 0, "lidar_files": 0, "images": 0,
+               "parked_boxes": 0, "parked_points": 0}
     worst_kp = 0.0
     speed_errors = []
     ious = []
@@ -174,6 +178,29 @@ def main():
             checked["points"] += int(mine.sum())
             checked["boxes"] += 1
 
+        # Parked cars: a `vehicle.car` box with `vehicle.parked` each, the size and place of its `parked_cars` row,
+        # and every LiDAR point of its instance (57344 + id) inside it.
+        for tok in sample["anns"]:
+            a = nusc.get("sample_annotation", tok)
+            inst = nusc.get("instance", a["instance_token"])
+            if inst["kind"] != "parked_car":
+                continue
+            attrs = {nusc.get("attribute", t)["name"] for t in a["attribute_tokens"]}
+            if a["category_name"] != "vehicle.car" or attrs != {"vehicle.parked"}:
+                fail(f"parked car annotation {tok}: {a['category_name']}, {attrs}")
+            car = parked.loc[(clip, inst["id"])]
+            want = np.array([car.x_m, car.y_m, car.z_m + 0.5 * car.height_m]) - origin
+            if np.abs(np.array(a["translation"]) - want).max() > 1e-3 or \
+                    np.abs(np.array(a["size"]) - [car.width_m, car.length_m, car.height_m]).max() > 1e-5:
+                fail(f"parked car {inst['id']} of {clip}: box {a['translation']} {a['size']}, row {want}")
+            mine = ours.instance.to_numpy() == 57344 + inst["id"]
+            inside = points_in_box(by_inst[a["token"]], pc.points[:3, :])
+            if np.any(mine & ~inside):
+                fail(f"{clip} frame {frame} parked car {inst['id']}: {int((mine & ~inside).sum())} of "
+                     f"{int(mine.sum())} of its points outside its box")
+            checked["parked_points"] += int(mine.sum())
+            checked["parked_boxes"] += 1
+
         # Camera: keypoints_3d through the exported poses and calibration land on our keypoints.
         cam_sd = nusc.get("sample_data", cam_tok)
         pose = nusc.get("ego_pose", cam_sd["ego_pose_token"])
@@ -243,7 +270,7 @@ def main():
     for f in ("cam.png", "lidar.png", "lidar2.png"):
         if os.path.getsize(f"{render_dir}/{f}") < 10_000:
             fail(f"render {f} is nearly empty")
-    if checked["boxes"] == 0 or checked["points"] == 0 or not speed_errors:
+    if checked["boxes"] == 0 or checked["points"] == 0 or not speed_errors or checked["parked_points"] == 0:
         fail(f"nothing checked: {checked}")
     # Box centres move as the body walks: their finite differences follow the tables' ground velocity.
     median_speed_error = float(np.median(speed_errors))
@@ -258,6 +285,7 @@ def main():
           f"{checked['keypoints']} keypoints (worst {worst_kp:.4f} px), 3D box projections around the 2D boxes "
           f"(median IoU {median_iou:.2f}, lowest {min(ious):.2f}), {checked['velocities']} velocities (pedestrians within a median {median_speed_error:.3f} m/s of the "
           f"tables'), "
+          f"{checked['parked_boxes']} parked-car boxes holding {checked['parked_points']} of their LiDAR points, "
           f"{checked['lidar_files']} LiDAR files; renders in {render_dir}")
 
 

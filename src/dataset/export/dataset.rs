@@ -175,6 +175,22 @@ pub struct Clip {
     /// The `traffic_lights` rows, in (frame, light) order (empty without lights, or for a dataset written before
     /// the table existed).
     pub traffic_lights: Vec<LightFrame>,
+    /// The `parked_cars` rows, by id (empty without parked cars, or for a dataset written before the table
+    /// existed).
+    pub parked_cars: Vec<ParkedCarRow>,
+}
+
+/// A row of the `parked_cars` table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParkedCarRow {
+    pub parked_car: u32,
+    /// Centre of the ground footprint, world metres.
+    pub x_m: f64,
+    pub y_m: f64,
+    pub z_m: f64,
+    pub yaw_rad: f64,
+    /// Length, width and height, metres.
+    pub size_m: [f64; 3],
 }
 
 /// A row of the `traffic_lights` table.
@@ -375,6 +391,7 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         cyclists: Vec::new(),
         tracks: BTreeMap::new(),
         traffic_lights: Vec::new(),
+        parked_cars: Vec::new(),
     };
     let cols = [
         "frame",
@@ -537,6 +554,35 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         }
     }
     clip.vehicles.sort_by_key(|v| (v.vehicle, v.frame));
+    let parked = file("parked_cars");
+    if parked.is_file() {
+        let cols = [
+            "parked_car",
+            "x_m",
+            "y_m",
+            "z_m",
+            "yaw_rad",
+            "length_m",
+            "width_m",
+            "height_m",
+        ];
+        for b in tables::read(&parked, &cols)? {
+            let id = b.u32s("parked_car")?;
+            let v: Vec<_> = cols[1..].iter().map(|c| b.f32s(c)).collect::<Result<_, _>>()?;
+            for i in 0..b.rows() {
+                let at = |k: usize| f64::from(v[k].value(i));
+                clip.parked_cars.push(ParkedCarRow {
+                    parked_car: id.value(i),
+                    x_m: at(0),
+                    y_m: at(1),
+                    z_m: at(2),
+                    yaw_rad: at(3),
+                    size_m: [at(4), at(5), at(6)],
+                });
+            }
+        }
+        clip.parked_cars.sort_by_key(|c| c.parked_car);
+    }
     let cyclists = file("cyclists");
     if cyclists.is_file() {
         let cols = [

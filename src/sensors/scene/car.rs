@@ -17,11 +17,23 @@ pub enum CarLamps {
     Off,
 }
 
+/// How much shorter than the footprint a car's body is at each end, metres: its lamps (6 cm deep) stand 3 cm out of it,
+/// to 5 mm inside the footprint.
+const LAMP_DEPTH_M: f32 = 0.035;
+/// How far inside its footprint's sides and height a car's mesh stays, metres.
+const INSET_M: f32 = 0.005;
+
 impl Mesh {
     /// Adds a car standing on `pos` (ground centre, scene-relative) facing `yaw_rad`, painted `paint` (linear),
     /// every primitive tagged [`tag::CAR`] with `instance`.
     pub fn car(&mut self, pos: Vec3, yaw_rad: f32, paint: Vec3, instance: u16, lamps: CarLamps) {
-        let (l, w, h) = (VEHICLE_LENGTH_M as f32, VEHICLE_WIDTH_M as f32, VEHICLE_HEIGHT_M as f32);
+        // 5 mm inside the footprint's sides and height, so that rounding (the scene is single precision) leaves no
+        // surface outside the box.
+        let (l, w, h) = (
+            VEHICLE_LENGTH_M as f32,
+            VEHICLE_WIDTH_M as f32 - 2.0 * INSET_M,
+            VEHICLE_HEIGHT_M as f32 - INSET_M,
+        );
         let (s, c) = yaw_rad.sin_cos();
         let fwd = Vec2::new(c, s);
         let centre = pos.truncate();
@@ -38,11 +50,13 @@ impl Mesh {
         let body = car(Material::CarPaint, paint);
         let glass = car(Material::CarGlass, linear([14, 16, 20]));
         let tyre = car(Material::Tyre, linear([20, 20, 20]));
-        // Lower body, cabin (glass sides, painted roof), four wheels.
+        // Lower body, cabin (glass sides, painted roof), four wheels. The body stops [`LAMP_DEPTH_M`] short of the
+        // footprint's ends, where the lamps stand out of it: the whole car stays inside its footprint (a box of
+        // the `parked_cars` or `vehicles` table holds every LiDAR point of it).
         self.upright_box(
             centre,
             yaw_rad,
-            Vec2::new(l * 0.5, w * 0.5),
+            Vec2::new(l * 0.5 - LAMP_DEPTH_M, w * 0.5),
             [base + 0.3, base + 0.55 * h + 0.15],
             body,
             body,
@@ -59,7 +73,8 @@ impl Mesh {
             let wc = centre + fwd * (fx * l) + fwd.perp() * (sy * (w * 0.5 - 0.14));
             self.upright_box(wc, yaw_rad, Vec2::new(0.33, 0.13), [base, base + 0.64], tyre, tyre);
         }
-        // Lamps: small boxes standing just out of the front and rear faces; a parked car's are dark.
+        // Lamps: small boxes standing out of the front and rear faces to 5 mm inside the footprint's ends; a parked
+        // car's are dark.
         let lit = matches!(lamps, CarLamps::Lit { .. });
         for (fx, mat, albedo) in [
             (0.5f32, Material::HeadLamp, linear([240, 240, 230])),
@@ -71,7 +86,7 @@ impl Mesh {
                 car(Material::CarGlass, albedo * 0.3)
             };
             for sy in [1.0f32, -1.0] {
-                let lc = centre + fwd * (fx * l + fx.signum() * 0.01) + fwd.perp() * (sy * w * 0.33);
+                let lc = centre + fwd * (fx * l - fx.signum() * LAMP_DEPTH_M) + fwd.perp() * (sy * w * 0.33);
                 self.upright_box(
                     lc,
                     yaw_rad,

@@ -289,7 +289,7 @@ struct ClipExport<'a> {
 
 /// A 3D box at a keyframe, in the world.
 struct Box3 {
-    /// (kind order, id): pedestrians 0, vehicles 1, cyclists 2.
+    /// (kind order, id): pedestrians 0, vehicles 1, cyclists 2, parked cars 3.
     key: (u8, u32),
     centre: DVec3,
     /// Length (along the yaw), width, height, metres.
@@ -314,7 +314,7 @@ impl Box3 {
     }
 }
 
-const KIND_NAMES: [&str; 3] = ["pedestrian", "vehicle", "cyclist"];
+const KIND_NAMES: [&str; 4] = ["pedestrian", "vehicle", "cyclist", "parked_car"];
 
 impl ClipExport<'_> {
     fn id(&self) -> &str {
@@ -521,8 +521,8 @@ impl ClipExport<'_> {
         }
     }
 
-    /// The boxes at keyframe `f`: the annotated pedestrians, then the vehicles and the cyclists within
-    /// [`ANNOTATION_RANGE_M`] of the ego, each by id.
+    /// The boxes at keyframe `f`: the annotated pedestrians, then the vehicles, the parked cars and the cyclists
+    /// within [`ANNOTATION_RANGE_M`] of the ego, each by id.
     fn boxes(&self, f: u32) -> Vec<Box3> {
         let clip = self.clip;
         let e = &clip.ego[f as usize];
@@ -576,6 +576,20 @@ impl ClipExport<'_> {
                 } else {
                     "vehicle.stopped"
                 },
+                occlusion: None,
+                crossing: None,
+                state: None,
+                tte_frames: None,
+            });
+        }
+        for c in clip.parked_cars.iter().filter(|c| near(c.x_m, c.y_m)) {
+            out.push(Box3 {
+                key: (3, c.parked_car),
+                centre: DVec3::new(c.x_m, c.y_m, c.z_m + 0.5 * c.size_m[2]),
+                size: DVec3::from_array(c.size_m),
+                yaw_rad: c.yaw_rad,
+                category: "vehicle.car",
+                attribute: "vehicle.parked",
                 occlusion: None,
                 crossing: None,
                 state: None,
