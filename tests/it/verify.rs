@@ -1,6 +1,6 @@
 //! `pedsynth verify DIR` passes a freshly generated dataset and names every kind of damage — a changed table, a
-//! changed or missing sensor file, a stray file, an unfinished clip — with exit 2, and `stats` and the exporters
-//! refuse such a dataset; a second `generate` into a directory another one is writing into refuses (the OS lock
+//! changed or missing sensor file, a stray file, an unfinished clip, parked cars numbered out of order — with exit
+//! 2, and `stats` and the exporters refuse such a dataset; a second `generate` into a directory another one is writing into refuses (the OS lock
 //! on `.pedsynth.lock`) and succeeds once the lock is free, reporting progress as JSON lines when asked.
 
 use crate::common;
@@ -181,4 +181,59 @@ fn a_second_generate_into_a_locked_directory_refuses_and_the_lock_frees_with_its
     assert_eq!(lines[1]["done"], 2);
     let (code, _, stderr) = verify(&ds);
     assert_eq!(code, Some(0), "{stderr}");
+}
+
+#[test]
+fn verify_names_parked_cars_numbered_out_of_order() {
+    use arrow_array::{Array, RecordBatch, UInt32Array};
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    use pedsynth::dataset::write::tables::{FileMeta, parquet_bytes};
+    use std::sync::Arc;
+    let tmp = common::Scratch::new("verify-parked");
+    let ds = tmp.path().join("ds");
+    let (code, _, stderr) = common::generate(&spec("quickstart.yaml"), &common::NO_SENSORS, &ds, None);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(verify(&ds).0, Some(0));
+    // Swap the first two parked cars' ids in one clip's table, writing it as the writer does and updating the
+    // manifest's hash, so that only the rows' check can find it.
+    let clip = "town01_like-clear_noon-0000";
+    let path = ds.join(format!("tables/parked_cars/{clip}.parquet"));
+    let old = std::fs::read(&path).unwrap();
+    let batch = ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(&path).unwrap())
+        .unwrap()
+        .build()
+        .unwrap()
+        .next()
+        .expect("a batch")
+        .unwrap();
+    assert!(batch.num_rows() >= 2, "{} parked cars", batch.num_rows());
+    let ids = batch.column_by_name("parked_car").unwrap();
+    let ids = ids.as_any().downcast_ref::<UInt32Array>().unwrap();
+    let mut swapped: Vec<u32> = ids.values().to_vec();
+    swapped.swap(0, 1);
+    let k = batch.schema().index_of("parked_car").unwrap();
+    let mut columns = batch.columns().to_vec();
+    columns[k] = Arc::new(UInt32Array::from(swapped));
+    let changed = RecordBatch::try_new(batch.schema(), columns).unwrap();
+    let manifest_path = ds.join("manifest.json");
+    let manifest = std::fs::read_to_string(&manifest_path).unwrap();
+    let spec_hash = serde_json::from_str::<serde_json::Value>(&manifest).unwrap()["spec_hash"]
+        .as_str()
+        .unwrap()
+        .to_owned();
+    let meta = FileMeta { spec_hash };
+    let bytes = parquet_bytes(&changed, &Default::default(), &meta, "parked_cars", clip).unwrap();
+    std::fs::write(&path, &bytes).unwrap();
+    let (from, to) = (
+        blake3::hash(&old).to_hex().to_string(),
+        blake3::hash(&bytes).to_hex().to_string(),
+    );
+    assert!(manifest.contains(&from));
+    std::fs::write(&manifest_path, manifest.replace(&from, &to)).unwrap();
+    let (code, _, stderr) = verify(&ds);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("tables/parked_cars/{clip}.parquet: row 0 is parked car 1")),
+        "{stderr}"
+    );
 }
