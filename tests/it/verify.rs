@@ -1,7 +1,8 @@
 //! `pedsynth verify DIR` passes a freshly generated dataset and names every kind of damage — a changed table, a
 //! changed or missing sensor file, a stray file, an unfinished clip, parked cars numbered out of order — with exit
-//! 2, and `stats` and the exporters refuse such a dataset; a second `generate` into a directory another one is writing into refuses (the OS lock
-//! on `.pedsynth.lock`) and succeeds once the lock is free, reporting progress as JSON lines when asked.
+//! 2, and `stats` and the exporters refuse such a dataset; a second `generate` into a directory another one is
+//! writing into refuses (the OS lock on `.pedsynth.lock`) and succeeds once the lock is free, reporting progress
+//! as JSON lines when asked.
 
 use crate::common;
 
