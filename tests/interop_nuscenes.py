@@ -47,6 +47,15 @@ def fail(msg):
     sys.exit(1)
 
 
+def annotations_of(nusc, sample, kind):
+    """The sample's annotations of instances of `kind`: (token, annotation, instance, attribute names)."""
+    for tok in sample["anns"]:
+        a = nusc.get("sample_annotation", tok)
+        inst = nusc.get("instance", a["instance_token"])
+        if inst["kind"] == kind:
+            yield tok, a, inst, {nusc.get("attribute", t)["name"] for t in a["attribute_tokens"]}
+
+
 def table(root, name):
     return pads.dataset(f"{root}/tables/{name}").to_table().to_pandas()
 
@@ -117,12 +126,7 @@ def main():
         # Pedestrian boxes against the annotations table.
         rows = ann[(ann.clip_id == clip) & (ann.frame == frame)].set_index("pedestrian")
         ped_anns = {}
-        for tok in sample["anns"]:
-            a = nusc.get("sample_annotation", tok)
-            inst = nusc.get("instance", a["instance_token"])
-            if inst["kind"] != "pedestrian":
-                continue
-            attrs = {nusc.get("attribute", t)["name"] for t in a["attribute_tokens"]}
+        for tok, a, inst, attrs in annotations_of(nusc, sample, "pedestrian"):
             if not attrs or not attrs <= PED_ATTRS:
                 fail(f"pedestrian annotation {tok}: attributes {attrs}")
             if not a["category_name"].startswith("human.pedestrian."):
@@ -180,12 +184,7 @@ def main():
 
         # Parked cars: a `vehicle.car` box with `vehicle.parked` each, the size and place of its `parked_cars` row,
         # and every LiDAR point of its instance (57344 + id) inside it.
-        for tok in sample["anns"]:
-            a = nusc.get("sample_annotation", tok)
-            inst = nusc.get("instance", a["instance_token"])
-            if inst["kind"] != "parked_car":
-                continue
-            attrs = {nusc.get("attribute", t)["name"] for t in a["attribute_tokens"]}
+        for tok, a, inst, attrs in annotations_of(nusc, sample, "parked_car"):
             if a["category_name"] != "vehicle.car" or attrs != {"vehicle.parked"}:
                 fail(f"parked car annotation {tok}: {a['category_name']}, {attrs}")
             car = parked.loc[(clip, inst["id"])]
