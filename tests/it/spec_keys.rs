@@ -314,6 +314,9 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         p if p.starts_with("traffic.cyclists.") && p != "traffic.cyclists.per_clip" => {
             vec![("traffic.cyclists.per_clip", json!([5, 5]))]
         }
+        // A nod shows only where a crosser acknowledges a yielding driver in an annotated frame: with parked cars
+        // hiding some pedestrians, the walk's few clips no longer have one; every crosser acknowledging makes more.
+        "pedestrians.gestures.nod_share" => vec![("pedestrians.gestures.acknowledge_probability", json!(1.0))],
         // The lookahead's predicted position matters only in in-road conflicts: more pedestrians make some.
         "crossing.lookahead.prediction_s" => vec![("pedestrians.per_clip", json!([20, 20]))],
         "annotations.visibility.min_box_far_px.height_px" => {
