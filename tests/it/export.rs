@@ -254,13 +254,62 @@ fn check_replay(clip: &pedsynth::dataset::export::dataset::Clip, xosc: &str) {
         "{}: the test's dataset has cyclists",
         clip.clip_id
     );
-    assert_eq!(declared.len(), 1 + vehicles.len() + cyclists.len() + clip.tracks.len());
+    assert!(
+        !clip.parked_cars.is_empty(),
+        "{}: the test's dataset has parked cars",
+        clip.clip_id
+    );
+    assert_eq!(
+        declared.len(),
+        1 + vehicles.len() + cyclists.len() + clip.tracks.len() + clip.parked_cars.len()
+    );
     let bicycles = doc
         .descendants()
         .filter(|n| n.has_tag_name("Vehicle") && n.attribute("vehicleCategory") == Some("bicycle"))
         .count();
     assert_eq!(bicycles, cyclists.len());
-    assert_eq!(polylines.len(), declared.len());
+    assert_eq!(
+        polylines.len(),
+        declared.len() - clip.parked_cars.len(),
+        "every moving entity has a trajectory, no parked car has one"
+    );
+    // Parked cars: declared with their row's size, teleported to their row's place in `Init`, never moved.
+    let init = doc.descendants().find(|n| n.has_tag_name("Init")).unwrap();
+    for car in &clip.parked_cars {
+        let name = format!("parked_car_{}", car.parked_car);
+        assert!(!polylines.contains_key(&name), "{name} has no trajectory");
+        let object = doc
+            .descendants()
+            .find(|n| n.has_tag_name("ScenarioObject") && n.attribute("name") == Some(name.as_str()))
+            .unwrap_or_else(|| panic!("{name} declared"));
+        let dims = object.descendants().find(|n| n.has_tag_name("Dimensions")).unwrap();
+        let size = [num(dims, "length"), num(dims, "width"), num(dims, "height")];
+        assert!(
+            size.iter().zip(car.size_m).all(|(a, b)| (a - b).abs() < 1e-6),
+            "{name}: {size:?} against {:?}",
+            car.size_m
+        );
+        let parked_property = object
+            .descendants()
+            .any(|n| n.has_tag_name("Property") && n.attribute("name") == Some("parked"));
+        assert!(parked_property, "{name} is marked parked");
+        let teleport = init
+            .descendants()
+            .find(|n| n.has_tag_name("Private") && n.attribute("entityRef") == Some(name.as_str()))
+            .unwrap_or_else(|| panic!("{name} placed in Init"));
+        let w = teleport
+            .descendants()
+            .find(|n| n.has_tag_name("WorldPosition"))
+            .unwrap();
+        let d = ((num(w, "x") - car.x_m).powi(2) + (num(w, "y") - car.y_m).powi(2) + (num(w, "z") - car.z_m).powi(2))
+            .sqrt();
+        let dh =
+            (num(w, "h") - car.yaw_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        assert!(
+            d < 0.002 && dh.abs() < 0.001,
+            "{name}: placed {d} m, {dh} rad from its row"
+        );
+    }
     assert_eq!(
         clip.tracks.len(),
         clip.pedestrians.len(),

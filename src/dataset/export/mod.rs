@@ -322,10 +322,11 @@ pub fn export(
         Format::Openscenario => {
             let r = openscenario::export(&ds, out)?;
             format!(
-                "{}: {} OpenSCENARIO files ({} entities, {} trajectory vertices for {} entity-frames) and {} towns as OpenDRIVE in towns/\n",
+                "{}: {} OpenSCENARIO files ({} entities, {} of them parked cars; {} trajectory vertices for {} entity-frames) and {} towns as OpenDRIVE in towns/\n",
                 out.display(),
                 r.scenarios,
                 r.entities,
+                r.parked,
                 r.vertices,
                 r.frames,
                 r.towns

@@ -5,8 +5,9 @@
 //! A file holds: the road network (a relative `LogicFile` path); the ego, every traffic vehicle, every cyclist
 //! and every pedestrian as entities with their dimensions (vehicles 4.6 × 1.9 × 1.5 m, cyclists as vehicles of
 //! category `bicycle` 1.75 × 0.65 × 1.7 m, pedestrians 0.6 m wide and their body height tall, mass from height
-//! at BMI 22); in `Init`, the weather as an `EnvironmentAction` and each entity teleported to its first pose; in
-//! one act, each entity's whole trace (`frames` for the ego, `vehicles`, `cyclists`, `tracks` for pedestrians)
+//! at BMI 22), and every parked car (`parked_cars`) as a vehicle of its row's size with the property
+//! `parked`; in `Init`, the weather as an `EnvironmentAction` and each entity teleported to its first pose (a
+//! parked car to its place, where it stays: it has no trajectory); in one act, each moving entity's whole trace (`frames` for the ego, `vehicles`, `cyclists`, `tracks` for pedestrians)
 //! as a `FollowTrajectoryAction` with a timed polyline in absolute time.
 //! Polylines keep only the vertices needed to reproduce every frame within 2 cm and 0.02 rad by linear
 //! interpolation (a pedestrian who waits is two vertices, not one per frame); headings are unwrapped so that
@@ -43,6 +44,8 @@ pub struct Summary {
     pub scenarios: usize,
     pub towns: usize,
     pub entities: usize,
+    /// Of the entities, parked cars (no trajectory).
+    pub parked: usize,
     pub vertices: usize,
     pub frames: usize,
 }
@@ -63,6 +66,7 @@ pub fn export(ds: &Dataset, out: &Path) -> Result<Summary, Error> {
         scenarios: 0,
         towns: 0,
         entities: 0,
+        parked: 0,
         vertices: 0,
         frames: 0,
     };
@@ -93,10 +97,12 @@ pub fn export(ds: &Dataset, out: &Path) -> Result<Summary, Error> {
         let clip = ds.load(info)?;
         let (xml, entities, vertices) = scenario(&clip);
         write_file(&out.join(format!("{}.xosc", clip.clip_id)), xml.as_bytes())?;
+        let moving = entities - clip.parked_cars.len();
         summary.scenarios += 1;
         summary.entities += entities;
+        summary.parked += clip.parked_cars.len();
         summary.vertices += vertices;
-        summary.frames += entities * clip.frame_count as usize;
+        summary.frames += moving * clip.frame_count as usize;
         bar.clip_done(&clip.clip_id, u64::from(clip.frame_count));
     }
     bar.finish();
@@ -161,12 +167,18 @@ struct Entity {
 
 enum Kind {
     Car,
-    Pedestrian { height_m: f64 },
+    Pedestrian {
+        height_m: f64,
+    },
     Bicycle,
+    /// A parked car: one pose, no trajectory; length, width and height in metres.
+    Parked {
+        size_m: [f64; 3],
+    },
 }
 
 /// The entities of a clip with their traces (headings unwrapped), in a fixed order: ego, vehicles by id,
-/// cyclists by id, pedestrians by id.
+/// cyclists by id, pedestrians by id, parked cars by id (one pose each).
 fn collect(clip: &Clip) -> Vec<Entity> {
     let fps = f64::from(clip.fps.max(1));
     let mut out = Vec::new();
@@ -237,6 +249,19 @@ fn collect(clip: &Clip) -> Vec<Entity> {
                 .collect(),
         });
     }
+    for car in &clip.parked_cars {
+        out.push(Entity {
+            name: format!("parked_car_{}", car.parked_car),
+            kind: Kind::Parked { size_m: car.size_m },
+            poses: vec![Pose {
+                t_s: 0.0,
+                x_m: car.x_m,
+                y_m: car.y_m,
+                z_m: car.z_m,
+                h_rad: car.yaw_rad,
+            }],
+        });
+    }
     out.retain(|e| !e.poses.is_empty());
     for e in &mut out {
         unwrap(&mut e.poses);
@@ -292,6 +317,16 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
                     0.5 * BICYCLE_HEIGHT_M
                 );
             }
+            Kind::Parked {
+                size_m: [length_m, width_m, height_m],
+            } => {
+                let _ = write!(
+                    x,
+                    "<Vehicle name=\"{}\" vehicleCategory=\"car\" mass=\"1500\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{:.3}\"/><Dimensions width=\"{width_m}\" length=\"{length_m}\" height=\"{height_m}\"/></BoundingBox>\n<Performance maxSpeed=\"50\" maxAcceleration=\"10\" maxDeceleration=\"10\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.6\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"1.4\" positionZ=\"0.325\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"-1.4\" positionZ=\"0.325\"/>\n</Axles>\n<Properties>\n<Property name=\"parked\" value=\"true\"/>\n</Properties>\n</Vehicle>\n",
+                    e.name,
+                    0.5 * height_m
+                );
+            }
             Kind::Pedestrian { height_m } => {
                 let _ = write!(
                     x,
@@ -318,7 +353,7 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
     }
     x.push_str("</Actions>\n</Init>\n<Story name=\"replay\">\n<Act name=\"replay\">\n");
     let mut vertices = 0;
-    for e in &entities {
+    for e in entities.iter().filter(|e| !matches!(e.kind, Kind::Parked { .. })) {
         let kept = simplify(&e.poses);
         vertices += kept.len();
         let n = &e.name;
