@@ -189,6 +189,12 @@ pub(super) fn plan_pedestrians(
             return Err(format!("pedestrian {id} is a crosser but has no road to cross"));
         }
         let (identity, child) = identity::identities(clip_seed, id, name, a.body, umbrella_share);
+        let step_out_ego_within_m = match scenario_rng.as_mut() {
+            Some(r) if in_view_before_crossing_s.is_some() && scenario.crosser_ego_within_m.max() > 0.0 => {
+                Some(draw(r, scenario.crosser_ego_within_m))
+            }
+            _ => None,
+        };
         scripts.push(PedestrianScript {
             id,
             archetype: name.to_owned(),
@@ -210,12 +216,8 @@ pub(super) fn plan_pedestrians(
             spawn_heading_rad: heading,
             ahead_of_ego_m: ahead,
             crossing,
-            step_out_ego_within_m: match scenario_rng.as_mut() {
-                Some(r) if in_view_before_crossing_s.is_some() && scenario.crosser_ego_within_m.max() > 0.0 => {
-                    Some(draw(r, scenario.crosser_ego_within_m))
-                }
-                _ => None,
-            },
+            step_out_ego_within_m,
+            step_out_stopped_ego_within_m: step_out_ego_within_m.and(stopped_ego_within(scenario)),
             in_view_before_crossing_s,
             curb_wait_s,
             identity,
@@ -521,6 +523,12 @@ pub(super) fn place_follower(
         ));
     }
     None
+}
+
+/// The distance within which a stopped ego lets a crosser that waits for it step out
+/// (`crossing.scenario.crosser_stopped_ego_within_m`), where that rule is on.
+pub(super) fn stopped_ego_within(scenario: &crate::spec::types::Scenario) -> Option<f64> {
+    Some(scenario.crosser_stopped_ego_within_m).filter(|&d| d > 0.0)
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@
 
 use super::{
     Behaviour, ClipBasics, ClipScript, CrosserSource, PedAlloc, PedestrianScript, Role, Side, SpawnPlace,
-    crosser_spawn_range, draw, place_crosser, quota, seeds,
+    crosser_spawn_range, draw, place_crosser, quota, seeds, stopped_ego_within,
 };
 use crate::spec::types::Spec;
 use crate::world::{RoadNetwork, Route};
@@ -88,6 +88,7 @@ pub fn promoted(
         place_crosser(net, route, lo, hi, side, approach_m, &others, &mut rng)?;
     let within = c.scenario.crosser_ego_within_m;
     let step_out_ego_within_m = (within.max() > 0.0).then(|| draw(&mut rng, within));
+    let step_out_stopped_ego_within_m = step_out_ego_within_m.and(stopped_ego_within(&c.scenario));
     Some(PedestrianScript {
         role: Role::Crosser,
         crosser_source: CrosserSource::Promoted,
@@ -99,6 +100,7 @@ pub fn promoted(
         crossing,
         in_view_before_crossing_s: Some(in_view_s),
         step_out_ego_within_m,
+        step_out_stopped_ego_within_m,
         curb_wait_s: None,
         group: None,
         red_light_violator: false,
@@ -128,6 +130,7 @@ pub fn demoted(spec: &Spec, clip: &ClipScript, i: usize) -> Option<PedestrianScr
         behaviour: Behaviour::HardNegative,
         in_view_before_crossing_s: None,
         step_out_ego_within_m: None,
+        step_out_stopped_ego_within_m: None,
         curb_wait_s: Some(wait_s),
         group: None,
         red_light_violator: false,

@@ -539,6 +539,10 @@ pub struct PedestrianScript {
     /// where that rule is off).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step_out_ego_within_m: Option<f64>,
+    /// A crosser that waits for the ego to come near also steps out once the ego has stopped within this
+    /// distance of it, metres (`crossing.scenario.crosser_stopped_ego_within_m`; absent where off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_out_stopped_ego_within_m: Option<f64>,
     /// How long a hard negative waits at the curb before walking on, seconds.
     pub curb_wait_s: Option<f64>,
     /// Who the pedestrian is: body height and looks, the same for every sensor and label.

@@ -142,6 +142,7 @@ fn crosser(net: &RoadNetwork, id: u32, x: f64, behaviour: Behaviour, source: Cro
         }),
         in_view_before_crossing_s: None,
         step_out_ego_within_m: None,
+        step_out_stopped_ego_within_m: None,
         curb_wait_s: None,
         identity: pedsynth::plan::identity::identities(1, id, "casual_person", Body::Adult, 0.0).0,
         child: None,
@@ -838,15 +839,17 @@ fn the_ego_eases_off_and_stops_short_for_a_pedestrian_waiting_at_the_curb() {
 }
 
 /// A crosser that waits at its curb for the ego to come within 6 m (`crossing.scenario.crosser_ego_within_m`)
-/// and an ego that yields to it: the ego rolls up near enough rather than stop 8 m short (where neither would
-/// move until the ego's patience ran out: 2,289 of 3,931 planned crossers of PedSynth++ with the JAAD profile
-/// never crossed), and the crosser steps out with the ego within its distance, in front of it.
+/// and an ego that yields to it, stopping 8 m short. Once the ego has stopped within 12 m
+/// (`crossing.scenario.crosser_stopped_ego_within_m`) the crosser goes in front of it (before that rule neither moved until the ego's patience ran out: 2,121 of 3,933 planned crossers
+/// of PedSynth++ with the JAAD profile never crossed). With `traffic.ego.courtesy_roll_up` the ego rolls up near
+/// enough instead, and the crosser steps out within its distance, in front of the still-moving ego.
 #[test]
 fn a_yielding_ego_rolls_up_to_a_crosser_that_waits_for_it_to_come_near() {
     let net = road();
-    let run = |roll_up: bool| {
+    let run = |roll_up: bool, stopped_ego_within_m: Option<f64>| {
         let mut p = at_curb(crosser(&net, 0, 150.0, Behaviour::Normal, CrosserSource::Allocated));
         p.step_out_ego_within_m = Some(6.0);
+        p.step_out_stopped_ego_within_m = stopped_ego_within_m;
         let mut ego = ego_at(&net, 60.0, 0.0);
         ego.courtesy_speed_mps = 2.5;
         ego.courtesy_patience_s = 30.0;
@@ -856,17 +859,45 @@ fn a_yielding_ego_rolls_up_to_a_crosser_that_waits_for_it_to_come_near() {
         assert_no_interpenetration(&trace);
         trace
     };
-    // Without the roll-up (`traffic.ego.courtesy_roll_up`, off by default) the ego stops short and the two wait.
-    let waits = run(false);
+    // Without the roll-up (`traffic.ego.courtesy_roll_up`, off by default) the ego stops short and, without the
+    // stopped-ego rule, the two wait for each other.
+    let waits = run(false, None);
     let stop = waits.ego.iter().position(|f| f.speed_mps < 0.1).expect("it stops");
     let gap_m = 150.0 - (waits.ego[stop].pos.x + VEHICLE_LENGTH_M / 2.0);
     assert!(
         (5.0..12.0).contains(&gap_m),
         "without the roll-up it stops {gap_m:.1} m short"
     );
-    assert_eq!(first_in_road(&waits, 0), None, "without the roll-up the crosser waits");
+    assert_eq!(first_in_road(&waits, 0), None, "without either rule the crosser waits");
+    // With the stopped-ego rule the crosser goes in front of the stopped ego.
+    let goes = run(false, Some(12.0));
+    let stop = goes.ego.iter().position(|f| f.speed_mps < 0.1).expect("it stops");
+    let entered = first_in_road(&goes, 0).expect("the crosser crosses once the ego has stopped");
+    assert!(entered > stop, "it steps out only after the ego has stopped");
+    let dist_m = (goes.ego[entered].pos - goes.pedestrians[0][entered].pos)
+        .truncate()
+        .length();
+    assert!(
+        dist_m > 6.0 + 0.5 && dist_m <= 12.0,
+        "the stopped ego is beyond the crosser's 6 m and within 12 m: {dist_m:.1} m"
+    );
+    assert!(
+        goes.ego[stop..=entered].iter().all(|f| f.speed_mps < 0.3),
+        "the ego stays stopped until the crosser steps out"
+    );
+    let entered_s = entered as f64 / 30.0;
+    assert!(
+        entered_s < 25.0,
+        "it stepped out at {entered_s:.1} s, before the ego's patience ran out"
+    );
+    // Beyond the rule's distance the stopped ego does not release it.
+    assert_eq!(
+        first_in_road(&run(false, Some(dist_m - 2.0)), 0),
+        None,
+        "a stopped ego too far away"
+    );
 
-    let near = run(true);
+    let near = run(true, None);
     let entered = first_in_road(&near, 0).expect("the crosser crosses in front of the ego");
     let ego = &near.ego[entered];
     let dist_m = (ego.pos - near.pedestrians[0][entered].pos).truncate().length();

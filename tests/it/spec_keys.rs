@@ -317,6 +317,10 @@ fn context(path: &str) -> Vec<(&'static str, Json)> {
         // A nod shows only where a crosser acknowledges a yielding driver in an annotated frame: with parked cars
         // hiding some pedestrians, the walk's few clips no longer have one; every crosser acknowledging makes more.
         "pedestrians.gestures.nod_share" => vec![("pedestrians.gestures.acknowledge_probability", json!(1.0))],
+        // The stopped-ego rule applies only to crossers that wait for the ego to come near.
+        "crossing.scenario.crosser_stopped_ego_within_m" => {
+            vec![("crossing.scenario.crosser_ego_within_m", json!([5, 8]))]
+        }
         // The lookahead's predicted position matters only in in-road conflicts: more pedestrians make some.
         "crossing.lookahead.prediction_s" => vec![("pedestrians.per_clip", json!([20, 20]))],
         "annotations.visibility.min_box_far_px.height_px" => {

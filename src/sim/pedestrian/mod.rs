@@ -160,6 +160,8 @@ pub(crate) struct Traits {
     pub in_view_before_crossing_s: Option<f64>,
     /// A crosser steps out only once the ego is within this distance of it, metres (`crossing.scenario`).
     pub step_out_ego_within_m: Option<f64>,
+    /// Or once the ego has stopped within this distance of it, metres (`crossing.scenario`).
+    pub step_out_stopped_ego_within_m: Option<f64>,
     /// A hard negative waits at the curb this long before walking on, seconds.
     pub curb_wait_s: Option<f64>,
     /// Two uniform draws in [0, 1) from the pedestrian's gesture stream: whether it gestures when the occasion
@@ -240,6 +242,8 @@ pub(crate) struct StepCtx<'a> {
 /// A crosser timing its walk to the ego (`Ped::holds_for_ego`) sets off this much earlier than the bare estimate,
 /// seconds (the ego slows as it comes).
 const HOLD_SLACK_S: f64 = 1.0;
+/// Below this speed the ego counts as stopped for a crosser that waits for it to come near, m/s.
+const EGO_STOPPED_MPS: f64 = 0.3;
 
 impl Ped {
     /// Sets a pedestrian up from its script; draws its per-pedestrian constants from its own stream, and its
@@ -286,6 +290,7 @@ impl Ped {
                 height_m: script.identity.height_m,
                 in_view_before_crossing_s: script.in_view_before_crossing_s,
                 step_out_ego_within_m: script.step_out_ego_within_m,
+                step_out_stopped_ego_within_m: script.step_out_stopped_ego_within_m,
                 curb_wait_s: script.curb_wait_s,
                 gesture_draws: (gesture_rng.random::<f64>(), gesture_rng.random::<f64>()),
             },
@@ -393,10 +398,20 @@ impl Ped {
 
     /// Whether the ego is near enough for it to step out, where its scenario asks for that
     /// (`crossing.scenario.crosser_ego_within_m`; always otherwise, and once the ego has passed).
+    /// Where the scenario says so (`crosser_stopped_ego_within_m`), a stopped ego within that distance counts as
+    /// near: real crossers go in front of a car that waits (for them, or for others crossing before it), and a
+    /// car held by a stream of crossers would otherwise never come near those who wait for it.
     pub(crate) fn ego_near_enough(&self) -> bool {
         self.traits
             .step_out_ego_within_m
-            .is_none_or(|d| !self.percept.ego_ahead || self.percept.ego_dist_m <= d)
+            .is_none_or(|d| !self.percept.ego_ahead || self.percept.ego_dist_m <= d || self.ego_waits_near())
+    }
+
+    /// Whether the ego is ahead and stopped within the crosser's `step_out_stopped_ego_within_m`.
+    fn ego_waits_near(&self) -> bool {
+        self.traits.step_out_stopped_ego_within_m.is_some_and(|d| {
+            self.percept.ego_ahead && self.percept.ego_speed_mps < EGO_STOPPED_MPS && self.percept.ego_dist_m <= d
+        })
     }
 
     /// Whether a crosser that waits for the ego to come near (its scenario) stands where it is for now, rather
@@ -406,7 +421,7 @@ impl Ped {
         let (Some(d), Some(line)) = (self.traits.step_out_ego_within_m, self.traits.line) else {
             return false;
         };
-        if self.attempt.over() || self.attempt.at_curb() || !self.percept.ego_ahead {
+        if self.attempt.over() || self.attempt.at_curb() || !self.percept.ego_ahead || self.ego_waits_near() {
             return false;
         }
         let walk_s = line.curb_point().distance(self.body.pos) / speed_mps.max(0.3);

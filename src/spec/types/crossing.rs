@@ -65,6 +65,11 @@ pub struct Scenario {
     /// drawn per crosser; the ego, easing off for a waiting pedestrian, comes close. `[0, 0]` (default): no
     /// such condition.
     pub crosser_ego_within_m: Range,
+    /// A crosser that waits for the ego to come within `crosser_ego_within_m` also steps out once the ego has
+    /// stopped (below 0.3 m/s) within this distance of it, metres: real crossers go in front of a car that
+    /// waits, for them or for others crossing before it (a car held by a stream of crossers never comes near
+    /// those who wait for it). `0` (default): off. Needs `crosser_ego_within_m`.
+    pub crosser_stopped_ego_within_m: f64,
     /// Where non-crossers walking along the sidewalk start, ahead of the ego along its route, metres
     /// `[min, max]`. `[0, 0]` (default): from layer 1's `spawn_ahead_m` minimum to the visibility distance.
     pub walker_ahead_m: Range,
@@ -80,6 +85,7 @@ impl Default for Scenario {
     fn default() -> Self {
         Scenario {
             crosser_ego_within_m: Range(0.0, 0.0),
+            crosser_stopped_ego_within_m: 0.0,
             walker_ahead_m: Range(0.0, 0.0),
             walker_lateral_m: Range(0.0, 0.0),
         }

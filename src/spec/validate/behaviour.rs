@@ -229,6 +229,13 @@ impl Validator<'_> {
         ] {
             self.range(key, range, 0.0, 500.0, "a distance to the ego in metres ([0, 0]: off)");
         }
+        self.num(
+            "crossing.scenario.crosser_stopped_ego_within_m",
+            c.scenario.crosser_stopped_ego_within_m,
+            0.0,
+            500.0,
+            "a distance to the stopped ego in metres (0: off)",
+        );
         self.range(
             "crossing.timeline.approach_m",
             c.timeline.approach_m,
