@@ -91,6 +91,11 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         spec.crossing.scenario.crosser_ego_within_m.min(),
         f.crosser_ego_within_m.0
     );
+    // Crossers that wait for the ego step out in front of it once it has stopped within the median distance.
+    assert_eq!(
+        spec.crossing.scenario.crosser_stopped_ego_within_m,
+        f.crosser_ego_within_m.1
+    );
     // JAAD's boxes move linearly over pieces of 2–10 frames (p25–p75): the annotator's keyframes. Pedestrians seen
     // together share a change of bearing of a 4.0° smooth heading wobble (tools' Python estimate of the common
     // change read as an AR(1) heading: 1.90°; × √((1 − e^−0.5) / (1 − 1.5 e^−0.5)) for the smooth one: 3.97°).

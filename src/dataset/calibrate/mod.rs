@@ -92,6 +92,8 @@ pub struct Fit {
     /// camera at their crossing point (from the box height, the fitted camera and the mean height). The drawn
     /// distance is the farthest the ego may be when a crosser steps out, and simulated crossers step out at or
     /// inside it (they wait for their gap and the ego's yield): hence the nearer half of the real distances.
+    /// The 50th percentile is also `crossing.scenario.crosser_stopped_ego_within_m`: a crosser waiting for the
+    /// ego steps out in front of it once it has stopped within that distance (for it, or for others crossing).
     pub crosser_ego_within_m: (f64, f64),
     /// `crossing.scenario.walker_ahead_m`: the 50th and 90th percentiles of non-crossers' distance when first
     /// annotated, tracks of the benchmark's minimum length of pedestrians not labelled crossers only (a crosser
@@ -330,8 +332,9 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p50)\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p50, p90)\n    walker_lateral_m: [{}, {}]  # and how far to the side (p10, p90)",
+        "  scenario:\n    crosser_ego_within_m: [{}, {}]  # crossers' distance at their crossing point (p10, p50)\n    crosser_stopped_ego_within_m: {}  # and they go in front of an ego stopped within the p50\n    walker_ahead_m: [{}, {}]  # non-crossers' distance when first annotated (p50, p90)\n    walker_lateral_m: [{}, {}]  # and how far to the side (p10, p90)",
         f.crosser_ego_within_m.0,
+        f.crosser_ego_within_m.1,
         f.crosser_ego_within_m.1,
         f.walker_ahead_m.0,
         f.walker_ahead_m.1,
