@@ -269,6 +269,15 @@ fn collect(clip: &Clip) -> Vec<Entity> {
     out
 }
 
+/// A `Vehicle` of category car: length, width and height in metres, its `Properties` element as given.
+fn car(x: &mut String, name: &str, [length_m, width_m, height_m]: [f64; 3], properties: &str) {
+    let _ = write!(
+        x,
+        "<Vehicle name=\"{name}\" vehicleCategory=\"car\" mass=\"1500\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{}\"/><Dimensions width=\"{width_m}\" length=\"{length_m}\" height=\"{height_m}\"/></BoundingBox>\n<Performance maxSpeed=\"50\" maxAcceleration=\"10\" maxDeceleration=\"10\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.6\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"1.4\" positionZ=\"0.325\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"-1.4\" positionZ=\"0.325\"/>\n</Axles>\n{properties}\n</Vehicle>\n",
+        0.5 * height_m
+    );
+}
+
 fn world_position(x: &mut String, p: &Pose) {
     let _ = write!(
         x,
@@ -301,14 +310,12 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
     for e in &entities {
         let _ = writeln!(x, "<ScenarioObject name=\"{}\">", e.name);
         match e.kind {
-            Kind::Car => {
-                let _ = write!(
-                    x,
-                    "<Vehicle name=\"{}\" vehicleCategory=\"car\" mass=\"1500\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{}\"/><Dimensions width=\"{VEHICLE_WIDTH_M}\" length=\"{VEHICLE_LENGTH_M}\" height=\"{VEHICLE_HEIGHT_M}\"/></BoundingBox>\n<Performance maxSpeed=\"50\" maxAcceleration=\"10\" maxDeceleration=\"10\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.6\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"1.4\" positionZ=\"0.325\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"-1.4\" positionZ=\"0.325\"/>\n</Axles>\n<Properties/>\n</Vehicle>\n",
-                    e.name,
-                    0.5 * VEHICLE_HEIGHT_M
-                );
-            }
+            Kind::Car => car(
+                &mut x,
+                &e.name,
+                [VEHICLE_LENGTH_M, VEHICLE_WIDTH_M, VEHICLE_HEIGHT_M],
+                "<Properties/>",
+            ),
             Kind::Bicycle => {
                 let _ = write!(
                     x,
@@ -317,16 +324,12 @@ pub fn scenario(clip: &Clip) -> (String, usize, usize) {
                     0.5 * BICYCLE_HEIGHT_M
                 );
             }
-            Kind::Parked {
-                size_m: [length_m, width_m, height_m],
-            } => {
-                let _ = write!(
-                    x,
-                    "<Vehicle name=\"{}\" vehicleCategory=\"car\" mass=\"1500\">\n<BoundingBox><Center x=\"0\" y=\"0\" z=\"{:.3}\"/><Dimensions width=\"{width_m}\" length=\"{length_m}\" height=\"{height_m}\"/></BoundingBox>\n<Performance maxSpeed=\"50\" maxAcceleration=\"10\" maxDeceleration=\"10\"/>\n<Axles>\n<FrontAxle maxSteering=\"0.6\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"1.4\" positionZ=\"0.325\"/>\n<RearAxle maxSteering=\"0\" wheelDiameter=\"0.65\" trackWidth=\"1.6\" positionX=\"-1.4\" positionZ=\"0.325\"/>\n</Axles>\n<Properties>\n<Property name=\"parked\" value=\"true\"/>\n</Properties>\n</Vehicle>\n",
-                    e.name,
-                    0.5 * height_m
-                );
-            }
+            Kind::Parked { size_m } => car(
+                &mut x,
+                &e.name,
+                size_m,
+                "<Properties>\n<Property name=\"parked\" value=\"true\"/>\n</Properties>",
+            ),
             Kind::Pedestrian { height_m } => {
                 let _ = write!(
                     x,
