@@ -536,7 +536,8 @@ pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
     colour.scale(f).add(V3::splat(light.fog).scale(F::ONE - f))
 }
 
-/// A head's colours at unit directions `normal` from its centre: hair on top and at the back (`albedo2`), and
+/// A head's colours at unit directions `normal` from its centre: hair on the crown, the temples and the back down
+/// to the nape (`albedo2`), and
 /// a face on the skin around the gaze direction (`prim.normal`, level): eyes, eyebrows in the hair's colour
 /// and a mouth, placed by the direction's components along the gaze, to the side and up.
 #[inline(always)]
@@ -545,7 +546,15 @@ fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
     let side = Vec3::new(fwd.y, -fwd.x, 0.0).normalize_or_zero();
     let (f, s, u) = (normal.dot_v(fwd), normal.dot_v(side).abs(), normal.z);
     let front = f.simd_gt(F::splat(0.55));
-    let hair = u.simd_gt(F::splat(0.25)) | f.simd_lt(F::splat(-0.3));
+    // Hair as a head of short hair wears it: the crown, the temples down to above the ears, and the whole back
+    // half of the head down to the nape, the ears left bare, so that a head seen from behind or three-quarters
+    // behind reads as hair, not as a face (MediaPipe took people seen from behind for people facing it when the
+    // sides of the back of the head were skin).
+    let ear =
+        s.simd_gt(F::splat(0.88)) & (u + F::splat(0.05)).abs().simd_lt(F::splat(0.15)) & f.simd_gt(F::splat(-0.05));
+    let hair = u.simd_gt(F::splat(0.25))
+        | (f.simd_lt(F::splat(0.3)) & u.simd_gt(F::splat(0.08)))
+        | (f.simd_lt(F::splat(0.05)) & u.simd_gt(F::splat(-0.7)) & !ear);
     let sq = |x: F| x * x;
     let eye = front & (sq(s - F::splat(0.33)) + sq(u - F::splat(0.06)) * F::splat(2.0)).simd_lt(F::splat(0.0081));
     let brow = front

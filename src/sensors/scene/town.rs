@@ -5,6 +5,9 @@
 
 use super::*;
 
+/// The share of a flat surface's albedo that hair of the same colour reflects (strands self-shadow).
+const HAIR_ALBEDO_SCALE: f32 = 0.6;
+
 /// A spatially coherent run of static triangles with its bounding sphere, for culling.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cluster {
@@ -133,7 +136,9 @@ impl Outfit {
         );
         let tights = linear([28, 26, 30]);
         let shoes = linear(identity.shoes_rgb);
-        let hair = linear(identity.hair_rgb);
+        // Hair shades darker than a flat surface of its colour: light enters between the strands and is absorbed
+        // there (a head of dark hair seen from behind reads as nearly black in a photo).
+        let hair = linear(identity.hair_rgb) * HAIR_ALBEDO_SCALE;
         let accessory = |c: Option<[u8; 3]>| linear(c.unwrap_or([60, 60, 60]));
         // A dress is one garment in the top's colour; a skirt is the bottom's.
         let skirt = if figure.garment == Garment::Skirt { bottom } else { top };
