@@ -537,9 +537,9 @@ pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
 }
 
 /// A head's colours at unit directions `normal` from its centre: hair on the crown, the temples and the back down
-/// to the nape (`albedo2`), and
-/// a face on the skin around the gaze direction (`prim.normal`, level): eyes, eyebrows in the hair's colour
-/// and a mouth, placed by the direction's components along the gaze, to the side and up.
+/// to the nape (`albedo2`), and a face on the skin around the gaze direction (`prim.normal`, level): eyes,
+/// eyebrows in the hair's colour and a mouth, placed by the direction's components along the gaze, to the side
+/// and up.
 #[inline(always)]
 fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
     let fwd = prim.normal;
