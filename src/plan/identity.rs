@@ -35,31 +35,17 @@ const SKIN: [[u8; 3]; 7] = [
     [118, 72, 45],
     [82, 52, 36],
 ];
-/// Hair colours (sRGB) of children and adults, each listed as often as it is drawn (a twentieth each): black and
-/// dark brown 30 % each, brown 20 %, blonde 10 %, light brown and auburn 5 % each, dark hair being the most common
-/// on city streets. (An even draw over the six gave the light ones half the heads; a light head seen from behind
+/// Hair colours (sRGB) of children and adults, each with the twentieths of heads that have it: black and dark
+/// brown 30 % each, brown 20 %, light brown 5 %, blonde 10 % and auburn 5 %, dark hair being the most common on
+/// city streets. (An even draw over the six gave the light ones half the heads; a light head seen from behind
 /// read as a face to MediaPipe, which then took the person to face the camera and swapped left and right.)
-const HAIR: [[u8; 3]; 20] = [
-    [28, 24, 20],
-    [28, 24, 20],
-    [28, 24, 20],
-    [28, 24, 20],
-    [28, 24, 20],
-    [28, 24, 20],
-    [58, 40, 28],
-    [58, 40, 28],
-    [58, 40, 28],
-    [58, 40, 28],
-    [58, 40, 28],
-    [58, 40, 28],
-    [96, 66, 40],
-    [96, 66, 40],
-    [96, 66, 40],
-    [96, 66, 40],
-    [168, 132, 84],
-    [206, 178, 120],
-    [206, 178, 120],
-    [128, 58, 32],
+const HAIR: [([u8; 3], usize); 6] = [
+    ([28, 24, 20], 6),
+    ([58, 40, 28], 6),
+    ([96, 66, 40], 4),
+    ([168, 132, 84], 1),
+    ([206, 178, 120], 2),
+    ([128, 58, 32], 1),
 ];
 /// Hair colours (sRGB) of seniors.
 const GREY_HAIR: [[u8; 3]; 3] = [[150, 148, 145], [188, 186, 182], [222, 220, 214]];
@@ -325,6 +311,20 @@ fn figure(rng: &mut ChaCha20Rng, age: AgeGroup, gender: Gender, skirts: bool) ->
     }
 }
 
+/// A colour of `palette` drawn with its weight: one index below the weights' sum, the same draw as picking from
+/// the palette written out with each colour repeated its weight's number of times.
+fn weighted_pick(rng: &mut ChaCha20Rng, palette: &[([u8; 3], usize)]) -> [u8; 3] {
+    let total: usize = palette.iter().map(|&(_, n)| n).sum();
+    let mut k = rng.random_range(..total.max(1));
+    for &(rgb, n) in palette {
+        if k < n {
+            return rgb;
+        }
+        k -= n;
+    }
+    [128, 128, 128]
+}
+
 fn looks(rng: &mut ChaCha20Rng, height_m: f64, age: AgeGroup) -> Identity {
     let gender = if rng.random_bool(0.5) {
         Gender::Female
@@ -336,7 +336,7 @@ fn looks(rng: &mut ChaCha20Rng, height_m: f64, age: AgeGroup) -> Identity {
     let hair_rgb = if age == AgeGroup::Senior && rng.random_bool(SENIOR_GREY_SHARE) {
         pick(rng, &GREY_HAIR)
     } else {
-        pick(rng, &HAIR)
+        weighted_pick(rng, &HAIR)
     };
     let jitter = |rgb: [u8; 3], rng: &mut ChaCha20Rng| {
         rgb.map(|c| (i32::from(c) + rng.random_range(-CLOTHING_JITTER..=CLOTHING_JITTER)).clamp(0, 255) as u8)
@@ -367,6 +367,22 @@ fn looks(rng: &mut ChaCha20Rng, height_m: f64, age: AgeGroup) -> Identity {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hair_colours_are_drawn_with_their_weights() {
+        let mut rng = seeds::clip_rng(7, "hair-test");
+        let n = 20_000;
+        let mut counts = [0usize; HAIR.len()];
+        for _ in 0..n {
+            let rgb = weighted_pick(&mut rng, &HAIR);
+            counts[HAIR.iter().position(|&(c, _)| c == rgb).expect("a palette colour")] += 1;
+        }
+        for (&(rgb, weight), &count) in HAIR.iter().zip(&counts) {
+            let share = count as f64 / f64::from(n);
+            let want = weight as f64 / 20.0;
+            assert!((share - want).abs() < 0.015, "{rgb:?}: {share} drawn, {want} wanted");
+        }
+    }
 
     #[test]
     fn identities_are_deterministic_and_in_range() {
