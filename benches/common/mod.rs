@@ -48,7 +48,7 @@ pub fn busy_quickstart_clip(overrides: &[String]) -> BusyClip {
     let frame = (0..counts.len())
         .max_by_key(|&f| (counts[f], std::cmp::Reverse(f)))
         .unwrap_or(0) as u32;
-    let scene = StaticScene::build(&script, &trace, &net);
+    let scene = StaticScene::build(&script, &trace, &net, &ann.scenery);
     BusyClip {
         script,
         trace,

@@ -1,5 +1,6 @@
 //! Annotation of a simulated clip: the visibility gate, tight 2D boxes of the projected body, COCO-17
-//! keypoints with visibility flags, occlusion by vehicles, buildings, street lamps and other pedestrians, per-frame crossing
+//! keypoints with visibility flags (occluded: hidden by another object or by the body itself), occlusion by
+//! vehicles, buildings, street lamps and other pedestrians, per-frame crossing
 //! labels with temporal smoothing, sequence labels, time-to-event and intention onset.
 //!
 //! Crossing label (the paper's definition): C = 1 in a frame when the pedestrian is in a crossing-type state
@@ -16,8 +17,8 @@ use glam::{DVec2, DVec3};
 
 use super::body::{self, BodyPose, CHILD_OFFSET_M, Capsule};
 use super::cyclist;
-use super::occlusion::{Occluder, may_block, occluded, static_occluders};
-use super::scene::ParkedCar;
+use super::occlusion::{Occluder, hidden_by_own_body, may_block, occluded, static_occluders};
+use super::scene::ClipScenery;
 use crate::plan::{ClipScript, Figure};
 use crate::sim::gate::{PED_OCCLUDER_RADIUS_PER_M, gate_box_size_px, min_box, too_small};
 use crate::sim::rig::{Camera, CameraPose};
@@ -61,7 +62,8 @@ pub struct AnnotationRow {
     pub tte_frames: Option<i32>,
     /// Share of the body's sample points hidden by other objects.
     pub occlusion: f32,
-    /// COCO-17 keypoints: `x, y, v` per joint (v: 0 outside the image, 1 occluded, 2 visible).
+    /// COCO-17 keypoints: `x, y, v` per joint (v: 0 outside the image, 1 occluded by another object or by the
+    /// body itself, 2 visible).
     pub keypoints: [f32; 51],
     /// The 17 joints in the world, `x, y, z` per joint, metres.
     pub keypoints_3d: [f32; 51],
@@ -132,8 +134,9 @@ pub struct ClipAnnotations {
     /// Every cyclist-frame in front of the camera whose box reaches at least a pixel into the image, ordered by
     /// (frame, cyclist).
     pub cyclists: Vec<CyclistRow>,
-    /// The clip's parked cars (scenery the occlusion labels test against), by id.
-    pub parked_cars: Vec<ParkedCar>,
+    /// The clip's street lamps, furniture and parked cars: the scenery the occlusion labels test against and
+    /// the sensors draw.
+    pub scenery: ClipScenery,
 }
 
 /// A cyclist seen by the camera in one frame: the box of rider and bicycle, the rider's keypoints.
@@ -154,7 +157,8 @@ pub struct CyclistRow {
     /// Whether it passes the pedestrians' visibility gate (distance, minimum box size, inside the image when
     /// required, occlusion).
     pub annotated: bool,
-    /// The rider's COCO-17 keypoints `(u, v, flag)` (flag 2 visible, 1 occluded, 0 outside the image).
+    /// The rider's COCO-17 keypoints `(u, v, flag)` (flag 2 visible, 1 occluded by another object or by the body
+    /// itself, 0 outside the image).
     pub keypoints: [f32; 51],
     /// The rider's joints in the world, `(x, y, z)` metres.
     pub keypoints_3d: [f32; 51],
@@ -307,14 +311,15 @@ pub fn annotate(
         .iter()
         .map(|l| l.iter().position(|c| *c).map(|f| f as u32))
         .collect();
-    let (statics, parked_cars) = static_occluders(script, trace, town);
+    let scenery = ClipScenery::new(script, trace, town);
+    let statics = static_occluders(&scenery);
     let mut out = ClipAnnotations {
         rows: Vec::new(),
         pedestrians: vec![PedestrianLabels::default(); n_peds],
         rejections: Rejections::default(),
         crossing: Vec::new(),
         cyclists: Vec::new(),
-        parked_cars,
+        scenery,
     };
     for (i, p) in out.pedestrians.iter_mut().enumerate() {
         p.first_crossing_frame = first_crossing[i];
@@ -412,6 +417,8 @@ pub fn annotate(
                 } else if occluded(town, &near, cam.centre, *joint) {
                     hidden += 1;
                     1.0
+                } else if hidden_by_own_body(&rider, k, cam.centre) {
+                    1.0
                 } else {
                     2.0
                 };
@@ -495,10 +502,13 @@ pub fn annotate(
                     break;
                 }
                 let p = projected[k];
+                // Hidden by the body itself: labelled occluded, but not occlusion by something else.
                 let flag = if !inside[k] {
                     0.0
                 } else if occluded(town, &near, cam.centre, *joint) {
                     hidden += 1;
+                    1.0
+                } else if hidden_by_own_body(&pose, k, cam.centre) {
                     1.0
                 } else {
                     2.0

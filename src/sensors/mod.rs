@@ -214,7 +214,8 @@ pub fn render_frame(
     town: &RoadNetwork,
     frame: u32,
 ) -> camera::CameraImages {
-    let stat = scene::StaticScene::build(script, trace, town);
+    let scenery = scene::ClipScenery::new(script, trace, town);
+    let stat = scene::StaticScene::build(script, trace, town, &scenery);
     let mut renderer = clip_renderer(&stat, script, trace, rig);
     let mut images = camera::CameraImages::default();
     let mut shutter = Shutter::new(&rig.camera.imaging, renderer.gain(), script.fps);

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glam::{DVec3, Vec2, Vec3};
-use pedsynth::plan::{ClipScript, Plan, TownContext};
+use pedsynth::plan::{ClipScript, Garment, HairStyle, Plan, TownContext};
 use pedsynth::sensors::camera::{CameraImages, Renderer, SKY_DEPTH_M, light::Lighting, luminance};
 use pedsynth::sensors::scene::{
     self, CYCLIST_INSTANCE_BASE, Cluster, FrameScene, Material, Mesh, Prim, StaticScene, pedestrian_instance, tag,
@@ -110,7 +110,18 @@ pub(crate) struct MaskReport {
     pub(crate) umbrellas: usize,
     pub(crate) dynamic_px: usize,
     pub(crate) dynamic_px_with_instance: usize,
+    /// Keypoints on their pedestrian's pixels, by flag (visible; occluded in a pedestrian no other object hides,
+    /// that is by its own body), and how many of each have the rendered body nearer the camera than the joint by
+    /// more than [`BODY_IN_FRONT_M`].
+    pub(crate) visible_on_body: usize,
+    pub(crate) visible_behind_body: usize,
+    pub(crate) self_hidden_on_body: usize,
+    pub(crate) self_hidden_behind_body: usize,
 }
+
+/// How much nearer than a joint the rendered body must be at its pixel for the joint to lie behind the body,
+/// metres: more than a limb's or the head's radius (4–9 cm), less than the body's depth (20 cm and more).
+const BODY_IN_FRONT_M: f32 = 0.12;
 
 /// Whether `test` holds for a pixel within one pixel of the image point (`x`, `y`) (the label sample of pixel
 /// (px, py) lies at (px + 0.25, py + 0.25)); `test` gets the pixel's index.
@@ -207,6 +218,42 @@ pub(crate) fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut
             report.keypoints += 1;
             report.keypoints_on_body += usize::from(near_pixel(img, x, y, |i| img.instance[i] == id));
         }
+        // Where a keypoint's pixel shows its own pedestrian, the rendered body is not far in front of a visible
+        // joint, and is in front of one its own body hides (nothing else hides this pedestrian: occlusion 0).
+        // Clothes over the joints (a skirt, a coat, long hair, a hat) are drawn in front of them and do not hide
+        // them: only pedestrians in trousers, bareheaded and without long hair are compared.
+        let figure = &c.script.pedestrians[r.pedestrian as usize].identity.figure;
+        if figure.garment != Garment::Trousers
+            || figure.hair == HairStyle::Long
+            || figure.headwear.is_some()
+            || figure.hood
+        {
+            continue;
+        }
+        let ego = &c.trace.ego[frame as usize];
+        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+        for k in 0..17 {
+            let flag = r.keypoints[3 * k + 2];
+            let (x, y) = (r.keypoints[3 * k], r.keypoints[3 * k + 1]);
+            let (px, py) = ((x - 0.25).round(), (y - 0.25).round());
+            if flag == 0.0 || px < 0.0 || py < 0.0 || px as usize >= w || py as usize >= img.height {
+                continue;
+            }
+            let i = py as usize * w + px as usize;
+            if img.instance[i] != id {
+                continue;
+            }
+            let joint = DVec3::from_array(std::array::from_fn(|a| f64::from(r.keypoints_3d[3 * k + a])));
+            let joint_depth_m = (joint - cam.centre).dot(cam.forward) as f32;
+            let behind = img.depth_m[i] < joint_depth_m - BODY_IN_FRONT_M;
+            if flag == 2.0 {
+                report.visible_on_body += 1;
+                report.visible_behind_body += usize::from(behind);
+            } else {
+                report.self_hidden_on_body += 1;
+                report.self_hidden_behind_body += usize::from(img.depth_m[i] < joint_depth_m - 0.03);
+            }
+        }
     }
 }
 
@@ -239,7 +286,7 @@ pub(crate) fn masks_match_boxes_and_keypoints(overrides: &[&str]) -> MaskReport 
         ..MaskReport::default()
     };
     let mut frames = 0;
-    let stat = StaticScene::build(&c.script, &c.trace, net);
+    let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
     sensors::render_cameras(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
         check_masks(&c, f.frame, f.images, &mut report);
         for (&tag_id, &instance) in f.images.semantic.iter().zip(&f.images.instance) {
@@ -289,6 +336,27 @@ pub(crate) fn masks_match_boxes_and_keypoints(overrides: &[&str]) -> MaskReport 
         "{} of {} visible keypoints on their pedestrian's pixels",
         report.keypoints_on_body,
         report.keypoints
+    );
+    // Visibility flags against the rendered depth: a visible joint is seldom behind its own body, a joint flagged
+    // as hidden by its own body mostly is (the hand behind the back, the far shoulder in profile, the face seen
+    // from behind).
+    let visible_behind = report.visible_behind_body as f64 / report.visible_on_body as f64;
+    let self_hidden_behind = report.self_hidden_behind_body as f64 / report.self_hidden_on_body.max(1) as f64;
+    eprintln!(
+        "{} of {} visible keypoints behind their own rendered body; {} of {} flagged hidden by it",
+        report.visible_behind_body, report.visible_on_body, report.self_hidden_behind_body, report.self_hidden_on_body
+    );
+    assert!(
+        visible_behind <= 0.02,
+        "{} of {} visible keypoints lie more than {BODY_IN_FRONT_M} m behind their own rendered body",
+        report.visible_behind_body,
+        report.visible_on_body
+    );
+    assert!(
+        report.self_hidden_on_body >= 100 && self_hidden_behind >= 0.9,
+        "{} of {} keypoints hidden by their own body lie behind its rendered pixels",
+        report.self_hidden_behind_body,
+        report.self_hidden_on_body
     );
     report
 }
@@ -867,7 +935,7 @@ fn static_scenes_give_no_dvs_events_and_motion_gives_some() {
     let net = &c.towns[&c.script.town].network;
     let mut per_frame = Vec::new();
     let sensors = c.plan.spec.sensors.clone();
-    let stat = StaticScene::build(&c.script, &c.trace, net);
+    let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
     sensors::render_cameras(&stat, &c.script, &c.trace, &sensors, &c.rig, |f| {
         per_frame.push((
             f.frame,
@@ -1143,7 +1211,7 @@ fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
     for weather in ["clear_noon", "night_rainy"] {
         let c = clip(&spec("quickstart.yaml"), &[&format!("dataset.weathers=[{weather}]")]);
         let net = &c.towns[&c.script.town].network;
-        let stat = StaticScene::build(&c.script, &c.trace, net);
+        let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
         let frame_no = c.busy_frames(1)[0];
         let mut frame = FrameScene::default();
         frame.build(&stat, &c.script, &c.trace, scene::SceneTime::at(frame_no));

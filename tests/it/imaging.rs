@@ -73,7 +73,7 @@ fn the_clip_renderer_meters_a_gain_between_one_and_its_bound() {
     for (weather, max_gain, want_above_one) in [("clear_noon", 16.0f32, false), ("night_clear", 16.0, true)] {
         let c = quickstart(weather, &[]);
         let net = &c.towns[&c.script.town].network;
-        let stat = StaticScene::build(&c.script, &c.trace, net);
+        let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
         let gain = sensors::clip_renderer(&stat, &c.script, &c.trace, &c.rig).gain();
         assert!((1.0..=max_gain).contains(&gain), "{weather}: gain {gain}");
         assert_eq!(gain > 1.0, want_above_one, "{weather}: gain {gain}");
@@ -130,7 +130,7 @@ fn the_dvs_sees_the_clean_image() {
         ]);
         let c = clip(&spec("quickstart.yaml"), &overrides);
         let net = &c.towns[&c.script.town].network;
-        let stat = StaticScene::build(&c.script, &c.trace, net);
+        let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
         let mut all = Vec::new();
         let mut rgb = Vec::new();
         sensors::render_cameras::<()>(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
@@ -225,7 +225,7 @@ fn motion_blur_smears_the_rgb_of_its_frame_and_leaves_the_labels() {
     ]);
     let c = clip(&spec("quickstart.yaml"), &overrides);
     let net = &c.towns[&c.script.town].network;
-    let stat = StaticScene::build(&c.script, &c.trace, net);
+    let stat = StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
     let mut frames = Vec::new();
     sensors::render_cameras::<()>(&stat, &c.script, &c.trace, &c.plan.spec.sensors, &c.rig, |f| {
         frames.push(f.images.rgb.clone());

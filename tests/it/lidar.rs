@@ -178,7 +178,7 @@ fn clip_of(spec_path: &Path) -> Clip {
     let trace = sim::simulate(&script, &plan.sim, &net);
     let rig = Rig::from_spec(&plan.spec.sensors);
     let annotations = sensors::observe(&script, &trace, &plan.spec, &rig, &net).annotations;
-    let stat = StaticScene::build(&script, &trace, &net);
+    let stat = StaticScene::build(&script, &trace, &net, &annotations.scenery);
     Clip {
         lidar: plan.spec.sensors.lidar.clone(),
         script,

@@ -49,11 +49,9 @@ fn clips() -> Vec<Clip> {
     out
 }
 
+/// The clip's parked cars, as its annotations placed them (and the sensors draw them).
 fn parked(c: &Clip) -> Vec<ParkedCar> {
-    let net = &c.towns[&c.script.town].network;
-    let posts = scene::clip_lamp_posts(&c.trace, net);
-    let furniture = scene::clip_furniture(&c.trace, net, c.script.seed, &posts);
-    scene::clip_parked_cars(&c.script, &c.trace, net, &posts, &furniture)
+    c.ann.scenery.parked_cars.clone()
 }
 
 #[test]

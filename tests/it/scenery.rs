@@ -220,7 +220,7 @@ fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
         probes.extend(posters.iter().map(|p| (p.centre(), p.foot)));
         // Each wall seen square-on from the road, 6 m in front of it (the static scene alone, clear noon): its
         // centre's pixel is the glass, tagged Static, at its depth.
-        let stat = scene::StaticScene::build(&c.script, &c.trace, net);
+        let stat = scene::StaticScene::build(&c.script, &c.trace, net, &c.ann.scenery);
         for (k, wall) in furniture
             .iter()
             .enumerate()

@@ -120,7 +120,7 @@ impl Walker {
                     let mut files =
                         ClipSensorWriter::new(&layout, &script.clip_id, script.fps, sensors, &plan.spec.output, &meta)
                             .expect("sensor writer");
-                    let stat = StaticScene::build(script, &trace, net);
+                    let stat = StaticScene::build(script, &trace, net, &ann.scenery);
                     let _ = sensors::render_cameras(&stat, script, &trace, sensors, &rig, |f| {
                         let last = f.frame >= 4;
                         files.frame(f).expect("sensor files");

@@ -38,7 +38,9 @@ pub fn run_clip(
     let mut images = 0u64;
     let mut sensor_rows = Vec::new();
     if sensors.cameras_enabled() || sensors.lidar.enabled {
-        let stat = crate::sensors::scene::StaticScene::build(script, trace, &town.network);
+        // The scenery the annotations placed and tested against, drawn as it is.
+        let scenery = &observations.annotations.scenery;
+        let stat = crate::sensors::scene::StaticScene::build(script, trace, &town.network, scenery);
         // Cameras and LiDAR write disjoint files: side by side on the rayon pool (an idle worker takes one).
         let (cameras, lidar) = rayon::join(
             || -> Result<Vec<crate::dataset::write::sensors::IndexRow>, Error> {

@@ -44,6 +44,34 @@ pub use parked::*;
 pub use recolour::*;
 pub use town::*;
 
+/// The scenery placed per clip along the ego's path: street lamps ([`clip_lamp_posts`]), street furniture
+/// ([`clip_furniture`]) and parked cars ([`clip_parked_cars`]). Computed once per clip and shared by the
+/// occlusion labels (which test against it) and the sensors (which draw it: [`StaticScene::build`]), so both
+/// see the same objects.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClipScenery {
+    /// Street lamps along the sidewalks.
+    pub lamp_posts: Vec<LampPost>,
+    /// Bins, bollards, signs and bus shelters at the curbs.
+    pub furniture: Vec<Furniture>,
+    /// Parked cars along the curbs, by id (the `parked_cars` table's `parked_car`).
+    pub parked_cars: Vec<ParkedCar>,
+}
+
+impl ClipScenery {
+    /// The scenery of the clip `script` whose simulation gave `trace`.
+    pub fn new(script: &ClipScript, trace: &ClipTrace, town: &RoadNetwork) -> ClipScenery {
+        let lamp_posts = clip_lamp_posts(trace, town);
+        let furniture = clip_furniture(trace, town, script.seed, &lamp_posts);
+        let parked_cars = clip_parked_cars(script, trace, town, &lamp_posts, &furniture);
+        ClipScenery {
+            lamp_posts,
+            furniture,
+            parked_cars,
+        }
+    }
+}
+
 /// CARLA's semantic tags (CARLA 0.9.14+, `carla.CityObjectLabel`), as written in the `semantic` stream.
 pub mod tag {
     /// Nothing (never drawn: every pixel is something).

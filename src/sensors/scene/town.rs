@@ -379,8 +379,9 @@ pub(super) fn stat_rel(origin: DVec3, p: DVec3) -> Vec3 {
 }
 
 impl StaticScene {
-    /// Builds the static scene of a clip: the town within [`SCENE_MARGIN_M`] of the ego's path.
-    pub fn build(script: &ClipScript, trace: &ClipTrace, town: &RoadNetwork) -> StaticScene {
+    /// Builds the static scene of a clip: the town within [`SCENE_MARGIN_M`] of the ego's path, with the clip's
+    /// `scenery` ([`ClipScenery::new`] of the same clip; the annotations carry it).
+    pub fn build(script: &ClipScript, trace: &ClipTrace, town: &RoadNetwork, scenery: &ClipScenery) -> StaticScene {
         let (lo, hi) = scene_bounds(trace);
         let z0 = trace.ego.first().map_or(0.0, |e| e.pos.z);
         let origin = DVec3::new(((lo.x + hi.x) * 0.5).round(), ((lo.y + hi.y) * 0.5).round(), z0.round());
@@ -610,8 +611,7 @@ impl StaticScene {
         let mut lamps = Vec::new();
         let metal = flat(Material::Metal, tag::POLE, linear([70, 74, 78]), Vec3::Z, 0);
         let head = flat(Material::LampHead, tag::POLE, linear([230, 220, 190]), -Vec3::Z, 0);
-        let posts = clip_lamp_posts(trace, town);
-        for post in &posts {
+        for post in &scenery.lamp_posts {
             let base = (post.base_z_m - origin.z) as f32;
             let f = (post.foot - origin.truncate()).as_vec2();
             let dir = post.to_road.as_vec2();
@@ -648,8 +648,7 @@ impl StaticScene {
         }
 
         // Street furniture (bins, rows of bollards, signs, bus shelters) at the curb, per clip.
-        let furniture = clip_furniture(trace, town, seed, &posts);
-        for item in &furniture {
+        for item in &scenery.furniture {
             let c = (item.foot - origin.truncate()).as_vec2();
             let half = item.half_m.truncate().as_vec2();
             let base = (item.base_z_m - origin.z) as f32;
@@ -689,10 +688,7 @@ impl StaticScene {
         }
 
         // Parked cars along the curbs, per clip, their lamps dark.
-        for (id, car) in clip_parked_cars(script, trace, town, &posts, &furniture)
-            .iter()
-            .enumerate()
-        {
+        for (id, car) in scenery.parked_cars.iter().enumerate() {
             let (paint, instance) = (linear(car.rgb), parked_instance(id as u32));
             b.mesh.car(
                 stat_rel(origin, car.centre),

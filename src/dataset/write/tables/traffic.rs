@@ -187,7 +187,7 @@ pub fn vehicles_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
 /// stands with two wheels up on the curb.
 pub fn parked_cars_batch(script: &ClipScript, ann: &ClipAnnotations) -> RecordBatch {
     use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
-    let cars = &ann.parked_cars;
+    let cars = &ann.scenery.parked_cars;
     let n = cars.len();
     let f32c = |get: &dyn Fn(&crate::sensors::scene::ParkedCar) -> f64| -> ArrayRef {
         Arc::new(Float32Array::from_iter_values(cars.iter().map(|c| get(c) as f32)))
