@@ -12,8 +12,11 @@ a person is found; a joint agrees when it lies within 10 % of the box height of 
 pedestrian crop, a crop of the same size at a seeded place in the same frame whose instance pixels hold no
 pedestrian, cyclist or child (skipped where 50 tries find none).
 
-Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png] [--per-joint]` (the
-dataset needs RGB as PNG and the instance stream). `--sheet` also writes a crop sheet: per weather (a row), six
+Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png] [--per-joint]
+[--per-view]` (the dataset needs RGB as PNG and the instance stream). `--per-view` also prints the figures by the
+view our keypoints give: *back* where our left shoulder lies left of our right one in the image by 8 %+ of the box
+height, *front* the other way round, *side* in between; a found front or back view is *mirrored* where MediaPipe's
+left shoulder lies on the other side of its right one than ours (its joints are counted apart). `--sheet` also writes a crop sheet: per weather (a row), six
 crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found.
 `--per-joint` also prints each joint's agreement over all weathers; `--crops FILE.csv` writes one row per
 pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing), to join with
@@ -59,6 +62,7 @@ def main() -> int:
     ap.add_argument("--max-background", type=float, default=0.05, help="--check: most background crops fired on")
     ap.add_argument("--sheet", type=Path)
     ap.add_argument("--per-joint", action="store_true", help="also print the agreement of each joint")
+    ap.add_argument("--per-view", action="store_true", help="also print the figures by view (front, back, side)")
     ap.add_argument("--crops", type=Path, help="also write one CSV row per pedestrian crop")
     a = ap.parse_args()
     root = a.dataset
@@ -71,6 +75,7 @@ def main() -> int:
     per = {}
     sheet = {}
     per_joint = {}
+    per_view = {}
     crop_rows = []
     for path in sorted(glob.glob(str(root / "tables/annotations/*.parquet"))):
         t = pq.read_table(path).to_pydict()
@@ -108,10 +113,21 @@ def main() -> int:
             row = {"clip_id": clip, "weather": weather[clip], "frame": frame, "pedestrian": t["pedestrian"][i],
                    "height_px": b[3] - b[1], "found": int(bool(res.pose_landmarks)), "joints": 0, "agree": 0}
             crop_rows.append(row)
+            kp = t["keypoints"][i]
+            # The view from our shoulders (COCO 5 left, 6 right), mirrored where MediaPipe's (11, 12) swap sides.
+            across = (kp[3 * 5] - kp[3 * 6]) / (b[3] - b[1])
+            view = "side" if abs(across) < 0.08 else ("front" if across > 0 else "back")
+            v = per_view.setdefault(view, {"crops": 0, "found": 0, "mirrored": 0, "joints": [0, 0], "agree": [0, 0]})
+            v["crops"] += 1
+            mirrored = 0
+            if res.pose_landmarks and view != "side":
+                theirs = res.pose_landmarks.landmark[11].x - res.pose_landmarks.landmark[12].x
+                mirrored = int((theirs > 0) != (across > 0))
             if res.pose_landmarks:
                 s["found"] += 1
+                v["found"] += 1
+                v["mirrored"] += mirrored
                 lm = res.pose_landmarks.landmark
-                kp = t["keypoints"][i]
                 for coco, blaze in COCO_TO_BLAZE.items():
                     if kp[3 * coco + 2] != 2:
                         continue
@@ -122,6 +138,8 @@ def main() -> int:
                     s["agree"] += agree
                     row["joints"] += 1
                     row["agree"] += agree
+                    v["joints"][mirrored] += 1
+                    v["agree"][mirrored] += agree
                     j = per_joint.setdefault(coco, [0, 0])
                     j[0] += agree
                     j[1] += 1
@@ -159,6 +177,19 @@ def main() -> int:
         for coco in sorted(per_joint):
             agree, n = per_joint[coco]
             print(f"  {COCO_NAMES[coco]:16s} {100 * agree / max(1, n):5.1f}% of {n}")
+    if a.per_view:
+        for view in sorted(per_view):
+            v = per_view[view]
+            line = (
+                f"  {view:5s} {v['crops']:4d} crops, {100 * v['found'] / max(1, v['crops']):5.1f}% found, joints "
+                f"{100 * v['agree'][0] / max(1, v['joints'][0]):5.1f}% of {v['joints'][0]}"
+            )
+            if view != "side":
+                line += (
+                    f"; mirrored {v['mirrored']} of {v['found']} found, their joints "
+                    f"{100 * v['agree'][1] / max(1, v['joints'][1]):5.1f}% of {v['joints'][1]}"
+                )
+            print(line)
     if a.crops:
         with open(a.crops, "w") as f:
             f.write(",".join(crop_rows[0].keys()) + "\n" if crop_rows else "")

@@ -638,18 +638,9 @@ mod tests {
 
     fn frame(state: PedState, lane: Option<LaneType>) -> PedFrame {
         PedFrame {
-            pos: DVec3::ZERO,
-            yaw_rad: 0.0,
-            velocity: DVec2::ZERO,
             state,
             lane_type: lane,
-            head_yaw_rad: 0.0,
-            gait_phase: 0.0,
-            on_phone: false,
-            gesture: None,
-            reaction: None,
-            walk_signal: None,
-            on_crosswalk: false,
+            ..PedFrame::STILL
         }
     }
 

@@ -99,24 +99,15 @@ const SELF_OCCLUDERS: [usize; 19] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 1
 /// arms 3–4, forearms 5–6, thighs 7–8, shins 9–10, hips 16): their surface may come up to their radius before
 /// the joint along a line of sight. The head's points (nose, eyes, ears) lie on the head's surface instead
 /// ([`HEAD_SURFACE_ALLOWANCE`]).
+#[rustfmt::skip]
 const JOINT_CAPSULES: [&[usize]; 17] = [
-    &[],
-    &[],
-    &[],
-    &[],
-    &[],
-    &[1, 3, 0, 17],
-    &[1, 4, 0, 17],
-    &[3, 5],
-    &[4, 6],
-    &[5],
-    &[6],
-    &[16, 7, 0, 17],
-    &[16, 8, 0, 17],
-    &[7, 9],
-    &[8, 10],
-    &[9],
-    &[10],
+    &[], &[], &[], &[], &[],            // nose, eyes, ears
+    &[1, 3, 0, 17], &[1, 4, 0, 17],     // shoulders
+    &[3, 5], &[4, 6],                   // elbows
+    &[5], &[6],                         // wrists
+    &[16, 7, 0, 17], &[16, 8, 0, 17],   // hips
+    &[7, 9], &[8, 10],                  // knees
+    &[9], &[10],                        // ankles
 ];
 
 /// The part that belongs to a joint and never hides it: a wrist's hand (capsules 14–15) and an ankle's foot
@@ -203,20 +194,7 @@ mod tests {
     /// A body standing at the origin facing +x, seen from 8 m at the camera's height in the direction `bearing_rad`
     /// (0: in front of it, π: behind it, π/2: on its left): the joints its own body hides.
     fn self_hidden(figure: &crate::plan::Figure, bearing_rad: f64) -> Vec<usize> {
-        let frame = crate::sim::trace::PedFrame {
-            pos: DVec3::ZERO,
-            yaw_rad: 0.0,
-            velocity: DVec2::ZERO,
-            state: crate::sim::trace::PedState::WalkingSidewalk,
-            lane_type: None,
-            head_yaw_rad: 0.0,
-            gait_phase: 0.0,
-            on_phone: false,
-            gesture: None,
-            reaction: None,
-            walk_signal: None,
-            on_crosswalk: false,
-        };
+        let frame = crate::sim::trace::PedFrame::STILL;
         let pose = super::super::body::pose(&frame, 1.75, figure, DVec3::ZERO);
         let camera = DVec2::from_angle(bearing_rad).extend(1.4) * DVec3::new(8.0, 8.0, 1.0);
         (0..17).filter(|&k| hidden_by_own_body(&pose, k, camera)).collect()

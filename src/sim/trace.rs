@@ -159,6 +159,26 @@ pub struct PedFrame {
     pub on_crosswalk: bool,
 }
 
+#[cfg(test)]
+impl PedFrame {
+    /// A pedestrian standing still at the origin on the sidewalk, facing +x, head straight, doing nothing (for
+    /// tests: override what matters with `PedFrame { .., ..PedFrame::STILL }`).
+    pub(crate) const STILL: PedFrame = PedFrame {
+        pos: DVec3::ZERO,
+        yaw_rad: 0.0,
+        velocity: DVec2::ZERO,
+        state: PedState::WalkingSidewalk,
+        lane_type: None,
+        head_yaw_rad: 0.0,
+        gait_phase: 0.0,
+        on_phone: false,
+        gesture: None,
+        reaction: None,
+        walk_signal: None,
+        on_crosswalk: false,
+    };
+}
+
 /// A gesture to the ego's driver (PIE's `gesture` labels; DATASET.md maps them to JAAD's).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
