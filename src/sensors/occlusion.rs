@@ -134,8 +134,8 @@ const SELF_OCCLUSION_TOLERANCE_M: f64 = 0.02;
 
 /// Whether joint `k` (COCO-17) of `pose` is hidden from `camera` by the body's own parts ([`SELF_OCCLUDERS`]):
 /// the line of sight enters one of them farther before the joint than the joint's depth inside that part allows
-/// ([`JOINT_CAPSULES`]; a joint's hand or foot never hides it, [`own_part`]). Such a joint is labelled as occluded (COCO's flag 1) but does not count towards the
-/// body's occlusion by other things.
+/// ([`JOINT_CAPSULES`]; a joint's hand or foot never hides it, [`own_part`]). Such a joint is labelled as
+/// occluded (COCO's flag 1) but does not count towards the body's occlusion by other things.
 pub(super) fn hidden_by_own_body(pose: &BodyPose, k: usize, camera: DVec3) -> bool {
     let joint = pose.joints[k];
     let distance_m = joint.distance(camera);
