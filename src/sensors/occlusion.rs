@@ -139,6 +139,7 @@ const SELF_OCCLUSION_TOLERANCE_M: f64 = 0.02;
 pub(super) fn hidden_by_own_body(pose: &BodyPose, k: usize, camera: DVec3) -> bool {
     let joint = pose.joints[k];
     let distance_m = joint.distance(camera);
+    let dir = (joint - camera) / distance_m;
     // In the joint's frame (single precision is plenty there): the ray reaches the joint at time 1.
     let ray = Ray::new((camera - joint).as_vec3(), (joint - camera).as_vec3());
     SELF_OCCLUDERS.iter().any(|&i| {
@@ -153,6 +154,18 @@ pub(super) fn hidden_by_own_body(pose: &BodyPose, k: usize, camera: DVec3) -> bo
         } else {
             SELF_OCCLUSION_TOLERANCE_M
         };
+        // Cheap rejections first (a millimetre to spare, so that the ray cast alone decides near the bounds): a
+        // capsule wholly beyond the depth it would have to reach, or whose bounding sphere the line of sight
+        // misses, cannot hide the joint.
+        let (da, db) = ((c.a - camera).dot(dir), (c.b - camera).dot(dir));
+        if da.min(db) - c.radius_m > distance_m - allowance_m + 1e-3 {
+            return false;
+        }
+        let centre = (c.a + c.b) * 0.5 - camera;
+        let bound_m = c.a.distance(c.b) * 0.5 + c.radius_m + 1e-3;
+        if centre.reject_from_normalized(dir).length_squared() > bound_m * bound_m {
+            return false;
+        }
         let shape = parry3d::shape::Capsule::new((c.a - joint).as_vec3(), (c.b - joint).as_vec3(), c.radius_m as f32);
         shape
             .cast_local_ray(&ray, 1.0, true)
