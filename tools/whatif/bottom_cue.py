@@ -1,6 +1,6 @@
 """Why the box-bottom cue (crossers' windows lower in the image than non-crossers') is weaker in a generated set
 than in JAAD train: the cue with and without each video's or clip's horizon, the horizon's spread, the classes'
-box heights and bottoms, and which pedestrians the synthetic windows come from.
+box heights and bottoms, which pedestrians the synthetic windows come from, and where non-crossers' tracks end.
 
 The horizon of a video (JAAD) or clip (ours) is the intercept of `bottom = horizon + slope × height` fitted to its
 unoccluded boxes (fractions of the image height), as `pedsynth calibrate` fits the camera. Windows are
@@ -132,9 +132,66 @@ def report(name: str, rows, size, hz) -> None:
             print(f"    {k:28s} {mk.sum():6d} windows, median height {np.median(q['height'][mk]):.3f}")
 
 
+def track_ends(name: str, tracks, length) -> None:
+    """Non-crossers' tracks of 76+ frames: the share that ends with its video or clip (within 3 frames), and the
+    box height 3 frames before the end (where the benchmark's last window ends), for those and the others."""
+    ends = np.array([(last >= length[g] - 3, h) for g, last, h in tracks])
+    at_end, earlier = ends[ends[:, 0] == 1, 1], ends[ends[:, 0] == 0, 1]
+    print(
+        f"{name}: {len(ends)} non-crossers' tracks, {100 * len(at_end) / len(ends):.0f} % end with the "
+        f"video or clip (median last height {np.median(at_end):.3f}), the others earlier ({np.median(earlier):.3f})"
+    )
+
+
+def real_ends():
+    videos = {v["video"]: v for v in pq.read_table(REAL / "videos.parquet").to_pylist() if v["split"] == "train"}
+    peds = {(p["video"], p["pedestrian"]): p for p in pq.read_table(REAL / "pedestrians.parquet").to_pylist()}
+    tracks = defaultdict(list)
+    for r in pq.read_table(REAL / "boxes.parquet", columns=["video", "pedestrian", "frame", "y_min", "y_max"]).to_pylist():
+        if r["video"] in videos and "p" not in r["pedestrian"]:
+            tracks[(r["video"], r["pedestrian"])].append((r["frame"], (r["y_max"] - r["y_min"]) / videos[r["video"]]["height"]))
+    out = []
+    for key, rows in tracks.items():
+        p = peds.get(key, {})
+        if not ("b" in key[1] and (p.get("crossing") or 0) > 0) and len(rows) >= te.MIN_TRACK:
+            rows.sort()
+            out.append((key[0], rows[-1][0], rows[-3][1]))
+    return out, {v: videos[v]["num_frames"] for v in videos}
+
+
+def synthetic_ends(root: Path):
+    spec = yaml.safe_load((root / "spec.resolved.yaml").read_text())
+    height = spec["sensors"]["rgb"]["height_px"]
+    box = "annotator" if spec.get("annotations", {}).get("export_box") == "annotator" else "bbox"
+    frames = {
+        r["clip_id"]: r["frame_count"]
+        for r in ds.dataset(str(root / "tables/clips"), format="parquet").to_table(columns=["clip_id", "frame_count"]).to_pylist()
+    }
+    crosser = {
+        (r["clip_id"], r["pedestrian"]): r["crosser"]
+        for r in ds.dataset(str(root / "tables/pedestrians"), format="parquet")
+        .to_table(columns=["clip_id", "pedestrian", "crosser"])
+        .to_pylist()
+    }
+    t = ds.dataset(str(root / "tables/annotations"), format="parquet").to_table(
+        columns=["clip_id", "pedestrian", "frame", f"{box}_y_min", f"{box}_y_max"]
+    ).to_pydict()
+    tracks = defaultdict(list)
+    for c, p, f, y0, y1 in zip(t["clip_id"], t["pedestrian"], t["frame"], t[f"{box}_y_min"], t[f"{box}_y_max"]):
+        tracks[(c, p)].append((f, (y1 - y0) / height))
+    out = []
+    for key, rows in tracks.items():
+        if not crosser[key] and len(rows) >= te.MIN_TRACK:
+            rows.sort()
+            out.append((key[0], rows[-1][0], rows[-3][1]))
+    return out, frames
+
+
 def main() -> int:
     report("JAAD train", *real())
     report(sys.argv[1], *synthetic(Path(sys.argv[1])))
+    track_ends("JAAD train", *real_ends())
+    track_ends(sys.argv[1], *synthetic_ends(Path(sys.argv[1])))
     return 0
 
 
