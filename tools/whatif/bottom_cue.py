@@ -17,11 +17,12 @@ from pathlib import Path
 import numpy as np
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
-import yaml
 from sklearn.metrics import roc_auc_score
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import transfer_eval as te  # noqa: E402
+
+import common  # noqa: E402
 
 REAL = Path(__file__).resolve().parents[3] / "shared/real/jaad_trainval"
 
@@ -55,55 +56,51 @@ def real():
     for r in boxes:
         if "p" not in r["pedestrian"]:
             tracks[(r["video"], r["pedestrian"])].append((r["frame"], r["x_min"], r["y_min"], r["x_max"], r["y_max"]))
-    out = []
+    out, ends = [], []
     for key in sorted(tracks):
         rows = sorted(tracks[key])
         p = peds.get(key, {})
+        label = int("b" in key[1] and (p.get("crossing") or 0) > 0)
+        if not label and len(rows) >= te.MIN_TRACK:
+            # The whole track's last frame, and the box height 3 frames before it (track_ends).
+            ends.append((key[0], rows[-1][0], (rows[-3][4] - rows[-3][2]) / size[1]))
         event = p.get("crossing_point") if "b" in key[1] else -1
         event = -1 if event is None else int(event)
         rows = rows[: [r[0] for r in rows].index(event) + 1] if event != -1 else rows[:-2]
-        label = int("b" in key[1] and (p.get("crossing") or 0) > 0)
         if len(rows) >= te.MIN_TRACK:
             for w in te.windows(np.array([r[1:] for r in rows], dtype=np.float64)):
                 out.append((w, label, key[0], "jaad"))
-    return out, size, hz
+    lengths = {v["video"]: v["num_frames"] for v in videos if v["video"] in keep}
+    return (out, size, hz), (ends, lengths)
+
+
+def box_kind(spec: dict) -> str:
+    """The box the spec's `annotations.export_box` chooses (the tight box by default)."""
+    return "annotator" if spec.get("annotations", {}).get("export_box") == "annotator" else "bbox"
 
 
 def synthetic(root: Path):
-    spec = yaml.safe_load((root / "spec.resolved.yaml").read_text())
+    spec = common.spec(root)
     size = (spec["sensors"]["rgb"]["width_px"], spec["sensors"]["rgb"]["height_px"])
-    box = "annotator" if spec.get("annotations", {}).get("export_box") == "annotator" else "bbox"
-    edges = [f"{box}_x_min", f"{box}_y_min", f"{box}_x_max", f"{box}_y_max"]
-    peds = {
-        (r["clip_id"], r["pedestrian"]): r
+    box = box_kind(spec)
+    kind = {
+        (r["clip_id"], r["pedestrian"]): f"{r['role']}/{r['behaviour']}"
         for r in ds.dataset(str(root / "tables/pedestrians"), format="parquet")
-        .to_table(columns=["clip_id", "pedestrian", "crosser", "role", "behaviour"])
+        .to_table(columns=["clip_id", "pedestrian", "role", "behaviour"])
         .to_pylist()
     }
     tab = ds.dataset(str(root / "tables/annotations"), format="parquet").to_table(
-        columns=["clip_id", "pedestrian", "frame", "crossing", "occlusion", *edges]
+        columns=["clip_id", "occlusion", f"{box}_y_min", f"{box}_y_max"]
     )
     c = {n: tab.column(n).to_numpy(zero_copy_only=False) for n in tab.column_names}
     clear = c["occlusion"] == 0
-    hz = horizons(
-        c["clip_id"][clear],
-        (c[edges[3]][clear] - c[edges[1]][clear]) / size[1],
-        c[edges[3]][clear] / size[1],
-    )
-    tracks = defaultdict(list)
-    for i in range(tab.num_rows):
-        tracks[(c["clip_id"][i], int(c["pedestrian"][i]))].append(i)
-    out = []
-    for key in sorted(tracks):
-        idx = sorted(tracks[key], key=lambda i: c["frame"][i])
-        p = peds[key]
-        if p["crosser"]:
-            first = next((k for k, i in enumerate(idx) if c["crossing"][i]), None)
-            idx = idx[: first + 1] if first is not None else []
-        if len(idx) >= te.MIN_TRACK:
-            arr = np.stack([c[e][idx] for e in edges], axis=1).astype(np.float64)
-            for w in te.windows(arr):
-                out.append((w, int(p["crosser"]), key[0], f"{p['role']}/{p['behaviour']}"))
+    y_min, y_max = c[f"{box}_y_min"][clear], c[f"{box}_y_max"][clear]
+    hz = horizons(c["clip_id"][clear], (y_max - y_min) / size[1], y_max / size[1])
+    out = [
+        (w, int(crosser), key[0], kind[key])
+        for key, _, boxes, crosser in common.tracks(root, box)
+        for w in te.windows(boxes)
+    ]
     return out, size, hz
 
 
@@ -143,54 +140,28 @@ def track_ends(name: str, tracks, length) -> None:
     )
 
 
-def real_ends():
-    videos = {v["video"]: v for v in pq.read_table(REAL / "videos.parquet").to_pylist() if v["split"] == "train"}
-    peds = {(p["video"], p["pedestrian"]): p for p in pq.read_table(REAL / "pedestrians.parquet").to_pylist()}
-    tracks = defaultdict(list)
-    for r in pq.read_table(REAL / "boxes.parquet", columns=["video", "pedestrian", "frame", "y_min", "y_max"]).to_pylist():
-        if r["video"] in videos and "p" not in r["pedestrian"]:
-            tracks[(r["video"], r["pedestrian"])].append((r["frame"], (r["y_max"] - r["y_min"]) / videos[r["video"]]["height"]))
-    out = []
-    for key, rows in tracks.items():
-        p = peds.get(key, {})
-        if not ("b" in key[1] and (p.get("crossing") or 0) > 0) and len(rows) >= te.MIN_TRACK:
-            rows.sort()
-            out.append((key[0], rows[-1][0], rows[-3][1]))
-    return out, {v: videos[v]["num_frames"] for v in videos}
-
-
 def synthetic_ends(root: Path):
-    spec = yaml.safe_load((root / "spec.resolved.yaml").read_text())
-    height = spec["sensors"]["rgb"]["height_px"]
-    box = "annotator" if spec.get("annotations", {}).get("export_box") == "annotator" else "bbox"
+    spec = common.spec(root)
     frames = {
         r["clip_id"]: r["frame_count"]
-        for r in ds.dataset(str(root / "tables/clips"), format="parquet").to_table(columns=["clip_id", "frame_count"]).to_pylist()
-    }
-    crosser = {
-        (r["clip_id"], r["pedestrian"]): r["crosser"]
-        for r in ds.dataset(str(root / "tables/pedestrians"), format="parquet")
-        .to_table(columns=["clip_id", "pedestrian", "crosser"])
+        for r in ds.dataset(str(root / "tables/clips"), format="parquet")
+        .to_table(columns=["clip_id", "frame_count"])
         .to_pylist()
     }
-    t = ds.dataset(str(root / "tables/annotations"), format="parquet").to_table(
-        columns=["clip_id", "pedestrian", "frame", f"{box}_y_min", f"{box}_y_max"]
-    ).to_pydict()
-    tracks = defaultdict(list)
-    for c, p, f, y0, y1 in zip(t["clip_id"], t["pedestrian"], t["frame"], t[f"{box}_y_min"], t[f"{box}_y_max"]):
-        tracks[(c, p)].append((f, (y1 - y0) / height))
-    out = []
-    for key, rows in tracks.items():
-        if not crosser[key] and len(rows) >= te.MIN_TRACK:
-            rows.sort()
-            out.append((key[0], rows[-1][0], rows[-3][1]))
+    height = spec["sensors"]["rgb"]["height_px"]
+    out = [
+        (key[0], int(f[-1]), (boxes[-3, 3] - boxes[-3, 1]) / height)
+        for key, f, boxes, crosser in common.tracks(root, box_kind(spec))
+        if not crosser
+    ]
     return out, frames
 
 
 def main() -> int:
-    report("JAAD train", *real())
+    windows, ends = real()
+    report("JAAD train", *windows)
     report(sys.argv[1], *synthetic(Path(sys.argv[1])))
-    track_ends("JAAD train", *real_ends())
+    track_ends("JAAD train", *ends)
     track_ends(sys.argv[1], *synthetic_ends(Path(sys.argv[1])))
     return 0
 
