@@ -47,15 +47,16 @@ def tracks(root: Path, box: str):
 def evaluate(label: str, root: Path, box: str, transform) -> None:
     """Prints the transfer and domain AUC of windows of `transform(key, frames, boxes)` for every track."""
     s = spec(root)["sensors"]["rgb"]
-    xs, ys = [], []
+    xs, ys, gs = [], [], []
     for key, frames, boxes, crosser in tracks(root, box):
         for w in t.windows(transform(key, frames, boxes)):
             xs.append(w)
             ys.append(int(crosser))
-    xs, ys = np.array(xs), np.array(ys)
+            gs.append(key[0])
+    xs, ys, gs = np.array(xs), np.array(ys), np.array(gs)
     real = Path("../shared/real/jaad_trainval")
-    xr, _, sr = t.real_windows(real, "train")
+    xr, _, sr, gr = t.real_windows_grouped(real, "train")
     xv, yv, sv = t.real_windows(real, "val")
     fr, fv, fs = t.features(xr, sr), t.features(xv, sv), t.features(xs, (s["width_px"], s["height_px"]))
     transfer = t.auc(yv, t.classifier().fit(fs, ys).predict_proba(fv)[:, 1])
-    print(label, "transfer", round(transfer, 3), "domain", round(t.domain_auc(fr, fs), 3))
+    print(label, "transfer", round(transfer, 3), "domain", round(t.domain_auc(fr, fs, gr, gs), 3))

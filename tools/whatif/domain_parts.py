@@ -1,5 +1,5 @@
 """Which parts of the 16-box windows give a generated set away: the domain classifier (synthetic vs JAAD
-train, 5-fold) on feature groups alone.
+train, 5-fold grouped by clip and video, as tools/transfer_eval.py) on feature groups alone.
 
 Not pedsynth code: a what-if measured on a generated dataset's tables before building anything (BENCHMARKS.md,
 "Transfer to real data"). Run from the repository root: `python3 tools/whatif/domain_parts.py DATASET `. Needs
@@ -8,8 +8,8 @@ Not pedsynth code: a what-if measured on a generated dataset's tables before bui
 import sys; sys.path.insert(0,'tools')
 import transfer_eval as t, numpy as np
 from pathlib import Path
-xs,ys,ss=t.synth_windows(Path(sys.argv[1]))
-xr,yr,sr=t.real_windows(Path('../shared/real/jaad_trainval'),'train')
+xs,ys,ss,gs=t.synth_windows_grouped(Path(sys.argv[1]))
+xr,yr,sr,gr=t.real_windows_grouped(Path('../shared/real/jaad_trainval'),'train')
 def parts(w,size):
     W,H=size
     x0,y0,x1,y1=[w[:,:,i] for i in range(4)]
@@ -19,7 +19,7 @@ def parts(w,size):
             'size+place at the last frame':np.stack([cx[:,-1],b[:,-1],h[:,-1],bw[:,-1]],1),
             'second differences over h':np.concatenate([np.diff(cx,2,axis=1)/h[:,2:],np.diff(h,2,axis=1)/h[:,2:],np.diff(b,2,axis=1)/h[:,2:]],1)}
 ps,pr=parts(xs,ss),parts(xr,sr)
-for k in ps: print(f'{k:45s} domain AUC {t.domain_auc(pr[k],ps[k]):.3f}')
+for k in ps: print(f'{k:45s} domain AUC {t.domain_auc(pr[k],ps[k],gr,gs):.3f}')
 
 
 # Finer: the dynamics and the window's shape by part.
@@ -35,4 +35,4 @@ def parts2(w, size):
             'total change of cx, h, bottom, w over the window / h': np.concatenate([tot(cx), tot(h), tot(b), tot(bw)], 1) / h[:, :1],
             'residual sd of cx, h about a 16-frame line / h': np.stack([resid(cx), resid(h)], 1) / h[:, :1]}
 ps, pr = parts2(xs, ss), parts2(xr, sr)
-for k in ps: print(f'{k:52s} domain AUC {t.domain_auc(pr[k], ps[k]):.3f}')
+for k in ps: print(f'{k:52s} domain AUC {t.domain_auc(pr[k], ps[k], gr, gs):.3f}')
