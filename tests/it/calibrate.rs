@@ -97,14 +97,16 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         f.crosser_ego_within_m.1
     );
     // JAAD's boxes move linearly over pieces of 2–10 frames (p25–p75): the annotator's keyframes. Pedestrians seen
-    // together share a change of bearing of a 4.0° smooth heading wobble (tools' Python estimate of the common
-    // change read as an AR(1) heading: 1.90°; × √((1 − e^−0.5) / (1 − 1.5 e^−0.5)) for the smooth one: 3.97°).
+    // together share a change of bearing of a 7.7° smooth heading wobble with a 2.1 s correlation time (the
+    // common change's root mean square over 2 frames to 3 s, 0.24° to 6.9°, fitted; an independent numpy
+    // reading of the same boxes and lags with the same grid: T 2.10 s, σ 7.68°).
     assert_eq!(f.keyframe_every, (2, 10));
     assert_eq!(
         spec.annotations.annotator_box.keyframe_every,
         pedsynth::spec::types::CountRange(2, 10)
     );
-    assert_eq!(f.heading_wobble_sd_deg, Some(4.0));
+    assert_eq!(f.heading_wobble_sd_deg, Some(7.7));
+    assert_eq!(f.heading_wobble_correlation_s, Some(2.1));
     // Non-crossers (JAAD's crossing attribute not 1, tracks of 76+ frames, 666 of them) first seen 2.1–19.5 m
     // to the side (p10–p90 as `measure::quantile` reads them; numpy's interpolated percentiles of the same boxes:
     // 2.09 and 19.44).
@@ -113,7 +115,8 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         spec.crossing.scenario.walker_lateral_m,
         pedsynth::spec::types::Range(2.1, 19.5)
     );
-    assert_eq!(spec.traffic.ego.heading_wobble.sd_deg, 4.0);
+    assert_eq!(spec.traffic.ego.heading_wobble.sd_deg, 7.7);
+    assert_eq!(spec.traffic.ego.heading_wobble.correlation_s, 2.1);
     // People draw small boxes relatively wider: over the 9,383 windows, the mean aspect against the mean height
     // is 5.8 px / height above a residual of 0.28–0.46 (p10–p90). An independent numpy fit of the same windows
     // (JAAD's crossers cut at their crossing point, tracks of 76+ boxes): pad 5.799 px, residual 0.2803–0.4619.

@@ -141,50 +141,88 @@ pub fn linear_pieces(videos: &[RealVideo]) -> Vec<f64> {
     pieces
 }
 
-/// Frames over which [`pan_sd_deg`] measures each pedestrian's change of bearing (0.5 s at 30 frames/s).
-const PAN_LAG_FRAMES: u32 = 15;
+/// The lags at which [`pan_wobble`] measures the common change of bearing, seconds (2 to 90 frames at 30
+/// frames/s).
+const PAN_LAGS_S: [f64; 8] = [2.0 / 30.0, 4.0 / 30.0, 8.0 / 30.0, 0.5, 1.0, 1.5, 2.0, 3.0];
 
-/// The camera's heading wobble, degrees: the standard deviation of the simulator's smooth heading offset (two
-/// first-order lags of 1 s, autocorrelation `(1 + τ/T) e^{−τ/T}`) whose change over [`PAN_LAG_FRAMES`] frames
-/// explains what pedestrians seen together share of their change of bearing. In each video, every 15th frame,
-/// each pedestrian's bearing `atan((centre − W/2) / f)` is compared with its bearing 15 frames later; the mean
-/// product of two different pedestrians' changes (their own walking and the annotators' noise are independent
-/// and drop out; a turn or wobble of the car moves them all) is the variance of the common change,
-/// `2 σ² (1 − 1.5 e^{−0.5})` (τ = 0.5 s, T = 1 s). The car's forward motion also moves pedestrians on one side
-/// together, so this bounds the wobble from above (a set generated without wobble measures 1.5°: 0.74° read as an
-/// AR(1)). `None` with fewer than 100 such pairs.
-pub fn pan_sd_deg(videos: &[RealVideo], focal_px: f64) -> Option<f64> {
-    let (mut sum, mut pairs) = (0.0, 0.0);
-    for v in videos {
-        let half_w = v.width_px * 0.5;
-        let mut by_frame: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
-        for t in &v.tracks {
-            let bearing: BTreeMap<u32, f64> = t
-                .boxes
-                .iter()
-                .map(|b| (b.frame, ((0.5 * (b.x_min_px + b.x_max_px) - half_w) / focal_px).atan()))
-                .collect();
-            for (&frame, &at) in bearing.iter().filter(|(f, _)| *f % PAN_LAG_FRAMES == 0) {
-                if let Some(&later) = bearing.get(&(frame + PAN_LAG_FRAMES)) {
-                    by_frame.entry(frame).or_default().push(later - at);
+/// The camera's heading wobble fitted to what pedestrians seen together share of their change of bearing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanFit {
+    /// The standard deviation of the simulator's smooth heading offset, degrees.
+    pub sd_deg: f64,
+    /// Its correlation time `T` (two first-order lags of `T`), seconds.
+    pub correlation_s: f64,
+}
+
+/// The camera's heading wobble: the spread and correlation time of the simulator's smooth heading offset (two
+/// first-order lags of `T`, autocorrelation `ρ(τ) = (1 + τ/T) e^{−τ/T}`) whose changes over lags of 2 frames to
+/// 3 s explain what pedestrians seen together share of their change of bearing. In each video, at every lag `τ`
+/// ([`PAN_LAGS_S`], in whole frames of the video), every `τ`-th frame, each pedestrian's bearing
+/// `atan((centre − W/2) / f)` is compared with its bearing `τ` later; the mean product of two different
+/// pedestrians' changes (their own walking and the annotators' noise are independent and drop out; a turn or
+/// wobble of the car moves them all) is the variance of the common change, `V(τ) = 2 σ² (1 − ρ(τ))`. `T` is
+/// the one on a 0.05 s grid (0.1–10 s) whose curve fits the logarithms of the measured `V` best (least
+/// squares), `σ` the one that fits them best for that `T` (closed form). A lag counts where it has at least 100
+/// pairs and a positive `V`; `None` with fewer than three such lags. The car's forward motion also moves
+/// pedestrians on one side together, so this bounds the wobble from above. JAAD train: the common change's
+/// root mean square grows from 0.24° over 2 frames to 6.9° over 3 s, nearly in proportion to the lag at first
+/// (a smooth turn): `T` 2.1 s, `σ` 7.7° (with `T` held at 1 s, as before, one lag of 0.5 s gave 4.0°, which makes the
+/// change over 3 s 5.1° and the turn rate change within half a second twice as fast as JAAD's).
+pub fn pan_wobble(videos: &[RealVideo], focal_px: f64) -> Option<PanFit> {
+    let mut measured: Vec<(f64, f64)> = Vec::new();
+    for lag_s in PAN_LAGS_S {
+        let (mut sum, mut pairs) = (0.0, 0.0);
+        for v in videos {
+            let lag = (lag_s * v.fps).round().max(1.0) as u32;
+            let half_w = v.width_px * 0.5;
+            let mut by_frame: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
+            for t in &v.tracks {
+                let bearing: BTreeMap<u32, f64> = t
+                    .boxes
+                    .iter()
+                    .map(|b| (b.frame, ((0.5 * (b.x_min_px + b.x_max_px) - half_w) / focal_px).atan()))
+                    .collect();
+                for (&frame, &at) in bearing.iter().filter(|(f, _)| *f % lag == 0) {
+                    if let Some(&later) = bearing.get(&(frame + lag)) {
+                        by_frame.entry(frame).or_default().push(later - at);
+                    }
                 }
             }
+            for changes in by_frame.values().filter(|c| c.len() >= 2) {
+                let total: f64 = changes.iter().sum();
+                let squares: f64 = changes.iter().map(|c| c * c).sum();
+                let n = changes.len() as f64;
+                sum += 0.5 * (total * total - squares);
+                pairs += 0.5 * n * (n - 1.0);
+            }
         }
-        for changes in by_frame.values().filter(|c| c.len() >= 2) {
-            let total: f64 = changes.iter().sum();
-            let squares: f64 = changes.iter().map(|c| c * c).sum();
-            let n = changes.len() as f64;
-            sum += 0.5 * (total * total - squares);
-            pairs += 0.5 * n * (n - 1.0);
+        if pairs >= 100.0 && sum > 0.0 {
+            measured.push((lag_s, sum / pairs));
         }
     }
-    if pairs < 100.0 {
+    if measured.len() < 3 {
         return None;
     }
-    let common_var = (sum / pairs).max(0.0);
-    let lag_s = f64::from(PAN_LAG_FRAMES) / 30.0;
-    let correlation = (1.0 + lag_s) * (-lag_s).exp();
-    Some((common_var / (2.0 * (1.0 - correlation))).sqrt().to_degrees())
+    let one_minus_rho = |tau_s: f64, t_s: f64| 1.0 - (1.0 + tau_s / t_s) * (-tau_s / t_s).exp();
+    let mut best: Option<(f64, f64, f64)> = None;
+    for step in 2..=200 {
+        let t_s = f64::from(step) * 0.05;
+        // ln V = ln(2σ²) + ln(1 − ρ): the best ln(2σ²) is the mean difference.
+        let diffs: Vec<f64> = measured
+            .iter()
+            .map(|&(tau, v)| v.ln() - one_minus_rho(tau, t_s).ln())
+            .collect();
+        let ln_two_var = diffs.iter().sum::<f64>() / diffs.len() as f64;
+        let error: f64 = diffs.iter().map(|d| (d - ln_two_var).powi(2)).sum();
+        if best.is_none_or(|(e, _, _)| error < e) {
+            best = Some((error, t_s, ln_two_var));
+        }
+    }
+    let (_, correlation_s, ln_two_var) = best?;
+    Some(PanFit {
+        sd_deg: (0.5 * ln_two_var.exp()).sqrt().to_degrees(),
+        correlation_s,
+    })
 }
 
 /// ROC AUC of `score` for `positive` (Mann–Whitney, ties counted half); `None` without both classes.
@@ -570,5 +608,80 @@ mod tests {
             "{c:?}"
         );
         assert_eq!(camera_spread(&videos[..2]), None, "two videos are too few");
+    }
+
+    /// Videos whose pedestrians all turn with one smooth heading offset (the simulator's two lags of `t_s`,
+    /// spread `sd_deg`), each with its own bearing and 0.3° of independent noise per frame.
+    fn panning_videos(sd_deg: f64, t_s: f64, videos: u64) -> Vec<RealVideo> {
+        use rand::SeedableRng;
+        use rand_distr::{Distribution, StandardNormal};
+        let (fps, frames, focal_px) = (30.0, 900u32, 960.0);
+        let rho = (-1.0 / (fps * t_s)).exp();
+        let sd_inner = sd_deg.to_radians() * (1.0 + rho) / (1.0 + rho * rho).sqrt();
+        (0..videos)
+            .map(|v| {
+                let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(v);
+                let mut z = || -> f64 { StandardNormal.sample(&mut rng) };
+                let (mut inner, mut offset) = (0.0, 0.0);
+                let offsets: Vec<f64> = (0..3000 + frames)
+                    .map(|_| {
+                        inner = rho * inner + sd_inner * (1.0 - rho * rho).sqrt() * z();
+                        offset = rho * offset + (1.0 - rho) * inner;
+                        offset
+                    })
+                    .skip(3000)
+                    .collect();
+                let tracks = (0..4)
+                    .map(|p| super::super::real::RealTrack {
+                        id: p.to_string(),
+                        crosser: false,
+                        crossing_frame: None,
+                        boxes: (0..frames)
+                            .map(|frame| {
+                                let bearing =
+                                    -0.3 + 0.2 * f64::from(p) + offsets[frame as usize] + 0.3f64.to_radians() * z();
+                                let centre = 960.0 + focal_px * bearing.tan();
+                                RealBox {
+                                    frame,
+                                    x_min_px: centre - 20.0,
+                                    y_min_px: 500.0,
+                                    x_max_px: centre + 20.0,
+                                    y_max_px: 620.0,
+                                    occluded: false,
+                                    standing: None,
+                                    looking: None,
+                                }
+                            })
+                            .collect(),
+                    })
+                    .collect();
+                RealVideo {
+                    name: format!("v{v}"),
+                    split: "train".into(),
+                    width_px: 1920.0,
+                    height_px: 1080.0,
+                    fps,
+                    tracks,
+                    ego_actions: BTreeMap::new(),
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn pan_wobble_recovers_the_spread_and_the_correlation_time_of_a_common_turn() {
+        for (sd_deg, t_s) in [(6.0, 2.0), (3.0, 0.7)] {
+            let fit = pan_wobble(&panning_videos(sd_deg, t_s, 60), 960.0).unwrap();
+            assert!(
+                (fit.sd_deg / sd_deg - 1.0).abs() < 0.12 && (fit.correlation_s / t_s - 1.0).abs() < 0.15,
+                "{fit:?} for {sd_deg}° and {t_s} s"
+            );
+        }
+        // One pedestrian per video: nobody to share a turn with.
+        let mut alone = panning_videos(6.0, 2.0, 5);
+        for v in &mut alone {
+            v.tracks.truncate(1);
+        }
+        assert_eq!(pan_wobble(&alone, 960.0), None);
     }
 }
