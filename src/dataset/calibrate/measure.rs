@@ -169,19 +169,27 @@ pub struct PanFit {
 /// (a smooth turn): `T` 2.1 s, `σ` 7.7° (with `T` held at 1 s, as before, one lag of 0.5 s gave 4.0°, which makes the
 /// change over 3 s 5.1° and the turn rate change within half a second twice as fast as JAAD's).
 pub fn pan_wobble(videos: &[RealVideo], focal_px: f64) -> Option<PanFit> {
+    // Each track's bearing by frame, read once for every lag.
+    let bearings: Vec<(f64, Vec<BTreeMap<u32, f64>>)> = videos
+        .iter()
+        .map(|v| {
+            let half_w = v.width_px * 0.5;
+            let tracks = v.tracks.iter().map(|t| {
+                t.boxes
+                    .iter()
+                    .map(|b| (b.frame, ((0.5 * (b.x_min_px + b.x_max_px) - half_w) / focal_px).atan()))
+                    .collect()
+            });
+            (v.fps, tracks.collect())
+        })
+        .collect();
     let mut measured: Vec<(f64, f64)> = Vec::new();
     for lag_s in PAN_LAGS_S {
         let (mut sum, mut pairs) = (0.0, 0.0);
-        for v in videos {
-            let lag = (lag_s * v.fps).round().max(1.0) as u32;
-            let half_w = v.width_px * 0.5;
+        for (fps, tracks) in &bearings {
+            let lag = (lag_s * fps).round().max(1.0) as u32;
             let mut by_frame: BTreeMap<u32, Vec<f64>> = BTreeMap::new();
-            for t in &v.tracks {
-                let bearing: BTreeMap<u32, f64> = t
-                    .boxes
-                    .iter()
-                    .map(|b| (b.frame, ((0.5 * (b.x_min_px + b.x_max_px) - half_w) / focal_px).atan()))
-                    .collect();
+            for bearing in tracks {
                 for (&frame, &at) in bearing.iter().filter(|(f, _)| *f % lag == 0) {
                     if let Some(&later) = bearing.get(&(frame + lag)) {
                         by_frame.entry(frame).or_default().push(later - at);
