@@ -105,8 +105,13 @@ fn jaad_tables_calibrate_to_an_independent_fit_and_the_benchmark_cues() {
         spec.annotations.annotator_box.keyframe_every,
         pedsynth::spec::types::CountRange(2, 10)
     );
-    assert_eq!(f.heading_wobble_sd_deg, Some(7.7));
-    assert_eq!(f.heading_wobble_correlation_s, Some(2.1));
+    assert_eq!(
+        f.heading_wobble,
+        Some(pedsynth::dataset::calibrate::measure::PanFit {
+            sd_deg: 7.7,
+            correlation_s: 2.1
+        })
+    );
     // Non-crossers (JAAD's crossing attribute not 1, tracks of 76+ frames, 666 of them) first seen 2.1–19.5 m
     // to the side (p10–p90 as `measure::quantile` reads them; numpy's interpolated percentiles of the same boxes:
     // 2.09 and 19.44).

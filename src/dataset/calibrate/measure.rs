@@ -146,7 +146,7 @@ pub fn linear_pieces(videos: &[RealVideo]) -> Vec<f64> {
 const PAN_LAGS_S: [f64; 8] = [2.0 / 30.0, 4.0 / 30.0, 8.0 / 30.0, 0.5, 1.0, 1.5, 2.0, 3.0];
 
 /// The camera's heading wobble fitted to what pedestrians seen together share of their change of bearing.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PanFit {
     /// The standard deviation of the simulator's smooth heading offset, degrees.
     pub sd_deg: f64,

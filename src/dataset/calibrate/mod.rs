@@ -113,12 +113,9 @@ pub struct Fit {
     /// `annotations.annotator_box.keyframe_every`: the 25th and 75th percentiles of the lengths of the pieces
     /// over which the real boxes' left edge moves linearly ([`measure::linear_pieces`]), frames.
     pub keyframe_every: (u32, u32),
-    /// `traffic.ego.heading_wobble.sd_deg`: [`measure::pan_wobble`]'s spread with the fitted focal length.
-    /// `None` where too few pedestrians are seen together.
-    pub heading_wobble_sd_deg: Option<f64>,
-    /// `traffic.ego.heading_wobble.correlation_s`: [`measure::pan_wobble`]'s correlation time, seconds (with
-    /// `heading_wobble_sd_deg`).
-    pub heading_wobble_correlation_s: Option<f64>,
+    /// `traffic.ego.heading_wobble`: [`measure::pan_wobble`] with the fitted focal length (`sd_deg` to 0.1°,
+    /// within the spec's 10°; `correlation_s` to 0.01 s). `None` where too few pedestrians are seen together.
+    pub heading_wobble: Option<measure::PanFit>,
     /// `crossing.layers.behaviour_mix.mix`'s `sudden` share: crossers walking in the last frame of their windows
     /// (a sudden crosser walks into the road without stopping at the curb); `normal` and `jaywalk` share the
     /// rest 2 : 1 as the paper's mix does. `None` where the real data has no standing/walking labels.
@@ -186,7 +183,6 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     let (width_px, height_px) =
         most_common(videos.iter().map(|v| (v.width_px as u32, v.height_px as u32))).unwrap_or((1920, 1080));
     let focal_px = f64::from(width_px) / 2.0 / (options.fov_deg.to_radians() / 2.0).tan();
-    let pan = measure::pan_wobble(videos, focal_px);
     let pitch_deg = ((horizon.horizon - 0.5) * f64::from(height_px) / focal_px)
         .atan()
         .to_degrees();
@@ -259,8 +255,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         ),
         width_pad_px: round(aspect.pad_px.clamp(0.0, 200.0), 1),
         sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
-        heading_wobble_sd_deg: pan.map(|p| round(p.sd_deg.clamp(0.0, 10.0), 1)),
-        heading_wobble_correlation_s: pan.map(|p| round(p.correlation_s, 2)),
+        heading_wobble: measure::pan_wobble(videos, focal_px).map(|p| measure::PanFit {
+            sd_deg: round(p.sd_deg.clamp(0.0, 10.0), 1),
+            correlation_s: round(p.correlation_s, 2),
+        }),
         keyframe_every: {
             let mut pieces = measure::linear_pieces(videos);
             let mut at = |q| (measure::quantile(&mut pieces, q).round() as u32).clamp(1, 300);
@@ -355,7 +353,11 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
             100.0 * sudden
         );
     }
-    if let (Some(sd), Some(t)) = (f.heading_wobble_sd_deg, f.heading_wobble_correlation_s) {
+    if let Some(measure::PanFit {
+        sd_deg: sd,
+        correlation_s: t,
+    }) = f.heading_wobble
+    {
         let _ = writeln!(
             out,
             "traffic:\n  ego:\n    heading_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of their change of bearing over 2 frames to 3 s (an upper bound: includes the car's forward motion)"
