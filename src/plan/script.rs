@@ -79,7 +79,10 @@ pub struct SimParams {
     pub cyclists: Option<Cyclists>,
     /// The ego's heading wobble (absent when off, and then absent from the plan file).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ego_heading: Option<crate::spec::types::HeadingWobble>,
+    pub ego_heading: Option<crate::spec::types::Wobble>,
+    /// The ego's pitch wobble (absent when off, and then absent from the plan file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ego_pitch: Option<crate::spec::types::Wobble>,
 }
 
 impl SimParams {
@@ -99,6 +102,7 @@ impl SimParams {
             signals: spec.traffic.signals.enabled.then(|| spec.traffic.signals.clone()),
             cyclists: (spec.traffic.cyclists.per_clip.max() > 0).then(|| spec.traffic.cyclists.clone()),
             ego_heading: Some(spec.traffic.ego.heading_wobble).filter(|w| w.sd_deg > 0.0),
+            ego_pitch: Some(spec.traffic.ego.pitch_wobble).filter(|w| w.sd_deg > 0.0),
         }
     }
 }

@@ -338,7 +338,7 @@ pub fn annotate(
     let (width, height) = (f64::from(camera.width_px), f64::from(camera.height_px));
     for frame in 0..trace.frame_count as usize {
         let Some(ego) = trace.ego.get(frame) else { break };
-        let cam = camera.at(ego.pos, ego.yaw_rad);
+        let cam = camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
         occluders.clear();
         occluders.extend_from_slice(&statics);
         for v in &trace.vehicles {

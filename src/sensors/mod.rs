@@ -171,8 +171,8 @@ pub fn scan_lidar<E>(
     for frame in 0..frames {
         let t = scene::SceneTime::at(frame);
         frame_scene.build(stat, script, trace, t);
-        let (pos, yaw) = scene::ego_at(trace, t);
-        let pose = scene_from(stat, &rig.world_from_lidar(pos, yaw));
+        let (pos, yaw, pitch) = scene::ego_at(trace, t);
+        let pose = scene_from(stat, &rig.world_from_lidar(pos, yaw, pitch));
         tracer.set_agents(&frame_scene, &pose);
         points.clear();
         let stats = lidar::scan(
@@ -199,10 +199,10 @@ pub fn scan_lidar<E>(
 /// The world pose of each sensor at a frame: the camera (whose image the annotations are in) and the LiDAR,
 /// each as `world_from_sensor` with sensor axes x forward, y left, z up.
 pub fn sensor_poses(trace: &ClipTrace, rig: &Rig, frame: u32) -> [(&'static str, DAffine3); 2] {
-    let (pos, yaw): (DVec3, f64) = scene::ego_at(trace, scene::SceneTime::at(frame));
+    let (pos, yaw, pitch): (DVec3, f64, f64) = scene::ego_at(trace, scene::SceneTime::at(frame));
     [
-        ("camera", rig.camera.world_from_sensor(pos, yaw)),
-        ("lidar", rig.world_from_lidar(pos, yaw)),
+        ("camera", rig.camera.world_from_sensor(pos, yaw, pitch)),
+        ("lidar", rig.world_from_lidar(pos, yaw, pitch)),
     ]
 }
 
@@ -257,11 +257,11 @@ impl ClipView<'_> {
         images: &mut camera::CameraImages,
     ) {
         frame_scene.build(self.stat, self.script, self.trace, t);
-        let (pos, yaw) = scene::ego_at(self.trace, t);
+        let (pos, yaw, pitch) = scene::ego_at(self.trace, t);
         renderer.render(
             self.stat,
             frame_scene,
-            &self.rig.camera.at(pos, yaw),
+            &self.rig.camera.at(pos, yaw, pitch),
             streak_seed,
             images,
         );

@@ -109,6 +109,12 @@ pub fn simulate(script: &ClipScript, params: &SimParams, town: &RoadNetwork) -> 
     if let Some(wobble) = &params.ego_heading {
         wobble_heading(&mut trace, wobble, script.seed, script.fps);
     }
+    if let Some(wobble) = &params.ego_pitch {
+        let offsets_rad = wobble_offsets_rad(wobble, script.seed, "ego pitch", script.fps, trace.ego.len());
+        for (frame, offset_rad) in trace.ego.iter_mut().zip(offsets_rad) {
+            frame.pitch_rad = offset_rad;
+        }
+    }
     trace
 }
 
@@ -119,22 +125,24 @@ pub fn simulate(script: &ClipScript, params: &SimParams, town: &RoadNetwork) -> 
 /// (AR(1)) would turn the camera by a fresh random rate every frame. The lags run for ten time constants before
 /// the clip's first frame, so the offset starts from its stationary spread. The sensors point along the recorded
 /// heading; the simulated path is unchanged.
-fn wobble_heading(trace: &mut ClipTrace, wobble: &crate::spec::types::HeadingWobble, clip_seed: u64, fps: u32) {
-    let offsets_rad = heading_offsets_rad(wobble, clip_seed, fps, trace.ego.len());
+fn wobble_heading(trace: &mut ClipTrace, wobble: &crate::spec::types::Wobble, clip_seed: u64, fps: u32) {
+    let offsets_rad = wobble_offsets_rad(wobble, clip_seed, "ego heading", fps, trace.ego.len());
     for (frame, offset_rad) in trace.ego.iter_mut().zip(offsets_rad) {
         frame.yaw_rad += offset_rad;
     }
 }
 
-/// The heading wobble's offsets for `frames` frames (see [`wobble_heading`]), radians.
-fn heading_offsets_rad(
-    wobble: &crate::spec::types::HeadingWobble,
+/// A wobble's offsets for `frames` frames (see [`wobble_heading`]) from the clip's stream `stream` (`"ego
+/// heading"`, `"ego pitch"`), radians.
+fn wobble_offsets_rad(
+    wobble: &crate::spec::types::Wobble,
     clip_seed: u64,
+    stream: &str,
     fps: u32,
     frames: usize,
 ) -> Vec<f64> {
     use rand_distr::{Distribution, StandardNormal};
-    let mut rng = crate::plan::seeds::clip_rng(clip_seed, "ego heading");
+    let mut rng = crate::plan::seeds::clip_rng(clip_seed, stream);
     let sd_rad = wobble.sd_deg.to_radians();
     let frames_per_t = f64::from(fps.max(1)) * wobble.correlation_s.max(1e-3);
     let rho = (-1.0 / frames_per_t).exp();
@@ -340,6 +348,7 @@ impl<'a> Sim<'a> {
             let frame = VehicleFrame {
                 pos: DVec3::new(v.pose.pos.x, v.pose.pos.y, v.pose.z_m),
                 yaw_rad: v.pose.heading_rad,
+                pitch_rad: 0.0,
                 speed_mps: v.speed_mps,
                 accel_mps2: v.accel_mps2,
                 yielding: v.yielding,
@@ -646,7 +655,7 @@ fn form_groups(script: &ClipScript, peds: &mut [Ped]) {
 #[cfg(test)]
 mod tests {
     use super::heading_offsets_rad;
-    use crate::spec::types::HeadingWobble;
+    use crate::spec::types::Wobble;
 
     /// The standard deviation of `xs` about their mean.
     fn sd(xs: &[f64]) -> f64 {
@@ -656,14 +665,14 @@ mod tests {
 
     #[test]
     fn the_heading_wobble_is_smooth_with_the_asked_spread_and_change_over_half_a_second() {
-        let wobble = HeadingWobble {
+        let wobble = Wobble {
             sd_deg: 2.0,
             correlation_s: 1.0,
         };
         // Many clips' offsets (each from its own seed), degrees.
         let clips: Vec<Vec<f64>> = (0..400_u64)
             .map(|seed| {
-                heading_offsets_rad(&wobble, seed, 30, 450)
+                wobble_offsets_rad(&wobble, seed, "ego heading", 30, 450)
                     .iter()
                     .map(|r| r.to_degrees())
                     .collect()
@@ -692,8 +701,13 @@ mod tests {
             sd(&steps)
         );
         assert_eq!(
-            heading_offsets_rad(&wobble, 9, 30, 100),
-            heading_offsets_rad(&wobble, 9, 30, 100)
+            wobble_offsets_rad(&wobble, 9, "ego heading", 30, 100),
+            wobble_offsets_rad(&wobble, 9, "ego heading", 30, 100)
+        );
+        // The pitch draws from its own stream: the two wobbles of a clip are independent.
+        assert_ne!(
+            wobble_offsets_rad(&wobble, 9, "ego heading", 30, 100),
+            wobble_offsets_rad(&wobble, 9, "ego pitch", 30, 100)
         );
     }
 }

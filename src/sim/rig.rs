@@ -41,9 +41,10 @@ impl Rig {
         }
     }
 
-    /// The LiDAR's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
-    pub fn world_from_lidar(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
-        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.lidar_vehicle_from_sensor
+    /// The LiDAR's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`, its body
+    /// pitched `pitch_rad` (nose up positive).
+    pub fn world_from_lidar(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64, vehicle_pitch_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad, vehicle_pitch_rad) * self.lidar_vehicle_from_sensor
     }
 }
 
@@ -125,7 +126,7 @@ const OPTICAL_FROM_SENSOR: DMat3 = DMat3::from_cols(
 );
 
 /// The camera mount of the clip seeded `clip_seed`: `rgb.mount` with its height and pitch offset by draws from
-/// `rgb.mount_spread`'s ranges (the clip's `"camera mount"` stream). With the default spread (`[0, 0]`) it is
+/// `rgb.mount_spread`'s ranges or pitch quantiles (the clip's `"camera mount"` stream). With the default spread (`[0, 0]`) it is
 /// `rgb.mount` exactly.
 pub fn clip_mount(rgb: &Rgb, clip_seed: u64) -> Mount {
     let spread = &rgb.mount_spread;
@@ -134,9 +135,9 @@ pub fn clip_mount(rgb: &Rgb, clip_seed: u64) -> Mount {
         return mount;
     }
     let mut rng = clip_rng(clip_seed, "camera mount");
-    let mut draw = |r: crate::spec::types::Range| r.min() + (r.max() - r.min()) * rng.random::<f64>();
-    mount.up_m += draw(spread.up_m);
-    mount.pitch_deg += draw(spread.pitch_deg);
+    let up = spread.up_m;
+    mount.up_m += up.min() + (up.max() - up.min()) * rng.random::<f64>();
+    mount.pitch_deg += spread.pitch_at(rng.random::<f64>());
     mount
 }
 
@@ -152,9 +153,18 @@ pub fn vehicle_from_mount(mount: &Mount) -> DAffine3 {
     )
 }
 
-/// The pose of a vehicle in the world: on the ground at `pos` (z is the ground height), heading `yaw_rad`.
-pub fn world_from_vehicle(pos: DVec3, yaw_rad: f64) -> DAffine3 {
-    DAffine3::from_mat3_translation(DMat3::from_rotation_z(yaw_rad), pos)
+/// The pose of a vehicle in the world: on the ground at `pos` (z is the ground height), heading `yaw_rad`, its
+/// body pitched `pitch_rad` about the ground point (nose up positive, CARLA's convention; the ego's pitch
+/// wobble, 0 for every other vehicle).
+pub fn world_from_vehicle(pos: DVec3, yaw_rad: f64, pitch_rad: f64) -> DAffine3 {
+    if pitch_rad == 0.0 {
+        // Without pitch, exactly the matrix of earlier versions (bit for bit).
+        return DAffine3::from_mat3_translation(DMat3::from_rotation_z(yaw_rad), pos);
+    }
+    DAffine3::from_mat3_translation(
+        DMat3::from_rotation_z(yaw_rad) * DMat3::from_rotation_y(-pitch_rad),
+        pos,
+    )
 }
 
 /// A camera placed in the world for one frame: everything needed to project points.
@@ -219,14 +229,15 @@ impl Camera {
         )
     }
 
-    /// The camera's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`.
-    pub fn world_from_sensor(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> DAffine3 {
-        world_from_vehicle(vehicle_pos, vehicle_yaw_rad) * self.vehicle_from_sensor
+    /// The camera's pose in the world (x forward, y left, z up) on a vehicle at `pos` heading `yaw_rad`, pitched
+    /// `pitch_rad` ([`world_from_vehicle`]).
+    pub fn world_from_sensor(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64, vehicle_pitch_rad: f64) -> DAffine3 {
+        world_from_vehicle(vehicle_pos, vehicle_yaw_rad, vehicle_pitch_rad) * self.vehicle_from_sensor
     }
 
-    /// The camera on a vehicle at `pos` heading `yaw_rad`.
-    pub fn at(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64) -> CameraPose {
-        let world_from_sensor = self.world_from_sensor(vehicle_pos, vehicle_yaw_rad);
+    /// The camera on a vehicle at `pos` heading `yaw_rad`, pitched `pitch_rad` ([`world_from_vehicle`]).
+    pub fn at(&self, vehicle_pos: DVec3, vehicle_yaw_rad: f64, vehicle_pitch_rad: f64) -> CameraPose {
+        let world_from_sensor = self.world_from_sensor(vehicle_pos, vehicle_yaw_rad, vehicle_pitch_rad);
         let sensor_from_world = world_from_sensor.inverse();
         let optical_from_world = DAffine3::from_mat3(OPTICAL_FROM_SENSOR) * sensor_from_world;
         let rot = world_from_sensor.matrix3;
@@ -278,7 +289,7 @@ mod tests {
     fn intrinsics_and_axes_follow_the_spec() {
         let cam = Camera::from_spec(&Rgb::default());
         assert!((cam.focal_px - 640.0).abs() < 1e-9, "f = W / (2 tan(45°)) = 640");
-        let pose = cam.at(DVec3::ZERO, 0.0);
+        let pose = cam.at(DVec3::ZERO, 0.0, 0.0);
         assert!((pose.centre - DVec3::new(0.8, 0.3, 1.4)).length() < 1e-12);
         // Pitch −8° looks down: the forward axis has a negative z component.
         assert!((pose.forward.z - (-8f64.to_radians()).sin()).abs() < 1e-12);
@@ -296,7 +307,7 @@ mod tests {
     #[test]
     fn the_camera_turns_with_the_vehicle() {
         let cam = Camera::from_spec(&Rgb::default());
-        let pose = cam.at(DVec3::new(10.0, 5.0, 0.0), std::f64::consts::FRAC_PI_2);
+        let pose = cam.at(DVec3::new(10.0, 5.0, 0.0), std::f64::consts::FRAC_PI_2, 0.0);
         assert!(
             (pose.forward.truncate().normalize() - DVec2::Y).length() < 1e-9,
             "heading north looks north"

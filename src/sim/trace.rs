@@ -85,6 +85,11 @@ impl PedState {
     }
 }
 
+/// Whether a body pitch is level (left out of serialised traces).
+fn is_level(pitch_rad: &f64) -> bool {
+    *pitch_rad == 0.0
+}
+
 /// A vehicle (ego or traffic) in one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct VehicleFrame {
@@ -92,6 +97,10 @@ pub struct VehicleFrame {
     pub pos: DVec3,
     /// Heading.
     pub yaw_rad: f64,
+    /// Body pitch about the ground point, nose up positive: the ego's pitch wobble (`traffic.ego.pitch_wobble`),
+    /// 0 for every other vehicle and without the wobble.
+    #[serde(default, skip_serializing_if = "is_level")]
+    pub pitch_rad: f64,
     /// Speed along the heading, m/s.
     pub speed_mps: f64,
     /// Longitudinal acceleration, m/s².

@@ -137,7 +137,7 @@ fn parked_cars_are_drawn_as_cars_with_their_own_instance() {
         let cars = parked(&c);
         for frame in (0..c.trace.frame_count as usize).step_by(30) {
             let ego = c.trace.ego[frame];
-            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
             let img = c.render(frame as u32);
             for (id, car) in cars.iter().enumerate() {
                 // The middle of its side at door height (0.6 m up), 5–30 m away.
@@ -202,7 +202,7 @@ fn keypoints_behind_a_parked_car_are_labelled_occluded() {
         let frames: std::collections::BTreeSet<u32> = c.ann.rows.iter().map(|r| r.frame).collect();
         for &frame in frames.iter().step_by(6) {
             let ego = c.trace.ego[frame as usize];
-            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
             let img = c.render(frame);
             for row in c.ann.rows.iter().filter(|r| r.frame == frame) {
                 for j in 0..17 {

@@ -83,6 +83,10 @@ pub struct Fit {
     /// (degrees), `√3 ×` the per-video standard deviations ([`measure::CameraSpread`]; a uniform draw of that
     /// half-width has that deviation); 0 where too few videos can be fitted alone.
     pub mount_spread: (f64, f64),
+    /// `sensors.rgb.mount_spread.pitch_quantiles_deg` (in place of the uniform pitch range): the per-video
+    /// horizons' quantiles at every 5 % ([`measure::horizon_quantiles`]) as pitches, less `pitch_deg`, to 0.1°;
+    /// empty where fewer than 10 videos can be placed.
+    pub pitch_quantiles_deg: Vec<f64>,
     /// `dataset.fps`: the most common frame rate.
     pub fps: u32,
     /// `crossing.timeline.in_view_before_crossing_s`: the 10th and 90th percentiles of how long crossers are
@@ -116,6 +120,9 @@ pub struct Fit {
     /// `traffic.ego.heading_wobble`: [`measure::pan_wobble`] with the fitted focal length (`sd_deg` to 0.1°,
     /// within the spec's 10°; `correlation_s` to 0.01 s). `None` where too few pedestrians are seen together.
     pub heading_wobble: Option<measure::PanFit>,
+    /// `traffic.ego.pitch_wobble`: [`measure::pitch_wobble`] with the fitted focal length and slope (`sd_deg` to
+    /// 0.01°, within the spec's 5°; `correlation_s` to 0.01 s). `None` where too few pedestrians are seen together.
+    pub pitch_wobble: Option<measure::PanFit>,
     /// `crossing.layers.behaviour_mix.mix`'s `sudden` share: crossers walking in the last frame of their windows
     /// (a sudden crosser walks into the road without stopping at the curb); `normal` and `jaywalk` share the
     /// rest 2 : 1 as the paper's mix does. `None` where the real data has no standing/walking labels.
@@ -194,6 +201,18 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
             3f64.sqrt() * (c.horizon_sd * f64::from(height_px) / focal_px * cos2).to_degrees(),
         )
     });
+    let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
+    let fitted_pitch_deg = round(pitch_deg.clamp(-30.0, 30.0), 1);
+    let pitch_quantiles_deg = measure::horizon_quantiles(videos, horizon.slope, 21)
+        .map(|q| {
+            q.iter()
+                .map(|h| {
+                    let pitch = ((h - 0.5) * f64::from(height_px) / focal_px).atan().to_degrees();
+                    round((pitch - fitted_pitch_deg).clamp(-45.0, 45.0), 1)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     let seen = real.seen_before_crossing_s;
     let distance = |b: &RealBox| measure::distance_m(focal_px, options.person_height_m, b.y_max_px - b.y_min_px);
     let mut at_crossing = Vec::new();
@@ -220,7 +239,6 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
     let (crossers_at, walkers_at) = (measure::Spread::of(at_crossing), measure::Spread::of(walkers_first));
     let walkers_aside = measure::Spread::of(walkers_aside);
     let aspect = measure::aspect_fit(videos, &options.pab);
-    let round = |x: f64, d: i32| (x * 10f64.powi(d)).round() / 10f64.powi(d);
     let lo = round(seen.p10.clamp(0.5, 30.0), 1);
     let fit = Fit {
         width_px,
@@ -228,7 +246,8 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         fov_deg: options.fov_deg,
         up_m: round((horizon.slope * options.person_height_m).clamp(0.5, 3.0), 2),
         person_height_m: options.person_height_m,
-        pitch_deg: round(pitch_deg.clamp(-30.0, 30.0), 1),
+        pitch_deg: fitted_pitch_deg,
+        pitch_quantiles_deg,
         mount_spread: (
             round(mount_spread.0.clamp(0.0, 1.0), 2),
             round(mount_spread.1.clamp(0.0, 15.0), 1),
@@ -257,6 +276,10 @@ pub fn calibrate(videos: &[RealVideo], options: &CalibrateOptions) -> Result<Cal
         sudden_share: real.crossing.standing.map(|standing| round(1.0 - standing, 2)),
         heading_wobble: measure::pan_wobble(videos, focal_px).map(|p| measure::PanFit {
             sd_deg: round(p.sd_deg.clamp(0.0, 10.0), 1),
+            correlation_s: round(p.correlation_s, 2),
+        }),
+        pitch_wobble: measure::pitch_wobble(videos, focal_px, horizon.slope).map(|p| measure::PanFit {
+            sd_deg: round(p.sd_deg.clamp(0.0, 5.0), 2),
             correlation_s: round(p.correlation_s, 2),
         }),
         keyframe_every: {
@@ -320,9 +343,19 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
         let (up, pitch) = f.mount_spread;
         let _ = writeln!(
             out,
-            "    mount_spread:  # per clip: {} videos fitted alone, horizon sd {:.3}, slope sd {:.3}\n      up_m: [{}, {}]\n      pitch_deg: [{}, {}]",
-            c.videos, c.horizon_sd, c.slope_sd, -up, up, -pitch, pitch
+            "    mount_spread:  # per clip: {} videos fitted alone, horizon sd {:.3}, slope sd {:.3}\n      up_m: [{}, {}]",
+            c.videos, c.horizon_sd, c.slope_sd, -up, up
         );
+        if f.pitch_quantiles_deg.is_empty() {
+            let _ = writeln!(out, "      pitch_deg: [{}, {}]", -pitch, pitch);
+        } else {
+            let list: Vec<String> = f.pitch_quantiles_deg.iter().map(|q| q.to_string()).collect();
+            let _ = writeln!(
+                out,
+                "      pitch_quantiles_deg: [{}]  # the videos' horizons (median of bottom - slope x height) at every 5 %, as pitches about pitch_deg",
+                list.join(", ")
+            );
+        }
     }
     let _ = writeln!(
         out,
@@ -353,6 +386,9 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
             100.0 * sudden
         );
     }
+    if f.heading_wobble.is_some() || f.pitch_wobble.is_some() {
+        let _ = writeln!(out, "traffic:\n  ego:");
+    }
     if let Some(measure::PanFit {
         sd_deg: sd,
         correlation_s: t,
@@ -360,7 +396,17 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     {
         let _ = writeln!(
             out,
-            "traffic:\n  ego:\n    heading_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of their change of bearing over 2 frames to 3 s (an upper bound: includes the car's forward motion)"
+            "    heading_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of their change of bearing over 2 frames to 3 s (an upper bound: includes the car's forward motion)"
+        );
+    }
+    if let Some(measure::PanFit {
+        sd_deg: sd,
+        correlation_s: t,
+    }) = f.pitch_wobble
+    {
+        let _ = writeln!(
+            out,
+            "    pitch_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of the change of their horizon (bottom - slope x height) over 2 frames to 3 s"
         );
     }
     let _ = writeln!(

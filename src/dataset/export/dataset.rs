@@ -95,6 +95,8 @@ pub struct EgoFrame {
     pub y_m: f64,
     pub z_m: f64,
     pub yaw_rad: f64,
+    /// Body pitch, nose up positive (the pitch wobble; 0 without it).
+    pub pitch_rad: f64,
     pub speed_mps: f64,
     pub accel_mps2: f64,
 }
@@ -307,7 +309,7 @@ impl Dataset {
             .ego
             .first()
             .ok_or_else(|| refuse(format!("clip `{}`: no frames", clip.clip_id)))?;
-        let ego_from_world = crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad).inverse();
+        let ego_from_world = crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad).inverse();
         let mut out = BTreeMap::new();
         let cols = ["frame", "sensor", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"];
         for b in tables::read(&self.layout.table("sensor_poses", &clip.clip_id), &cols)? {
@@ -399,6 +401,7 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
         "ego_y_m",
         "ego_z_m",
         "ego_yaw_rad",
+        "ego_pitch_rad",
         "ego_speed_mps",
         "ego_accel_mps2",
     ];
@@ -414,8 +417,9 @@ fn read_clip(layout: &Layout, info: ClipInfo, export_box: ExportBox) -> Result<C
                 y_m: v[1].value(i),
                 z_m: v[2].value(i),
                 yaw_rad: v[3].value(i),
-                speed_mps: v[4].value(i),
-                accel_mps2: v[5].value(i),
+                pitch_rad: v[4].value(i),
+                speed_mps: v[5].value(i),
+                accel_mps2: v[6].value(i),
             });
         }
     }

@@ -368,7 +368,7 @@ fn write_video(
     let cameras: Vec<_> = clip
         .ego
         .iter()
-        .map(|e| camera.at(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad))
+        .map(|e| camera.at(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad))
         .collect();
     let mut i = 0;
     while i < clip.vehicles.len() {
@@ -526,11 +526,13 @@ fn write_video(
             o,
             "  <frame id=\"{i}\" GPS_speed=\"{kmh:.4}\" OBD_speed=\"{kmh:.4}\" accX=\"{:.5}\" accY=\"{:.5}\" \
              accZ=\"9.80665\" gyroX=\"0\" gyroY=\"0\" gyroZ=\"{:.5}\" heading_angle=\"{:.4}\" latitude=\"{lat:.9}\" \
-             longitude=\"{lon:.9}\" pitch=\"0\" roll=\"0\" yaw=\"{:.4}\" />",
+             longitude=\"{lon:.9}\" pitch=\"{}\" roll=\"0\" yaw=\"{:.4}\" />",
             e.accel_mps2,
             e.speed_mps * yaw_rate,
             yaw_rate.to_degrees(),
             compass_heading_deg(e.yaw_rad),
+            // "0" on a level car, as before the pitch wobble.
+            if e.pitch_rad == 0.0 { "0".to_owned() } else { format!("{:.4}", e.pitch_rad.to_degrees()) },
             e.yaw_rad.to_degrees(),
         );
     }

@@ -298,13 +298,20 @@ impl Distortion {
 /// Per-clip offsets of the camera mount, each drawn uniformly from its range `[min, max]` with the clip's seed
 /// (`sim::rig::clip_mount`). JAAD's videos come from several cars and cameras: fitted per video, their horizons
 /// and camera heights scatter (`pedsynth calibrate` fits these ranges to a real dataset's spread).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct MountSpread {
     /// Offset of the mount's height, metres `[min, max]`.
     pub up_m: super::Range,
     /// Offset of the mount's pitch, degrees `[min, max]` (negative looks down).
     pub pitch_deg: super::Range,
+    /// Offset of the mount's pitch drawn from a measured distribution instead of `pitch_deg`'s uniform range:
+    /// its quantiles at equal steps of probability from 0 (the lowest) to 1 (the highest), ascending, degrees,
+    /// interpolated linearly between them. JAAD's videos' horizons gather near the middle with long tails, which
+    /// no uniform range gives (`pedsynth calibrate` writes the per-video horizons' quantiles). Empty (the
+    /// default): `pitch_deg`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pitch_quantiles_deg: Vec<f64>,
 }
 
 impl Default for MountSpread {
@@ -312,6 +319,24 @@ impl Default for MountSpread {
         MountSpread {
             up_m: super::Range(0.0, 0.0),
             pitch_deg: super::Range(0.0, 0.0),
+            pitch_quantiles_deg: Vec::new(),
+        }
+    }
+}
+
+impl MountSpread {
+    /// The pitch offset at probability `u` in [0, 1): `pitch_quantiles_deg` interpolated where given, else
+    /// uniform over `pitch_deg`.
+    pub fn pitch_at(&self, u: f64) -> f64 {
+        let q = &self.pitch_quantiles_deg;
+        match q.len() {
+            0 => self.pitch_deg.min() + (self.pitch_deg.max() - self.pitch_deg.min()) * u,
+            1 => q[0],
+            n => {
+                let x = u.clamp(0.0, 1.0) * (n - 1) as f64;
+                let i = (x.floor() as usize).min(n - 2);
+                q[i] + (q[i + 1] - q[i]) * (x - i as f64)
+            }
         }
     }
 }

@@ -280,25 +280,32 @@ pub struct Ego {
     /// The ego's heading about its path as a real car's wanders (lane-keeping corrections, the road's camber
     /// and curves a lane does not have): off by default.
     #[serde(skip_serializing_if = "super::is_default")]
-    pub heading_wobble: HeadingWobble,
+    pub heading_wobble: Wobble,
+    /// The ego's body pitch as a real car's nods (road undulation, joints and potholes, the suspension's answer
+    /// to braking and throttle), about the ground point under its centre, nose up positive: off by default.
+    /// Its camera and LiDAR pitch with it, so pedestrians' boxes move up and down together, as the boxes of
+    /// pedestrians seen together in JAAD do (`pedsynth calibrate` fits it to them).
+    #[serde(skip_serializing_if = "super::is_default")]
+    pub pitch_wobble: Wobble,
 }
 
-/// A smooth offset of the ego's recorded heading (so of its camera and LiDAR), drawn per clip from its seed
-/// (the stream `"ego heading"`): white noise through two first-order lags of time constant `correlation_s`,
-/// stationary standard deviation `sd_deg`, so that the heading turns at a smoothly changing rate as a steered
-/// car's does. The simulated path does not change, only where the car (and its sensors) point along it.
+/// A smooth offset of one of the ego's recorded angles (its heading: the stream `"ego heading"`; its body pitch:
+/// `"ego pitch"`; so of its camera and LiDAR), drawn per clip from its seed: white noise through two first-order
+/// lags of time constant `correlation_s`, stationary standard deviation `sd_deg`, so that the angle turns at a
+/// smoothly changing rate as a steered, sprung car's does. The simulated path does not change, only where the
+/// car (and its sensors) point along it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
-pub struct HeadingWobble {
+pub struct Wobble {
     /// Standard deviation of the heading offset, degrees (0: off).
     pub sd_deg: f64,
     /// Time constant of each of the two lags, seconds (autocorrelation `(1 + τ/T) e^(−τ/T)`).
     pub correlation_s: f64,
 }
 
-impl Default for HeadingWobble {
+impl Default for Wobble {
     fn default() -> Self {
-        HeadingWobble {
+        Wobble {
             sd_deg: 0.0,
             correlation_s: 1.0,
         }
@@ -319,7 +326,8 @@ impl Default for Ego {
             courtesy_stop_short_m: 8.0,
             courtesy_patience_s: Range(5.0, 12.0),
             courtesy_roll_up: false,
-            heading_wobble: HeadingWobble::default(),
+            heading_wobble: Wobble::default(),
+            pitch_wobble: Wobble::default(),
         }
     }
 }

@@ -38,6 +38,47 @@ impl Validator<'_> {
         }
     }
 
+    /// `sensors.rgb.mount_spread.pitch_quantiles_deg`: each within ±45°, ascending, at least two, and not
+    /// together with a `pitch_deg` range.
+    fn pitch_quantiles(&mut self, spread: &crate::spec::types::MountSpread) {
+        let path = "sensors.rgb.mount_spread.pitch_quantiles_deg";
+        let q = &spread.pitch_quantiles_deg;
+        if q.is_empty() {
+            return;
+        }
+        if q.len() == 1 {
+            let problem = Problem::new(code::OUT_OF_RANGE, format!("`{path}` has one quantile"))
+                .at(self.span(path), "one value")
+                .help("give the lowest and the highest at least (or use `pitch_deg` for a uniform range)");
+            self.problems.push(problem);
+        }
+        let before = self.problems.len();
+        for (i, &v) in q.iter().enumerate() {
+            self.num(&format!("{path}[{i}]"), v, -45.0, 45.0, "a pitch offset in degrees");
+        }
+        if self.problems.len() == before {
+            if let Some(i) = q.windows(2).position(|w| w[1] < w[0]) {
+                let problem = Problem::new(
+                    code::EMPTY_RANGE,
+                    format!("`{path}` falls from {} to {}", fmt_num(q[i]), fmt_num(q[i + 1])),
+                )
+                .at(self.span(&format!("{path}[{}]", i + 1)), "lower than the one before")
+                .help("list the quantiles in ascending order, from the lowest to the highest");
+                self.problems.push(problem);
+            }
+        }
+        if spread.pitch_deg != crate::spec::types::Range(0.0, 0.0) {
+            let problem = Problem::new(
+                code::OUT_OF_RANGE,
+                format!("`{path}` and `sensors.rgb.mount_spread.pitch_deg` both give the pitch's spread"),
+            )
+            .at(self.span(path), "quantiles")
+            .also(self.span("sensors.rgb.mount_spread.pitch_deg"), "range")
+            .help("keep one: the quantiles of a measured distribution, or a uniform range");
+            self.problems.push(problem);
+        }
+    }
+
     pub(super) fn mount(&mut self, base: &str, m: &Mount) {
         self.num(
             &format!("{base}.forward_m"),
@@ -297,6 +338,7 @@ impl Validator<'_> {
             45.0,
             "a pitch offset in degrees",
         );
+        self.pitch_quantiles(spread);
         self.distortion(&s.rgb);
         self.imaging(&s.rgb);
         let l = &s.lidar;

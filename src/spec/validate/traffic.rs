@@ -108,6 +108,20 @@ impl Validator<'_> {
             60.0,
             "a correlation time in seconds",
         );
+        self.num(
+            "traffic.ego.pitch_wobble.sd_deg",
+            t.ego.pitch_wobble.sd_deg,
+            0.0,
+            5.0,
+            "a standard deviation of the body pitch in degrees",
+        );
+        self.num(
+            "traffic.ego.pitch_wobble.correlation_s",
+            t.ego.pitch_wobble.correlation_s,
+            0.05,
+            60.0,
+            "a correlation time in seconds",
+        );
         self.positive(
             "traffic.ego.brake_ahead_m",
             t.ego.brake_ahead_m,

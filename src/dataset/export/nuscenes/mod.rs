@@ -323,7 +323,7 @@ impl ClipExport<'_> {
 
     fn world_from_ego(&self, frame: u32) -> DAffine3 {
         let e = &self.clip.ego[frame as usize];
-        world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad)
+        world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad)
     }
 
     fn to_global(&self, world: DVec3) -> DVec3 {

@@ -90,6 +90,7 @@ pub fn frames_batch(script: &ClipScript, trace: &ClipTrace) -> RecordBatch {
         .column("ego_y_m", false, col(|f| f.pos.y))
         .column("ego_z_m", false, col(|f| f.pos.z))
         .column("ego_yaw_rad", false, col(|f| f.yaw_rad))
+        .column("ego_pitch_rad", false, col(|f| f.pitch_rad))
         .column("ego_speed_mps", false, col(|f| f.speed_mps))
         .column("ego_accel_mps2", false, col(|f| f.accel_mps2))
         .column(
