@@ -39,8 +39,8 @@ fn setup(town: &str) -> Setup {
     let mut frame_scene = FrameScene::default();
     let t = SceneTime::at(clip.frame);
     frame_scene.build(&clip.scene, &clip.script, &clip.trace, t);
-    let (pos, yaw) = ego_at(&clip.trace, t);
-    let pose = sensors::scene_from(&clip.scene, &clip.rig.world_from_lidar(pos, yaw));
+    let (pos, yaw, pitch) = ego_at(&clip.trace, t);
+    let pose = sensors::scene_from(&clip.scene, &clip.rig.world_from_lidar(pos, yaw, pitch));
     let mut tracer = Tracer::new(&clip.scene);
     tracer.set_agents(&frame_scene, &pose);
     Setup {

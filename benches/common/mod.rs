@@ -66,8 +66,8 @@ impl BusyClip {
         let t = SceneTime::at(frame);
         let mut scene = FrameScene::default();
         scene.build(&self.scene, &self.script, &self.trace, t);
-        let (pos, yaw) = ego_at(&self.trace, t);
-        (scene, self.rig.camera.at(pos, yaw))
+        let (pos, yaw, pitch) = ego_at(&self.trace, t);
+        (scene, self.rig.camera.at(pos, yaw, pitch))
     }
 
     /// A renderer with the clip's lighting, set up for its busiest frame.

@@ -654,7 +654,7 @@ fn form_groups(script: &ClipScript, peds: &mut [Ped]) {
 
 #[cfg(test)]
 mod tests {
-    use super::heading_offsets_rad;
+    use super::wobble_offsets_rad;
     use crate::spec::types::Wobble;
 
     /// The standard deviation of `xs` about their mean.

@@ -319,6 +319,56 @@ mod tests {
     }
 
     #[test]
+    fn a_nose_up_body_pitch_moves_the_scene_down_the_image_by_f_tan_pitch() {
+        let cam = Camera::from_spec(&Rgb {
+            mount: Mount {
+                pitch_deg: 0.0,
+                ..Rgb::default().mount
+            },
+            ..Rgb::default()
+        });
+        let level = cam.at(DVec3::ZERO, 0.3, 0.0);
+        assert_eq!(
+            level.optical_from_world,
+            cam.at(DVec3::ZERO, 0.3, -0.0).optical_from_world
+        );
+        // A point far ahead, at the camera's height: on the principal point when level.
+        let far = level.centre + level.forward * 1e6;
+        assert!((level.project(far).px - DVec2::new(640.0, 360.0)).length() < 1e-6);
+        let pitch_rad = 0.5f64.to_radians();
+        let nodded = cam.at(DVec3::ZERO, 0.3, pitch_rad);
+        let px = nodded.project(far).px;
+        assert!(
+            (px.x - 640.0).abs() < 1e-6 && (px.y - (360.0 + 640.0 * pitch_rad.tan())).abs() < 1e-3,
+            "{px}"
+        );
+        // The LiDAR pitches with the body.
+        let rig = Rig::from_spec(&crate::spec::types::Sensors::default());
+        let (a, b) = (
+            rig.world_from_lidar(DVec3::ZERO, 0.0, 0.0),
+            rig.world_from_lidar(DVec3::ZERO, 0.0, pitch_rad),
+        );
+        assert!((b.matrix3.x_axis.z - pitch_rad.sin()).abs() < 1e-12 && a.matrix3.x_axis.z.abs() < 1e-12);
+    }
+
+    #[test]
+    fn pitch_quantiles_give_the_measured_distribution_in_place_of_the_uniform_range() {
+        let mut rgb = Rgb::default();
+        rgb.mount_spread.pitch_quantiles_deg = vec![-6.0, -1.0, 0.0, 1.0, 4.0];
+        // Linear between the quantiles at 0, ¼, ½, ¾ and 1.
+        let s = &rgb.mount_spread;
+        assert_eq!((s.pitch_at(0.0), s.pitch_at(0.125), s.pitch_at(0.5)), (-6.0, -3.5, 0.0));
+        assert!((s.pitch_at(0.999_999_999) - 4.0).abs() < 1e-6 && s.pitch_at(1.0) == 4.0);
+        let pitches: Vec<f64> = (0..2000)
+            .map(|seed| clip_mount(&rgb, seed).pitch_deg - rgb.mount.pitch_deg)
+            .collect();
+        assert!(pitches.iter().all(|p| (-6.0..=4.0).contains(p)));
+        // Half the clips between the quartiles −1° and 1°, where a uniform draw over [−6, 4] would put a fifth.
+        let inner = pitches.iter().filter(|p| (-1.0..=1.0).contains(*p)).count() as f64 / 2000.0;
+        assert!((inner - 0.5).abs() < 0.04, "{inner}");
+    }
+
+    #[test]
     fn clip_mounts_vary_within_the_spread_and_are_the_spec_mount_without_it() {
         let mut rgb = Rgb::default();
         for seed in [0, 1, u64::MAX] {

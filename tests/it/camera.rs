@@ -231,7 +231,7 @@ pub(crate) fn check_masks(c: &Clip, frame: u32, img: &CameraImages, report: &mut
             continue;
         }
         let ego = &c.trace.ego[frame as usize];
-        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
         for k in 0..17 {
             let flag = r.keypoints[3 * k + 2];
             let (x, y) = (r.keypoints[3 * k], r.keypoints[3 * k + 1]);
@@ -454,7 +454,7 @@ fn one_quad(q: [Vec3; 4], tag_id: u8, normal: Vec3) -> StaticScene {
 pub(crate) fn render_static(scene: &StaticScene, camera: &Camera, pos: DVec3, yaw: f64) -> CameraImages {
     let mut r = Renderer::new(camera, Lighting::from_weather(&WeatherPreset::ClearNoon.params()), 1);
     let mut img = CameraImages::default();
-    r.render(scene, &FrameScene::default(), &camera.at(pos, yaw), 1, &mut img);
+    r.render(scene, &FrameScene::default(), &camera.at(pos, yaw, 0.0), 1, &mut img);
     img
 }
 
@@ -470,7 +470,7 @@ fn depth_of_known_planes_reads_back_within_a_centimetre() {
         ..Rgb::default()
     };
     let camera = Camera::from_spec(&rgb);
-    let pose = camera.at(DVec3::ZERO, 0.0);
+    let pose = camera.at(DVec3::ZERO, 0.0, 0.0);
     // A wall facing the camera, 12.345 m ahead of it (the camera looks along +x).
     let x = (pose.centre.x + 12.345) as f32;
     let wall = one_quad(
@@ -506,7 +506,7 @@ fn depth_of_known_planes_reads_back_within_a_centimetre() {
         Vec3::Z,
     );
     let img = render_static(&ground, &camera, DVec3::ZERO, 0.3);
-    let pose = camera.at(DVec3::ZERO, 0.3);
+    let pose = camera.at(DVec3::ZERO, 0.3, 0.0);
     let (mut checked, mut sky) = (0, 0);
     for y in 0..img.height {
         for x in 0..img.width {
@@ -545,7 +545,7 @@ fn a_point_projects_to_the_same_pixel_in_the_renderer_and_the_annotations() {
         height_px: 360,
         ..Rgb::default()
     });
-    let pose = camera.at(DVec3::new(3.0, -2.0, 0.0), 0.4);
+    let pose = camera.at(DVec3::new(3.0, -2.0, 0.0), 0.4, 0.0);
     let centre = pose.centre + pose.forward * 15.0 + pose.right * -3.0 + pose.down * 1.0;
     let project = pose.project(centre).px;
     // A 0.5 m upright cube (a box of instance 7) centred on the point.
@@ -974,7 +974,7 @@ fn a_street_lamp_between_the_camera_and_a_pedestrian_hides_the_keypoints_it_cove
     let mut checked = 0;
     for frame in (0..c.trace.frame_count as usize).step_by(10) {
         let ego = c.trace.ego[frame];
-        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
         let eye = cam.centre.truncate();
         let posts = scene::clip_lamp_posts(&c.trace, net);
         let Some(post) = posts.iter().find(|p| {
@@ -1051,7 +1051,7 @@ fn a_litter_bin_between_the_camera_and_a_pedestrian_hides_its_feet() {
     let mut checked = 0;
     for frame in (0..c.trace.frame_count as usize).step_by(10) {
         let ego = c.trace.ego[frame];
-        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+        let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
         let eye = cam.centre.truncate();
         let Some(bin) = bins.iter().find(|b| {
             let at = cam.project(b.centre());

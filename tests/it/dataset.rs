@@ -142,7 +142,7 @@ fn read_table(dir: &Path, table: &str, spec_hash: &str) -> Vec<RecordBatch> {
         assert_eq!(kv["pedsynth.table"], table, "{}", path.display());
         assert_eq!(kv["pedsynth.clip_id"], clip_id, "{}", path.display());
         assert_eq!(kv["pedsynth.spec_hash"], spec_hash, "{}", path.display());
-        assert_eq!(kv["pedsynth.schema_version"], "11", "{}", path.display());
+        assert_eq!(kv["pedsynth.schema_version"], "12", "{}", path.display());
         assert_eq!(kv["pedsynth.version"], env!("CARGO_PKG_VERSION"), "{}", path.display());
         for batch in builder.build().expect("reader") {
             let batch = batch.expect("batch");
@@ -830,7 +830,7 @@ fn check_against_resimulation(d: &Dataset, spec_path: &Path, overrides: &[&str])
             let figure = &script.pedestrians[a.ped as usize].identity.figure;
             let pose = body::pose(f, height, figure, DVec3::ZERO);
             let ego = &trace.ego[a.frame as usize];
-            let cam = camera.at(ego.pos, ego.yaw_rad);
+            let cam = camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
             let mut lo = DVec2::splat(f64::INFINITY);
             let mut hi = DVec2::splat(f64::NEG_INFINITY);
             let mut add = |p: DVec3| {

@@ -232,8 +232,8 @@ fn tracer_equals_brute_force(spec_path: &Path) {
         };
         let (mut rays, mut hits) = (0, 0);
         for f in (0..c.trace.ego.len() as u32).step_by(7) {
-            let (pos, yaw) = ego_at(&c.trace, SceneTime::at(f));
-            let pose = sensors::scene_from(&c.stat, &c.rig.world_from_lidar(pos, yaw));
+            let (pos, yaw, pitch) = ego_at(&c.trace, SceneTime::at(f));
+            let pose = sensors::scene_from(&c.stat, &c.rig.world_from_lidar(pos, yaw, pitch));
             let o: Vec3 = pose.translation.into();
             for _ in 0..60 {
                 let azimuth = next() * std::f32::consts::TAU;
@@ -362,8 +362,8 @@ fn pedestrians_in_clear_view_get_points_and_every_pedestrian_point_is_in_its_box
     let mut by_frame: BTreeMap<u32, Vec<(u32, u32)>> = BTreeMap::new(); // frame → (actor, points)
     sensors::scan_lidar(&c.stat, &c.script, &c.trace, l, &c.rig, |t| {
         let mut counts: BTreeMap<u32, u32> = BTreeMap::new();
-        let (pos, yaw) = ego_at(&c.trace, SceneTime::at(t.frame));
-        let world_from_lidar = c.rig.world_from_lidar(pos, yaw);
+        let (pos, yaw, pitch) = ego_at(&c.trace, SceneTime::at(t.frame));
+        let world_from_lidar = c.rig.world_from_lidar(pos, yaw, pitch);
         for p in t.points.iter().filter(|p| p.tag == tag::PEDESTRIAN) {
             *counts.entry(u32::from(p.instance)).or_default() += 1;
             // Every pedestrian point, annotated or not, adult or child, lies in its own body's 3D box + 5 cm.
@@ -396,8 +396,8 @@ fn pedestrians_in_clear_view_get_points_and_every_pedestrian_point_is_in_its_box
     let (mut checked, mut blocked) = (0, 0);
     for row in &c.annotations.rows {
         let t = SceneTime::at(row.frame);
-        let (pos, yaw) = ego_at(&c.trace, t);
-        let world_from_lidar = c.rig.world_from_lidar(pos, yaw);
+        let (pos, yaw, pitch) = ego_at(&c.trace, t);
+        let world_from_lidar = c.rig.world_from_lidar(pos, yaw, pitch);
         let target = DVec3::new(
             f64::from(row.box3d_centre_m[0]),
             f64::from(row.box3d_centre_m[1]),

@@ -117,7 +117,7 @@ fn traffic_signs_stand_where_the_furniture_list_puts_them() {
         // middle of its post a pole's (unless something nearer covers them: then the depth says so).
         for frame in (0..c.trace.frame_count as usize).step_by(15) {
             let ego = c.trace.ego[frame];
-            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
             let eye = cam.centre.truncate();
             let img = c.render(frame as u32);
             for (k, plate) in furniture
@@ -231,7 +231,7 @@ fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
             let out = (roof.foot - wall.foot).normalize();
             let pos = (wall.foot + out * 6.0).extend(wall.base_z_m - 0.1);
             let yaw = (-out.y).atan2(-out.x);
-            let cam = c.rig.camera.at(pos, yaw);
+            let cam = c.rig.camera.at(pos, yaw, 0.0);
             let img = crate::camera::render_static(&stat, &c.rig.camera, pos, yaw);
             let at = cam.project(wall.centre());
             assert!(cam.in_image(at.px), "wall {wall:?} not in view");
@@ -246,7 +246,7 @@ fn bus_shelters_stand_on_the_sidewalk_and_are_drawn_where_listed() {
         }
         for frame in (0..c.trace.frame_count as usize).step_by(5) {
             let ego = c.trace.ego[frame];
-            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad);
+            let cam = c.rig.camera.at(ego.pos, ego.yaw_rad, ego.pitch_rad);
             let eye = cam.centre.truncate();
             let img = c.render(frame as u32);
             for &(point, foot) in &probes {

@@ -94,3 +94,48 @@ fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
         "{offsets:?}"
     );
 }
+
+#[test]
+fn the_pitch_wobble_nods_the_recorded_ego_only_with_the_asked_spread() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+    let plan_with = |overrides: &[&str]| {
+        let options = LoadOptions {
+            overrides: overrides.iter().map(|s| s.to_string()).collect(),
+            allow_large: false,
+            profile: None,
+        };
+        pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
+    };
+    let (_, towns, off) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
+    let (_, _, on) = plan_with(&[
+        "traffic.ego.heading_wobble.sd_deg=2",
+        "traffic.ego.pitch_wobble.sd_deg=0.5",
+        "traffic.ego.pitch_wobble.correlation_s=0.35",
+    ]);
+    assert!(off.sim.ego_pitch.is_none(), "off: absent from the plan file");
+    assert_eq!(off.clips, on.clips, "the wobble changes no clip script");
+    let net = &towns[&off.clips[0].town].network;
+    let (a, b) = (
+        sim::simulate(&off.clips[0], &off.sim, net),
+        sim::simulate(&on.clips[0], &on.sim, net),
+    );
+    assert!(a.ego.iter().all(|f| f.pitch_rad == 0.0), "level without it");
+    for (x, y) in a.ego.iter().zip(&b.ego) {
+        // Its own stream: the heading wobble's draws are the same with the pitch on.
+        assert_eq!(
+            (x.pos, x.yaw_rad, x.speed_mps),
+            (y.pos, y.yaw_rad, y.speed_mps),
+            "only the pitch changes"
+        );
+    }
+    assert_eq!(a.pedestrians, b.pedestrians, "nobody else moves differently");
+    assert!(
+        b.vehicles.iter().flatten().all(|f| f.pitch_rad == 0.0),
+        "traffic stays level"
+    );
+    let pitch_deg: Vec<f64> = b.ego.iter().map(|f| f.pitch_rad.to_degrees()).collect();
+    let rms = (pitch_deg.iter().map(|p| p * p).sum::<f64>() / pitch_deg.len() as f64).sqrt();
+    // One clip of some 10 s holds ~30 correlation times: its spread is within a third of the asked 0.5°.
+    assert!((rms - 0.5).abs() < 0.17, "rms {rms}° over {} frames", pitch_deg.len());
+    assert!(pitch_deg.iter().all(|p| p.abs() < 2.5), "{pitch_deg:?}");
+}

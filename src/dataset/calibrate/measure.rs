@@ -667,9 +667,35 @@ mod tests {
         assert_eq!(camera_spread(&videos[..2]), None, "two videos are too few");
     }
 
+    #[test]
+    fn horizon_quantiles_place_each_video_by_its_median_horizon_at_the_pooled_slope() {
+        // Twelve videos on the pooled slope 0.8, horizons 0.50, 0.51, …, 0.61; one more with too few boxes.
+        let mut videos: Vec<RealVideo> = (0..12)
+            .map(|i| line_video(0.5 + 0.01 * f64::from(i), 0.8, 120))
+            .collect();
+        videos.push(line_video(0.9, 0.8, 40));
+        let q = horizon_quantiles(&videos, 0.8, 3).unwrap();
+        assert_eq!(q.len(), 3);
+        // Lowest, median (nearest rank of 12: the 7th, 0.56) and highest; the short video is left out.
+        for (got, want) in q.iter().zip([0.50, 0.56, 0.61]) {
+            assert!((got - want).abs() < 1e-9, "{q:?}");
+        }
+        assert_eq!(horizon_quantiles(&videos[..9], 0.8, 3), None, "nine videos are too few");
+        assert_eq!(
+            horizon_quantiles(&videos, 0.8, 1),
+            None,
+            "one quantile is no distribution"
+        );
+    }
+
     /// Videos whose pedestrians all turn with one smooth heading offset (the simulator's two lags of `t_s`,
-    /// spread `sd_deg`), each with its own bearing and 0.3° of independent noise per frame.
+    /// spread `sd_deg`), each with its own bearing and 0.3° of independent noise per frame; with `nod`, the
+    /// offset and the noise move the boxes up and down (a pitch) instead.
     fn panning_videos(sd_deg: f64, t_s: f64, videos: u64) -> Vec<RealVideo> {
+        moving_videos(sd_deg, t_s, videos, false)
+    }
+
+    fn moving_videos(sd_deg: f64, t_s: f64, videos: u64, nod: bool) -> Vec<RealVideo> {
         use rand::SeedableRng;
         use rand_distr::{Distribution, StandardNormal};
         let (fps, frames, focal_px) = (30.0, 900u32, 960.0);
@@ -695,15 +721,20 @@ mod tests {
                         crossing_frame: None,
                         boxes: (0..frames)
                             .map(|frame| {
-                                let bearing =
+                                let angle =
                                     -0.3 + 0.2 * f64::from(p) + offsets[frame as usize] + 0.3f64.to_radians() * z();
-                                let centre = 960.0 + focal_px * bearing.tan();
+                                let (centre, horizon) = if nod {
+                                    (960.0 + 100.0 * f64::from(p), 540.0 + focal_px * (0.1 * angle).tan())
+                                } else {
+                                    (960.0 + focal_px * angle.tan(), 524.0)
+                                };
+                                // Boxes 120 px tall on a slope of 0.8: the bottom is 96 px below the horizon.
                                 RealBox {
                                     frame,
                                     x_min_px: centre - 20.0,
-                                    y_min_px: 500.0,
+                                    y_min_px: horizon + 96.0 - 120.0,
                                     x_max_px: centre + 20.0,
-                                    y_max_px: 620.0,
+                                    y_max_px: horizon + 96.0,
                                     occluded: false,
                                     standing: None,
                                     looking: None,
@@ -740,5 +771,21 @@ mod tests {
             v.tracks.truncate(1);
         }
         assert_eq!(pan_wobble(&alone, 960.0), None);
+    }
+
+    #[test]
+    fn pitch_wobble_recovers_the_spread_and_the_correlation_time_of_a_common_nod() {
+        // The boxes' horizon moves by a tenth of the angle drawn (a nod of 0.5° and 0.35 s from one of 5°).
+        for (sd_deg, t_s) in [(5.0, 0.35), (8.0, 1.0)] {
+            let fit = pitch_wobble(&moving_videos(sd_deg, t_s, 60, true), 960.0, 0.8).unwrap();
+            assert!(
+                (fit.sd_deg / (0.1 * sd_deg) - 1.0).abs() < 0.12 && (fit.correlation_s / t_s - 1.0).abs() < 0.15,
+                "{fit:?} for {}° and {t_s} s",
+                0.1 * sd_deg
+            );
+        }
+        // A pan moves no horizon: the fit finds (almost) nothing in level boxes.
+        let level = pitch_wobble(&panning_videos(6.0, 2.0, 20), 960.0, 0.8);
+        assert!(level.is_none_or(|f| f.sd_deg < 0.01), "{level:?}");
     }
 }

@@ -309,7 +309,8 @@ impl Dataset {
             .ego
             .first()
             .ok_or_else(|| refuse(format!("clip `{}`: no frames", clip.clip_id)))?;
-        let ego_from_world = crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad).inverse();
+        let ego_from_world =
+            crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad).inverse();
         let mut out = BTreeMap::new();
         let cols = ["frame", "sensor", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"];
         for b in tables::read(&self.layout.table("sensor_poses", &clip.clip_id), &cols)? {

@@ -532,7 +532,11 @@ fn write_video(
             yaw_rate.to_degrees(),
             compass_heading_deg(e.yaw_rad),
             // "0" on a level car, as before the pitch wobble.
-            if e.pitch_rad == 0.0 { "0".to_owned() } else { format!("{:.4}", e.pitch_rad.to_degrees()) },
+            if e.pitch_rad == 0.0 {
+                "0".to_owned()
+            } else {
+                format!("{:.4}", e.pitch_rad.to_degrees())
+            },
             e.yaw_rad.to_degrees(),
         );
     }

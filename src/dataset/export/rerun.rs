@@ -192,7 +192,8 @@ impl Recorder<'_> {
             self.rec
                 .set_duration_secs("time", f64::from(f) / f64::from(clip.fps.max(1)));
             let e = &clip.ego[f as usize];
-            let world_from_ego = crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad);
+            let world_from_ego =
+                crate::sim::rig::world_from_vehicle(DVec3::new(e.x_m, e.y_m, e.z_m), e.yaw_rad, e.pitch_rad);
             self.log("world/ego", &transform(&world_from_ego))?;
             self.log("timeseries/ego/speed_mps", &rerun::Scalars::new([e.speed_mps]))?;
             if let Some(ext) = rgb_ext {

@@ -56,16 +56,16 @@ impl Validator<'_> {
         for (i, &v) in q.iter().enumerate() {
             self.num(&format!("{path}[{i}]"), v, -45.0, 45.0, "a pitch offset in degrees");
         }
-        if self.problems.len() == before {
-            if let Some(i) = q.windows(2).position(|w| w[1] < w[0]) {
-                let problem = Problem::new(
-                    code::EMPTY_RANGE,
-                    format!("`{path}` falls from {} to {}", fmt_num(q[i]), fmt_num(q[i + 1])),
-                )
-                .at(self.span(&format!("{path}[{}]", i + 1)), "lower than the one before")
-                .help("list the quantiles in ascending order, from the lowest to the highest");
-                self.problems.push(problem);
-            }
+        if self.problems.len() == before
+            && let Some(i) = q.windows(2).position(|w| w[1] < w[0])
+        {
+            let problem = Problem::new(
+                code::EMPTY_RANGE,
+                format!("`{path}` falls from {} to {}", fmt_num(q[i]), fmt_num(q[i + 1])),
+            )
+            .at(self.span(&format!("{path}[{}]", i + 1)), "lower than the one before")
+            .help("list the quantiles in ascending order, from the lowest to the highest");
+            self.problems.push(problem);
         }
         if spread.pitch_deg != crate::spec::types::Range(0.0, 0.0) {
             let problem = Problem::new(

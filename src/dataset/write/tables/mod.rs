@@ -34,7 +34,7 @@ pub use people::*;
 pub use traffic::*;
 
 /// Version of the table schemas; bump on any change to a column.
-pub const SCHEMA_VERSION: u32 = 11;
+pub const SCHEMA_VERSION: u32 = 12;
 
 /// The tables, in the order they are written (`clips` last: its file marks the clip complete).
 pub const TABLES: [&str; 12] = [
