@@ -38,17 +38,26 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     Ok(())
 }
 
+/// The quickstart spec with `overrides`: its resolved spec, towns and plan.
+fn quickstart_with(
+    overrides: &[&str],
+) -> (
+    pedsynth::spec::LoadedSpec,
+    std::collections::BTreeMap<String, pedsynth::plan::TownContext>,
+    pedsynth::plan::Plan,
+) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+    let options = LoadOptions {
+        overrides: overrides.iter().map(|s| s.to_string()).collect(),
+        allow_large: false,
+        profile: None,
+    };
+    pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
+}
+
 #[test]
 fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-    let plan_with = |overrides: &[&str]| {
-        let options = LoadOptions {
-            overrides: overrides.iter().map(|s| s.to_string()).collect(),
-            allow_large: false,
-            profile: None,
-        };
-        pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
-    };
+    let plan_with = quickstart_with;
     let (_, towns, off) = plan_with(&[]);
     let (_, _, on) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
     assert!(off.sim.ego_heading.is_none(), "off: absent from the plan file");
@@ -97,15 +106,7 @@ fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
 
 #[test]
 fn the_pitch_wobble_nods_the_recorded_ego_only_with_the_asked_spread() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-    let plan_with = |overrides: &[&str]| {
-        let options = LoadOptions {
-            overrides: overrides.iter().map(|s| s.to_string()).collect(),
-            allow_large: false,
-            profile: None,
-        };
-        pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
-    };
+    let plan_with = quickstart_with;
     let (_, towns, off) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
     let (_, _, on) = plan_with(&[
         "traffic.ego.heading_wobble.sd_deg=2",
