@@ -518,12 +518,7 @@ pub fn ego_at(trace: &ClipTrace, t: SceneTime) -> (DVec3, f64, f64) {
     let a = &trace.ego[f.min(trace.ego.len() - 1)];
     let b = &trace.ego[(f + 1).min(trace.ego.len() - 1)];
     let (pos, yaw_rad) = lerp_vehicle(a, b, t.alpha);
-    let pitch_rad = if t.alpha == 0.0 {
-        a.pitch_rad
-    } else {
-        a.pitch_rad + (b.pitch_rad - a.pitch_rad) * t.alpha
-    };
-    (pos, yaw_rad, pitch_rad)
+    (pos, yaw_rad, a.pitch_rad + (b.pitch_rad - a.pitch_rad) * t.alpha)
 }
 
 #[cfg(test)]
