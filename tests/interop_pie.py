@@ -171,6 +171,7 @@ def setup(name, formats):
     # A dataset of many clips passes crosswalks; the two-clip quickstart need not (whether its ego comes within
     # sight of one depends on how long it waits for pedestrians at the curb).
     ap.add_argument("--expect-crosswalks", action="store_true")
+    ap.add_argument("--expect-pitch", action="store_true", help="the ego's pitch wobble is on: OBD pitch must vary")
     args = ap.parse_args()
     poses_too = not args.no_poses
     work = tempfile.mkdtemp(prefix=f"interop_{name}_")
@@ -197,7 +198,7 @@ def setup(name, formats):
 def main():
     args, work, out, export, poses_too, clips, peds, tracks = setup("pie", ["pie", "pab-poses"])
     video_of = {v["clip_id"]: (v["set"], v["video"]) for v in export["videos"]}
-    frames = table(args.dataset, "frames", ["clip_id", "frame", "ego_speed_mps", "ego_yaw_rad"])
+    frames = table(args.dataset, "frames", ["clip_id", "frame", "ego_speed_mps", "ego_yaw_rad", "ego_pitch_rad"])
     prefix = {
         v["clip_id"]: f"{int(v['set'][3:])}_{int(v['video'][6:])}" for v in export["videos"]
     }
@@ -226,6 +227,7 @@ def main():
             lights.setdefault(r["clip_id"], []).append(r)
     first = db[video_of[next(iter(video_of))][0]][video_of[next(iter(video_of))][1]]
     width, height = first["width"], first["height"]
+    nodding = 0  # frames whose ego pitch is not level (`traffic.ego.pitch_wobble`)
     for clip_id, (set_id, video) in video_of.items():
         v = db[set_id][video]
         if v["num_frames"] != clips[clip_id]["frame_count"]:
@@ -240,6 +242,9 @@ def main():
                 fail(f"{clip_id} frame {r['frame']}: OBD speed {obd['OBD_speed']} for {r['ego_speed_mps']} m/s")
             if abs(obd["yaw"] - np.degrees(r["ego_yaw_rad"])) > 1e-3:
                 fail(f"{clip_id} frame {r['frame']}: yaw {obd['yaw']} for {r['ego_yaw_rad']} rad")
+            if abs(obd["pitch"] - np.degrees(r["ego_pitch_rad"])) > 1e-3:
+                fail(f"{clip_id} frame {r['frame']}: pitch {obd['pitch']} for {r['ego_pitch_rad']} rad")
+            nodding += r["ego_pitch_rad"] != 0
         # Traffic objects (vehicles, crosswalks): PIE's classes, our ids, boxes inside the image, frames in
         # the clip, each object's frames increasing.
         light_ids = sorted({r["signal"] for r in lights.get(clip_id, [])})
@@ -300,11 +305,14 @@ def main():
             if attrs["age"] != age or attrs["gender"] != {"female": 1, "male": 2}[ped["gender"]]:
                 fail(f"{pid}: age/gender differ")
             seen += 1
-    print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames in "
+    print(f"interop_pie: generate_database: {seen} pedestrian tracks and {len(frames)} OBD frames "
+          f"({nodding} with the ego's body pitched) in "
           f"{len(video_of)} videos equal the tables; traffic objects {traffic}; {light_frames} traffic-light "
           f"states equal the tables; {bicycle_boxes} cyclist (bicycle) boxes equal the tables; "
           f"{crosswalk_checked - len(crosswalk_missed)} of {crosswalk_checked} frames with a pedestrian on a "
           f"crosswalk have a crosswalk box (missing: {crosswalk_missed[:5]})")
+    if args.expect_pitch and not nodding:
+        fail("the spec pitches the ego but every OBD frame is level")
     if cyclist_boxes and not bicycle_boxes:
         fail("the tables have cyclists in view but the export has no bicycle")
     if any(r["faces_ego"] for rows in lights.values() for r in rows) and not light_frames:
