@@ -58,6 +58,8 @@ pub struct Pose {
     pub y_m: f64,
     pub z_m: f64,
     pub h_rad: f64,
+    /// Pitch, nose up positive: the ego's body pitch (`frames.ego_pitch_rad`), 0 for everyone else.
+    pub p_rad: f64,
 }
 
 /// Writes `towns/*.xodr` and one `.xosc` per clip under `out`.
@@ -129,6 +131,7 @@ pub fn simplify(poses: &[Pose]) -> Vec<Pose> {
             );
             (dx * dx + dy * dy + dz * dz).sqrt() <= TOLERANCE_M
                 && (lerp(a.h_rad, b.h_rad) - p.h_rad).abs() <= TOLERANCE_RAD
+                && (lerp(a.p_rad, b.p_rad) - p.p_rad).abs() <= TOLERANCE_RAD
         })
     };
     let mut out = vec![poses[0]];
@@ -192,6 +195,7 @@ fn collect(clip: &Clip) -> Vec<Entity> {
             y_m: e.y_m,
             z_m: e.z_m,
             h_rad: e.yaw_rad,
+            p_rad: e.pitch_rad,
         })
         .collect();
     out.push(Entity {
@@ -207,6 +211,7 @@ fn collect(clip: &Clip) -> Vec<Entity> {
             y_m: v.y_m,
             z_m: v.z_m,
             h_rad: v.yaw_rad,
+            p_rad: 0.0,
         });
     }
     for (id, poses) in vehicles {
@@ -228,6 +233,7 @@ fn collect(clip: &Clip) -> Vec<Entity> {
                     y_m: c.y_m,
                     z_m: c.z_m,
                     h_rad: c.yaw_rad,
+                    p_rad: 0.0,
                 })
                 .collect(),
         });
@@ -245,6 +251,7 @@ fn collect(clip: &Clip) -> Vec<Entity> {
                     y_m: f.y_m,
                     z_m: f.z_m,
                     h_rad: f.yaw_rad,
+                    p_rad: 0.0,
                 })
                 .collect(),
         });
@@ -259,6 +266,7 @@ fn collect(clip: &Clip) -> Vec<Entity> {
                 y_m: car.y_m,
                 z_m: car.z_m,
                 h_rad: car.yaw_rad,
+                p_rad: 0.0,
             }],
         });
     }
@@ -281,9 +289,17 @@ fn car(x: &mut String, name: &str, [length_m, width_m, height_m]: [f64; 3], prop
 fn world_position(x: &mut String, p: &Pose) {
     let _ = write!(
         x,
-        "<Position><WorldPosition x=\"{:.3}\" y=\"{:.3}\" z=\"{:.3}\" h=\"{:.4}\" p=\"0\" r=\"0\"/></Position>",
+        "<Position><WorldPosition x=\"{:.3}\" y=\"{:.3}\" z=\"{:.3}\" h=\"{:.4}\" p=\"",
         p.x_m, p.y_m, p.z_m, p.h_rad
     );
+    // OpenSCENARIO's pitch is about the left-pointing y axis, positive nose down (ISO 8855): the negative of
+    // ours. "0" when level, as before the pitch wobble.
+    if p.p_rad == 0.0 {
+        x.push('0');
+    } else {
+        let _ = write!(x, "{:.4}", -p.p_rad);
+    }
+    x.push_str("\" r=\"0\"/></Position>");
 }
 
 fn start_trigger(x: &mut String, tag: &str, name: &str, time_s: f64, rule: &str, edge: &str) {
@@ -428,6 +444,7 @@ mod tests {
             y_m: 0.0,
             z_m: 0.0,
             h_rad: h,
+            p_rad: 0.0,
         }
     }
 
@@ -446,6 +463,22 @@ mod tests {
         );
         assert_eq!(kept.first(), poses.first());
         assert_eq!(kept.last(), poses.last());
+    }
+
+    #[test]
+    fn a_nodding_ego_keeps_the_vertices_of_its_pitch_and_writes_it_nose_down_positive() {
+        // Straight and level except a nod of 0.05 rad in the middle: the straight run would collapse to its ends.
+        let mut poses: Vec<Pose> = (0..5).map(|i| pose(f64::from(i), f64::from(i), 0.0)).collect();
+        assert_eq!(simplify(&poses).len(), 2);
+        poses[2].p_rad = 0.05;
+        let kept = simplify(&poses);
+        assert!(kept.iter().any(|p| p.p_rad == 0.05), "{} vertices", kept.len());
+        let mut x = String::new();
+        world_position(&mut x, &poses[2]);
+        assert!(x.contains("p=\"-0.0500\""), "{x}");
+        x.clear();
+        world_position(&mut x, &poses[0]);
+        assert!(x.contains("p=\"0\" r=\"0\""), "level: {x}");
     }
 
     #[test]
