@@ -389,25 +389,25 @@ pub fn profile_yaml(c: &Calibration, source: &str) -> String {
     if f.heading_wobble.is_some() || f.pitch_wobble.is_some() {
         let _ = writeln!(out, "traffic:\n  ego:");
     }
-    if let Some(measure::PanFit {
-        sd_deg: sd,
-        correlation_s: t,
-    }) = f.heading_wobble
-    {
-        let _ = writeln!(
-            out,
-            "    heading_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of their change of bearing over 2 frames to 3 s (an upper bound: includes the car's forward motion)"
-        );
-    }
-    if let Some(measure::PanFit {
-        sd_deg: sd,
-        correlation_s: t,
-    }) = f.pitch_wobble
-    {
-        let _ = writeln!(
-            out,
-            "    pitch_wobble: {{sd_deg: {sd}, correlation_s: {t}}}  # what pedestrians seen together share of the change of their horizon (bottom - slope x height) over 2 frames to 3 s"
-        );
+    let wobbles = [
+        (
+            "heading_wobble",
+            f.heading_wobble,
+            "of their change of bearing over 2 frames to 3 s (an upper bound: includes the car's forward motion)",
+        ),
+        (
+            "pitch_wobble",
+            f.pitch_wobble,
+            "of the change of their horizon (bottom - slope x height) over 2 frames to 3 s",
+        ),
+    ];
+    for (key, fit, what) in wobbles {
+        if let Some(measure::PanFit { sd_deg, correlation_s }) = fit {
+            let _ = writeln!(
+                out,
+                "    {key}: {{sd_deg: {sd_deg}, correlation_s: {correlation_s}}}  # what pedestrians seen together share {what}"
+            );
+        }
     }
     let _ = writeln!(
         out,
