@@ -13,14 +13,16 @@ pedestrian crop, a crop of the same size at a seeded place in the same frame who
 pedestrian, cyclist or child (skipped where 50 tries find none).
 
 Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--sheet FILE.png] [--per-joint]
-[--per-view]` (the dataset needs RGB as PNG and the instance stream). `--per-view` also prints the figures by the
+[--per-view] [--per-attribute]` (the dataset needs RGB as PNG and the instance stream). `--per-view` also prints the figures by the
 view our keypoints give: *back* where our left shoulder lies left of our right one in the image by 8 %+ of the box
 height, *front* the other way round, *side* in between; a found front or back view is *mirrored* where MediaPipe's
 left shoulder lies on the other side of its right one than ours (its joints are counted apart). `--sheet` also writes a crop sheet: per weather (a row), six
 crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found.
 `--per-joint` also prints each joint's agreement over all weathers; `--crops FILE.csv` writes one row per
 pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing), to join with
-the dataset's pedestrians table. Prints one row per weather; `--check` exits 1 unless the figures hold: by
+the dataset's pedestrians table. `--per-attribute` also prints, by what the person wears (hood, hat, hair, garment,
+age group, umbrella) and by whether our nose keypoint is visible (a head turned towards the camera), how many found
+back views MediaPipe mirrored. Prints one row per weather; `--check` exits 1 unless the figures hold: by
 default issue 44's (found ≥ 94 % in every weather, ≥ 80 % of joints, background ≤ 5 %), or the floors given with
 `--min-found-weather`, `--min-found`, `--min-joints` and `--max-background` (CI's regression floors, .ci/run).
 """
@@ -64,12 +66,25 @@ def main() -> int:
     ap.add_argument("--per-joint", action="store_true", help="also print the agreement of each joint")
     ap.add_argument("--per-view", action="store_true", help="also print the figures by view (front, back, side)")
     ap.add_argument("--crops", type=Path, help="also write one CSV row per pedestrian crop")
+    ap.add_argument(
+        "--per-attribute",
+        action="store_true",
+        help="also print the share of found back views mirrored by what the person wears (pedestrians table)",
+    )
     a = ap.parse_args()
     root = a.dataset
     weather = {}
     for path in sorted(glob.glob(str(root / "tables/clips/*.parquet"))):
         c = pq.read_table(path, columns=["clip_id", "weather"]).to_pydict()
         weather.update(zip(c["clip_id"], c["weather"]))
+    figure = {}
+    if a.per_attribute:
+        columns = ["clip_id", "pedestrian", "hood", "headwear", "hair", "garment", "age_group", "umbrella"]
+        for path in sorted(glob.glob(str(root / "tables/pedestrians/*.parquet"))):
+            for r in pq.read_table(path, columns=columns).to_pylist():
+                figure[(r["clip_id"], r["pedestrian"])] = r
+    # (attribute, value) -> [found back views, mirrored]
+    per_attribute = {}
     pose = mp.solutions.pose.Pose(static_image_mode=True, model_complexity=1, min_detection_confidence=0.5)
     rng = np.random.default_rng(44)
     per = {}
@@ -127,6 +142,19 @@ def main() -> int:
                 s["found"] += 1
                 v["found"] += 1
                 v["mirrored"] += mirrored
+                if a.per_attribute and view == "back":
+                    p = figure[(clip, t["pedestrian"][i])]
+                    for key in (
+                        ("head", "hood" if p["hood"] else ("hat" if p["headwear"] else "neither")),
+                        ("hair", p["hair"]),
+                        ("garment", p["garment"]),
+                        ("age", p["age_group"]),
+                        ("umbrella", "yes" if p["umbrella"] else "no"),
+                        ("nose", "visible" if kp[2] == 2 else "hidden"),
+                    ):
+                        c = per_attribute.setdefault(key, [0, 0])
+                        c[0] += 1
+                        c[1] += mirrored
                 lm = res.pose_landmarks.landmark
                 for coco, blaze in COCO_TO_BLAZE.items():
                     if kp[3 * coco + 2] != 2:
@@ -190,6 +218,10 @@ def main() -> int:
                     f"{100 * v['agree'][1] / max(1, v['joints'][1]):5.1f}% of {v['joints'][1]}"
                 )
             print(line)
+    if a.per_attribute:
+        print("  found back views mirrored, by attribute:")
+        for (attribute, value), (n, mirrored) in sorted(per_attribute.items()):
+            print(f"    {attribute:9s} {value:13s} {mirrored:4d} of {n:4d} ({100 * mirrored / max(1, n):3.0f}%)")
     if a.crops:
         with open(a.crops, "w") as f:
             f.write(",".join(crop_rows[0].keys()) + "\n" if crop_rows else "")
