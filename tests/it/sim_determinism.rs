@@ -38,29 +38,29 @@ fn traces_are_identical_across_runs_and_thread_counts() -> Result<(), Box<dyn st
     Ok(())
 }
 
-/// The quickstart spec with `overrides`: its resolved spec, towns and plan.
-fn quickstart_with(
-    overrides: &[&str],
+/// The quickstart's first clip simulated with the overrides `off` and with `on`, which must change no clip
+/// script: the plan without them and the two traces (the second checked to be a pure function of its clip).
+fn first_clip_off_and_on(
+    off: &[&str],
+    on: &[&str],
 ) -> (
-    pedsynth::spec::LoadedSpec,
-    std::collections::BTreeMap<String, pedsynth::plan::TownContext>,
     pedsynth::plan::Plan,
+    pedsynth::sim::trace::ClipTrace,
+    pedsynth::sim::trace::ClipTrace,
 ) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
-    let options = LoadOptions {
-        overrides: overrides.iter().map(|s| s.to_string()).collect(),
-        allow_large: false,
-        profile: None,
+    let plan_with = |overrides: &[&str]| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("specs/quickstart.yaml");
+        let options = LoadOptions {
+            overrides: overrides.iter().map(|s| s.to_string()).collect(),
+            allow_large: false,
+            profile: None,
+        };
+        let (_, towns, plan) =
+            pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()));
+        (towns, plan)
     };
-    pedsynth::dataset::inputs::plan_spec_file(&path, &options).unwrap_or_else(|e| panic!("{}", e.render()))
-}
-
-#[test]
-fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
-    let plan_with = quickstart_with;
-    let (_, towns, off) = plan_with(&[]);
-    let (_, _, on) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
-    assert!(off.sim.ego_heading.is_none(), "off: absent from the plan file");
+    let (towns, off) = plan_with(off);
+    let (_, on) = plan_with(on);
     assert_eq!(off.clips, on.clips, "the wobble changes no clip script");
     let net = &towns[&off.clips[0].town].network;
     let (a, b) = (
@@ -72,6 +72,13 @@ fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
         sim::simulate(&on.clips[0], &on.sim, net),
         "a pure function of the clip"
     );
+    (off, a, b)
+}
+
+#[test]
+fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
+    let (off, a, b) = first_clip_off_and_on(&[], &["traffic.ego.heading_wobble.sd_deg=2"]);
+    assert!(off.sim.ego_heading.is_none(), "off: absent from the plan file");
     let offsets: Vec<f64> = a
         .ego
         .iter()
@@ -106,20 +113,15 @@ fn the_heading_wobble_turns_the_recorded_heading_only_with_the_asked_spread() {
 
 #[test]
 fn the_pitch_wobble_nods_the_recorded_ego_only_with_the_asked_spread() {
-    let plan_with = quickstart_with;
-    let (_, towns, off) = plan_with(&["traffic.ego.heading_wobble.sd_deg=2"]);
-    let (_, _, on) = plan_with(&[
-        "traffic.ego.heading_wobble.sd_deg=2",
-        "traffic.ego.pitch_wobble.sd_deg=0.5",
-        "traffic.ego.pitch_wobble.correlation_s=0.35",
-    ]);
-    assert!(off.sim.ego_pitch.is_none(), "off: absent from the plan file");
-    assert_eq!(off.clips, on.clips, "the wobble changes no clip script");
-    let net = &towns[&off.clips[0].town].network;
-    let (a, b) = (
-        sim::simulate(&off.clips[0], &off.sim, net),
-        sim::simulate(&on.clips[0], &on.sim, net),
+    let (off, a, b) = first_clip_off_and_on(
+        &["traffic.ego.heading_wobble.sd_deg=2"],
+        &[
+            "traffic.ego.heading_wobble.sd_deg=2",
+            "traffic.ego.pitch_wobble.sd_deg=0.5",
+            "traffic.ego.pitch_wobble.correlation_s=0.35",
+        ],
     );
+    assert!(off.sim.ego_pitch.is_none(), "off: absent from the plan file");
     assert!(a.ego.iter().all(|f| f.pitch_rad == 0.0), "level without it");
     for (x, y) in a.ego.iter().zip(&b.ego) {
         // Its own stream: the heading wobble's draws are the same with the pitch on.
