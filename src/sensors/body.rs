@@ -87,9 +87,12 @@ pub fn push_keypoints(coco: &[f32; 51], format: PoseFormat, flags: bool, out: &m
     }
 }
 
-/// Number of capsules in a body silhouette: 18 of the body (always present) and 4 of its figure (hair, headwear,
-/// bag, garment; absent ones have a radius of 0).
-pub const CAPSULES: usize = 22;
+/// Number of capsules in a body silhouette: 18 of the body (always present), 4 of its figure (hair, headwear,
+/// bag, garment; absent ones have a radius of 0) and the jaw.
+pub const CAPSULES: usize = 23;
+
+/// The jaw's capsule in a silhouette ([`silhouette`]): below the front of the skull (capsule 2), narrower than it.
+pub const JAW: usize = 22;
 
 /// A capsule: the set of points within `radius_m` of the segment `a`–`b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -231,10 +234,18 @@ pub(crate) fn head_scale(h: f64) -> f64 {
 /// fraction of the body height.
 const HAND_LENGTH: f64 = 0.05;
 
-/// The head: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and half-length (its
-/// height with the radius: 23 cm), fractions of the body height (an adult's).
+/// The skull: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and length, fractions of
+/// the body height (an adult's), from the head's centre (ear level: its lower end) up; with the jaw below its front
+/// the head is 23 cm tall.
 const HEAD_RADIUS: f64 = 0.047;
 const HEAD_HALF_LENGTH: f64 = 0.018;
+/// The jaw: a capsule of this radius (10 cm wide for a 1.75 m adult: narrower than the skull, so that a head seen
+/// from behind or three-quarters behind shows a round head of hair over a neck, not a face as wide as the skull)
+/// from below the ears forward and down to the chin, in the head's frame (forward, up), fractions of the body
+/// height.
+const JAW_RADIUS: f64 = 0.028;
+const JAW_BACK: (f64, f64) = (-0.004, -0.022);
+const JAW_CHIN: (f64, f64) = (0.016, -0.037);
 
 /// The head's keypoints (nose, left and right eye, left and right ear) and its centre for a body of height
 /// `h` whose neck is at `neck` and whose head is turned by `head_rot` about it: the one head layout of walkers
@@ -296,7 +307,9 @@ pub(crate) fn silhouette(
     let ((l_waist, l_chest), (r_waist, r_chest)) = (torso_half(1.0), torso_half(-1.0));
     let head_up = head_rot * DVec3::Z * (HEAD_HALF_LENGTH * head_s * h);
     let hair = match figure.hair {
-        HairStyle::Long => cap(in_head(-0.015, 0.012), in_head(-0.04, -0.1), 0.052 * head_s),
+        // Long hair falls from the crown down the back of the head onto the shoulder blades, narrower than the
+        // skull, so that a head seen from behind keeps its round outline above the hair.
+        HairStyle::Long => cap(in_head(-0.018, 0.015), in_head(-0.035, -0.105), 0.04 * head_s),
         HairStyle::Bun => cap(in_head(-0.062, 0.03), in_head(-0.062, 0.03), 0.026 * head_s),
         HairStyle::Short | HairStyle::Bald => Capsule::ABSENT,
     };
@@ -333,10 +346,15 @@ pub(crate) fn silhouette(
         Garment::Coat => cap(pelvis + up * (0.3 * torso_m), pelvis - up * (0.7 * torso_m), 0.075 * g),
         Garment::Trousers => Capsule::ABSENT,
     };
+    let jaw = cap(
+        in_head(JAW_BACK.0, JAW_BACK.1),
+        in_head(JAW_CHIN.0, JAW_CHIN.1),
+        JAW_RADIUS * head_s,
+    );
     [
         cap(l_waist, l_chest, torso_r),
         cap(j(5), j(6), 0.04 * g),
-        cap(head_centre - head_up, head_centre + head_up, head_r),
+        cap(head_centre, head_centre + head_up, head_r),
         cap(j(5), j(7), 0.03 * g),
         cap(j(6), j(8), 0.03 * g),
         cap(j(7), j(9), 0.025 * g),
@@ -356,6 +374,7 @@ pub(crate) fn silhouette(
         headwear,
         carry,
         garment,
+        jaw,
     ]
 }
 
@@ -539,7 +558,16 @@ mod tests {
         use crate::plan::{Carry, Garment, HairStyle};
         let f = frame(1.3, 0.4);
         let plain = pose(&f, 1.75, &Figure::PLAIN, DVec3::ZERO);
-        assert_eq!(plain.parts().count(), 18);
+        assert_eq!(plain.parts().count(), 19, "the body's 18 capsules and the jaw");
+        // The head: a skull from the head's centre up, and a jaw narrower than it, below its front, touching it.
+        let (skull, jaw) = (plain.capsules[2], plain.capsules[JAW]);
+        let forward = DVec2::from_angle(plain.yaw_rad).extend(0.0);
+        assert!(jaw.radius_m < 0.7 * skull.radius_m, "{jaw:?} {skull:?}");
+        assert!(
+            jaw.b.z < skull.a.z && (jaw.b - skull.a).dot(forward) > 0.0,
+            "the chin below and before the centre"
+        );
+        assert!(jaw.a.distance(skull.a) < skull.radius_m, "the jaw hangs on the skull");
         let touches = |c: &Capsule, body: &[Capsule]| {
             body.iter().any(|b| {
                 let d = (0..=20)
@@ -570,7 +598,7 @@ mod tests {
                 average.joints, plain.joints,
                 "only the build moves joints (the shoulders)"
             );
-            let extra: Vec<&Capsule> = p.capsules[18..].iter().filter(|c| c.is_present()).collect();
+            let extra: Vec<&Capsule> = p.capsules[18..JAW].iter().filter(|c| c.is_present()).collect();
             assert_eq!(extra.len(), if hair == HairStyle::Bald { 3 } else { 4 });
             for c in extra {
                 assert!(

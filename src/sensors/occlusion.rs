@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 use parry3d::query::{Ray, RayCast};
 
-use super::body::BodyPose;
+use super::body::{BodyPose, JAW};
 use super::scene;
 use crate::sim::{VEHICLE_HEIGHT_M, VEHICLE_LENGTH_M, VEHICLE_WIDTH_M};
 use crate::world::RoadNetwork;
@@ -90,10 +90,10 @@ pub(super) fn may_block(occ: &Occluder, camera: DVec2, target: DVec2, reach_m: f
     crate::world::segment_projection(camera, target, centre).1 <= r * r
 }
 
-/// The capsules of [`super::body::silhouette`]'s layout that hide the body's own joints: the body's 18 and a
-/// bag. Hair, headwear and garments are worn over the joints, and COCO's annotators mark a joint under clothes
+/// The capsules of [`super::body::silhouette`]'s layout that hide the body's own joints: the body's 18, a bag and
+/// the jaw. Hair, headwear and garments are worn over the joints, and COCO's annotators mark a joint under clothes
 /// where it is.
-const SELF_OCCLUDERS: [usize; 19] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20];
+const SELF_OCCLUDERS: [usize; 20] = [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, JAW];
 
 /// For each COCO-17 joint, the capsules of that layout it lies in (torso halves 0 and 17, shoulders 1, upper
 /// arms 3–4, forearms 5–6, thighs 7–8, shins 9–10, hips 16): their surface may come up to their radius before
@@ -147,7 +147,7 @@ pub(super) fn hidden_by_own_body(pose: &BodyPose, k: usize, camera: DVec3) -> bo
         if !c.is_present() || own_part(k) == Some(i) {
             return false;
         }
-        let allowance_m = if k < 5 && i == 2 {
+        let allowance_m = if k < 5 && (i == 2 || i == JAW) {
             HEAD_SURFACE_ALLOWANCE * c.radius_m
         } else if JOINT_CAPSULES[k].contains(&i) {
             c.radius_m + SELF_OCCLUSION_TOLERANCE_M

@@ -354,8 +354,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             if let Some(c) = ctx.frame.capsules.get(body_capsule(prim.aux)) {
                 normal = capsule_normals(c, p);
                 if prim.material == Material::Head {
-                    // The face is placed by the directions from the head's centre (a sphere's normals).
-                    let rel = p.sub(V3::splat((c.a + c.b) * 0.5));
+                    // The face is placed by the directions from the head's centre (a sphere's normals): the skull
+                    // capsule's lower end (`body::silhouette`).
+                    let rel = p.sub(V3::splat(c.a));
                     let dir = rel.scale(F::ONE / rel.length_squared().max(F::splat(1.0e-12)).sqrt());
                     albedo = face(prim, dir, albedo);
                 }
@@ -560,7 +561,7 @@ fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
     let brow = front
         & (s - F::splat(0.33)).abs().simd_lt(F::splat(0.14))
         & (u - F::splat(0.19)).abs().simd_lt(F::splat(0.035));
-    let mouth = front & s.simd_lt(F::splat(0.17)) & (u + F::splat(0.36)).abs().simd_lt(F::splat(0.04));
+    let mouth = front & s.simd_lt(F::splat(0.17)) & (u + F::splat(0.5)).abs().simd_lt(F::splat(0.045));
     let mut colour = V3::select(hair | brow, V3::splat(prim.albedo2), skin);
     colour = V3::select(eye, V3::splat(Vec3::new(0.02, 0.02, 0.025)), colour);
     let lips = V3 {

@@ -99,6 +99,7 @@ pub(super) const WEAR: [Wear; CAPSULES] = [
     Wear::Headwear, // hat
     Wear::Carry,    // bag
     Wear::Garment,  // skirt, dress, coat
+    Wear::Skin,     // jaw
 ];
 
 impl FrameScene {
