@@ -238,7 +238,7 @@ const HAND_LENGTH: f64 = 0.05;
 /// the body height (an adult's), from the head's centre (ear level: its lower end) up; with the jaw below its front
 /// the head is 23 cm tall.
 const HEAD_RADIUS: f64 = 0.047;
-const HEAD_HALF_LENGTH: f64 = 0.018;
+const SKULL_LENGTH: f64 = 0.018;
 /// The jaw: a capsule of this radius (10 cm wide for a 1.75 m adult: narrower than the skull, so that a head seen
 /// from behind or three-quarters behind shows a round head of hair over a neck, not a face as wide as the skull)
 /// from below the ears forward and down to the chin, in the head's frame (forward, up), fractions of the body
@@ -253,7 +253,7 @@ const JAW_CHIN: (f64, f64) = (0.016, -0.037);
 /// The head's top is at the body's height; a child's larger head ([`head_scale`]) sits on a shorter neck.
 pub(crate) fn head_points(neck: DVec3, head_rot: DMat3, h: f64) -> ([DVec3; 5], DVec3) {
     let s = head_scale(h);
-    let centre = neck + head_rot * DVec3::new(0.0, 0.0, (0.13 - (HEAD_RADIUS + HEAD_HALF_LENGTH) * s) * h);
+    let centre = neck + head_rot * DVec3::new(0.0, 0.0, (0.13 - (HEAD_RADIUS + SKULL_LENGTH) * s) * h);
     let head_point = |x: f64, y: f64, z: f64| centre + head_rot * (DVec3::new(x, y, z - 0.93) * (h * s));
     (
         [
@@ -305,7 +305,7 @@ pub(crate) fn silhouette(
         )
     };
     let ((l_waist, l_chest), (r_waist, r_chest)) = (torso_half(1.0), torso_half(-1.0));
-    let head_up = head_rot * DVec3::Z * (HEAD_HALF_LENGTH * head_s * h);
+    let skull_axis = head_rot * DVec3::Z * (SKULL_LENGTH * head_s * h);
     let hair = match figure.hair {
         // Long hair falls from the crown down the back of the head onto the shoulder blades, narrower than the
         // skull, so that a head seen from behind keeps its round outline above the hair.
@@ -354,7 +354,7 @@ pub(crate) fn silhouette(
     [
         cap(l_waist, l_chest, torso_r),
         cap(j(5), j(6), 0.04 * g),
-        cap(head_centre, head_centre + head_up, head_r),
+        cap(head_centre, head_centre + skull_axis, head_r),
         cap(j(5), j(7), 0.03 * g),
         cap(j(6), j(8), 0.03 * g),
         cap(j(7), j(9), 0.025 * g),
