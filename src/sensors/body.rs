@@ -208,8 +208,9 @@ const RUN_MPS: f64 = 2.4;
 
 impl BodyPose {
     /// The points besides the 17 joints whose occlusion counts towards a body's: both ends of the torso, the
-    /// head's centre and the middle of both thighs (the capsules of [`silhouette`]'s layout: the torso's two
-    /// halves are capsules 0 and 17).
+    /// middle of the skull (capsule 2's; since the jaw, 1.6 cm above the head's centre for a 1.75 m adult) and the
+    /// middle of both thighs (the capsules of [`silhouette`]'s layout: the torso's two halves are capsules 0 and
+    /// 17).
     pub fn occlusion_samples(&self) -> [DVec3; 5] {
         let c = &self.capsules;
         let mid = |a: DVec3, b: DVec3| (a + b) * 0.5;
