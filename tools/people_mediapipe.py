@@ -19,8 +19,8 @@ height, *front* the other way round, *side* in between; a found front or back vi
 left shoulder lies on the other side of its right one than ours (its joints are counted apart). `--sheet` also writes a crop sheet: per weather (a row), six
 crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found.
 `--per-joint` also prints each joint's agreement over all weathers; `--crops FILE.csv` writes one row per
-pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing), to join with
-the dataset's pedestrians table. `--per-attribute` also prints, by what the person wears (hood, hat, hair, garment,
+pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing, view, mirrored),
+to join with the dataset's pedestrians table. `--per-attribute` also prints, by what the person wears (hood, hat, hair, garment,
 age group, umbrella) and by whether our nose keypoint is visible (a head turned towards the camera), how many found
 back views MediaPipe mirrored. Prints one row per weather; `--check` exits 1 unless the figures hold: by
 default issue 44's (found ≥ 94 % in every weather, ≥ 80 % of joints, background ≤ 5 %), or the floors given with
@@ -138,6 +138,8 @@ def main() -> int:
             if res.pose_landmarks and view != "side":
                 theirs = res.pose_landmarks.landmark[11].x - res.pose_landmarks.landmark[12].x
                 mirrored = int((theirs > 0) != (across > 0))
+            row["view"] = view
+            row["mirrored"] = mirrored
             if res.pose_landmarks:
                 s["found"] += 1
                 v["found"] += 1

@@ -12,80 +12,6 @@ use glam::{DMat3, DVec3};
 
 use crate::plan::{Carry, Figure, Garment, HairStyle};
 use crate::sim::trace::{Gesture, PedFrame};
-use crate::spec::types::PoseFormat;
-
-/// COCO-17 keypoint names, in COCO order.
-pub const COCO17: [&str; 17] = [
-    "nose",
-    "left_eye",
-    "right_eye",
-    "left_ear",
-    "right_ear",
-    "left_shoulder",
-    "right_shoulder",
-    "left_elbow",
-    "right_elbow",
-    "left_wrist",
-    "right_wrist",
-    "left_hip",
-    "right_hip",
-    "left_knee",
-    "right_knee",
-    "left_ankle",
-    "right_ankle",
-];
-
-/// OpenPose-18 joints (PedestrianActionBenchmark's order) as COCO-17 indices; the neck (`None`) is the
-/// shoulders' midpoint.
-pub const OPENPOSE18_FROM_COCO17: [Option<usize>; 18] = [
-    Some(0),  // nose
-    None,     // neck
-    Some(6),  // right shoulder
-    Some(8),  // right elbow
-    Some(10), // right wrist
-    Some(5),  // left shoulder
-    Some(7),  // left elbow
-    Some(9),  // left wrist
-    Some(12), // right hip
-    Some(14), // right knee
-    Some(16), // right ankle
-    Some(11), // left hip
-    Some(13), // left knee
-    Some(15), // left ankle
-    Some(1),  // left eye
-    Some(2),  // right eye
-    Some(3),  // left ear
-    Some(4),  // right ear
-];
-
-/// The number of joints of a keypoint format.
-pub fn joint_count(format: PoseFormat) -> usize {
-    match format {
-        PoseFormat::Coco17 => 17,
-        PoseFormat::Openpose18 => 18,
-    }
-}
-
-/// Appends the 17 COCO-order triplets of `coco` to `out` in `format`'s joint order. The third value of each
-/// triplet is a visibility flag when `flags` (a derived joint takes the lower of its sources' flags) and a
-/// coordinate otherwise (averaged like the first two).
-pub fn push_keypoints(coco: &[f32; 51], format: PoseFormat, flags: bool, out: &mut Vec<f32>) {
-    match format {
-        PoseFormat::Coco17 => out.extend_from_slice(coco),
-        PoseFormat::Openpose18 => {
-            for joint in OPENPOSE18_FROM_COCO17 {
-                match joint {
-                    Some(k) => out.extend_from_slice(&coco[3 * k..3 * k + 3]),
-                    None => {
-                        let (l, r) = (&coco[15..18], &coco[18..21]);
-                        let third = if flags { l[2].min(r[2]) } else { 0.5 * (l[2] + r[2]) };
-                        out.extend_from_slice(&[0.5 * (l[0] + r[0]), 0.5 * (l[1] + r[1]), third]);
-                    }
-                }
-            }
-        }
-    }
-}
 
 /// Number of capsules in a body silhouette: 18 of the body (always present), 4 of its figure (hair, headwear,
 /// bag, garment; absent ones have a radius of 0) and the jaw.
@@ -234,6 +160,13 @@ pub(crate) fn head_scale(h: f64) -> f64 {
 /// A hand's length from the wrist along the forearm to the knuckles (the fingers' length again is not drawn), a
 /// fraction of the body height.
 const HAND_LENGTH: f64 = 0.05;
+/// A foot's heel and toe in the body frame relative to the ankle (forward, up), in body heights, before its
+/// pitch.
+const FOOT_HEEL: (f64, f64) = (-0.035, -0.014);
+/// See [`FOOT_HEEL`].
+const FOOT_TOE: (f64, f64) = (0.09, -0.02);
+/// The share of the shin's lean from vertical that the foot's pitch follows.
+const FOOT_PITCH: f64 = 1.0;
 
 /// The skull: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and length, fractions of
 /// the body height (an adult's), from the head's centre (ear level: its lower end) up; with the jaw below its front
@@ -280,7 +213,18 @@ pub(crate) fn silhouette(
     figure: &Figure,
     to_world: impl Fn(DVec3) -> DVec3,
 ) -> [Capsule; CAPSULES] {
-    let toe = |ankle: DVec3| ankle + DVec3::new(0.09 * h, 0.0, -0.02 * h);
+    // A foot from its heel, a little behind and below the ankle, to its toe, pitched with the shin (by
+    // `FOOT_PITCH` of the shin's lean): toes up as the leading foot strikes, heel up as the trailing one pushes
+    // off, so that a walker seen from behind shows the heels and soles.
+    let foot = |knee: DVec3, ankle: DVec3| {
+        let shin = ankle - knee;
+        let pitch = FOOT_PITCH * shin.x.atan2(-shin.z);
+        let (sin, cos) = pitch.sin_cos();
+        let at = |x: f64, z: f64| ankle + DVec3::new(x * cos - z * sin, 0.0, x * sin + z * cos) * h;
+        (at(FOOT_HEEL.0, FOOT_HEEL.1), at(FOOT_TOE.0, FOOT_TOE.1))
+    };
+    let (l_heel, l_toe) = foot(joints[13], joints[15]);
+    let (r_heel, r_toe) = foot(joints[14], joints[16]);
     let hand = |elbow: DVec3, wrist: DVec3| wrist + (wrist - elbow).normalize_or_zero() * (HAND_LENGTH * h);
     let cap = |a: DVec3, b: DVec3, r: f64| Capsule {
         a: to_world(a),
@@ -364,8 +308,8 @@ pub(crate) fn silhouette(
         cap(j(12), j(14), 0.045 * g),
         cap(j(13), j(15), 0.035 * g),
         cap(j(14), j(16), 0.035 * g),
-        cap(j(15), toe(j(15)), 0.022),
-        cap(j(16), toe(j(16)), 0.022),
+        cap(l_heel, l_toe, 0.022),
+        cap(r_heel, r_toe, 0.022),
         cap(neck, head_centre, 0.035),
         cap(j(9), hand(j(7), j(9)), 0.02),
         cap(j(10), hand(j(8), j(10)), 0.02),
@@ -691,31 +635,6 @@ mod tests {
         let nod = at(Gesture::Nod, 0.2);
         assert!(nod.gaze.z < -0.3, "nodding looks down: {}", nod.gaze.z);
         assert_eq!(nod.joints[10], plain.joints[10]);
-    }
-
-    #[test]
-    fn openpose18_reorders_coco17_and_derives_the_neck() {
-        let mut coco = [0f32; 51];
-        for k in 0..17 {
-            coco[3 * k..3 * k + 3].copy_from_slice(&[k as f32, 100.0 + k as f32, 2.0]);
-        }
-        coco[3 * 6 + 2] = 1.0; // the right shoulder is occluded
-        let mut out = Vec::new();
-        push_keypoints(&coco, PoseFormat::Openpose18, true, &mut out);
-        assert_eq!(out.len(), 54);
-        assert_eq!(&out[0..3], &[0.0, 100.0, 2.0], "nose first");
-        assert_eq!(
-            &out[3..6],
-            &[5.5, 105.5, 1.0],
-            "neck: shoulders' midpoint, the lower flag"
-        );
-        assert_eq!(&out[6..9], &[6.0, 106.0, 1.0], "right shoulder");
-        assert_eq!(&out[15..18], &[5.0, 105.0, 2.0], "left shoulder");
-        assert_eq!(&out[42..45], &[1.0, 101.0, 2.0], "left eye");
-        assert_eq!(&out[51..54], &[4.0, 104.0, 2.0], "right ear last");
-        out.clear();
-        push_keypoints(&coco, PoseFormat::Coco17, true, &mut out);
-        assert_eq!(out, coco);
     }
 
     /// An umbrella is held in the left hand: only the left elbow and wrist move (the arm stops swinging), the

@@ -2,6 +2,7 @@
 //!
 //! - [`body`] — the articulated pedestrian body (COCO-17 joints, capsule silhouette).
 //! - [`cyclist`] — a cyclist's rider (riding pose, same joints) and bicycle.
+//! - [`keypoints`] — keypoint formats (COCO-17, OpenPose-18).
 //! - [`annotate`] — visibility gate, boxes, keypoints, occlusion and crossing labels.
 //! - [`scene`] — the renderable geometry of a frame (one source for cameras and LiDAR).
 //! - [`camera`] — RGB, depth, semantic, instance and DVS, rendered on the CPU.
@@ -15,6 +16,7 @@ pub mod annotator;
 pub mod body;
 pub mod camera;
 pub mod cyclist;
+pub mod keypoints;
 pub mod lidar;
 mod occlusion;
 pub mod realise;

@@ -18,7 +18,7 @@ use serde::Serialize;
 use super::dataset::{Clip, Dataset};
 use super::{LinkMode, link_file, write_file};
 use crate::error::{Error, code};
-use crate::sensors::body::{COCO17, OPENPOSE18_FROM_COCO17};
+use crate::sensors::keypoints::{COCO17, OPENPOSE18_FROM_COCO17};
 
 /// COCO's person skeleton (1-based keypoint indices, as in `person_keypoints_*.json`).
 pub const SKELETON: [[u8; 2]; 19] = [

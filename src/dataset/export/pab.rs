@@ -11,7 +11,7 @@ use super::dataset::{AnnotatedFrame, Dataset};
 use super::pie::{SETS, assign_videos, track_id};
 use super::write_file;
 use crate::error::{Error, code};
-use crate::sensors::body::push_keypoints;
+use crate::sensors::keypoints::push_keypoints;
 use crate::spec::types::PoseFormat;
 
 /// The 36 values of one pedestrian-frame.

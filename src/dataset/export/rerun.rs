@@ -21,7 +21,7 @@ use rerun::datatypes::{AnnotationInfo, ClassDescription, KeypointPair};
 use super::dataset::{Clip, Dataset, SENSOR_FROM_OPTICAL};
 use crate::dataset::read::tables as read_tables;
 use crate::error::{Error, code};
-use crate::sensors::body::COCO17;
+use crate::sensors::keypoints::COCO17;
 use crate::sim::trace::PedState;
 
 /// What an export wrote: entity path → rows (frames logged).

@@ -65,7 +65,7 @@ fn label_rows(clip: &Clip) -> String {
             );
             // COCO-17 as written (the OpenPose-18 option's neck is dropped): u, v, confidence = flag / 2.
             let coco: Vec<f32> = if f.keypoints.len() == 54 {
-                crate::sensors::body::OPENPOSE18_FROM_COCO17
+                crate::sensors::keypoints::OPENPOSE18_FROM_COCO17
                     .iter()
                     .zip(f.keypoints.chunks_exact(3))
                     .filter_map(|(c, j)| c.map(|c| (c, j)))

@@ -113,10 +113,10 @@ fn keypoint_list(
     flags: bool,
     get: fn(&crate::sensors::annotate::AnnotationRow) -> &[f32; 51],
 ) -> ArrayRef {
-    let width = 3 * crate::sensors::body::joint_count(format);
+    let width = 3 * crate::sensors::keypoints::joint_count(format);
     let mut values = Vec::with_capacity(rows.len() * width);
     for r in rows {
-        crate::sensors::body::push_keypoints(get(r), format, flags, &mut values);
+        crate::sensors::keypoints::push_keypoints(get(r), format, flags, &mut values);
     }
     let mut builder =
         FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(values.len()), width as i32, rows.len())
@@ -135,7 +135,7 @@ pub fn annotations_batch(script: &ClipScript, ann: &ClipAnnotations, format: Pos
     let f32c = |get: fn(&crate::sensors::annotate::AnnotationRow) -> f32| -> ArrayRef {
         Arc::new(Float32Array::from_iter_values(rows.iter().map(get)))
     };
-    let width = 3 * crate::sensors::body::joint_count(format) as i32;
+    let width = 3 * crate::sensors::keypoints::joint_count(format) as i32;
     let list = DataType::FixedSizeList(Arc::new(Field::new("item", DataType::Float32, false)), width);
     Table::new()
         .column("clip_id", false, repeated_utf8(n, &script.clip_id))

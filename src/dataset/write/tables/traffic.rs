@@ -257,7 +257,7 @@ pub fn cyclists_batch(
     let boxc =
         |k: usize| -> ArrayRef { Arc::new(Float32Array::from_iter(seen.iter().map(|s| s.map(|s| s.bbox_px[k])))) };
     let script_of = |c: u32| script.cyclists.get(c as usize);
-    let width = 3 * crate::sensors::body::joint_count(format);
+    let width = 3 * crate::sensors::keypoints::joint_count(format);
     let keypoints = |three_d: bool| -> ArrayRef {
         let mut builder =
             FixedSizeListBuilder::with_capacity(Float32Builder::with_capacity(n * width), width as i32, n)
@@ -268,7 +268,7 @@ pub fn cyclists_batch(
             match s {
                 Some(s) => {
                     let src = if three_d { &s.keypoints_3d } else { &s.keypoints };
-                    crate::sensors::body::push_keypoints(src, format, !three_d, &mut buf);
+                    crate::sensors::keypoints::push_keypoints(src, format, !three_d, &mut buf);
                 }
                 None => buf.resize(width, 0.0),
             }
