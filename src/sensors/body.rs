@@ -494,6 +494,44 @@ mod tests {
         assert!((p.joints[5] - p.joints[6]).truncate().dot(left) > 0.0);
     }
 
+    /// A foot runs from a heel behind the ankle to a toe ahead of it, on the ground when standing, and rolls
+    /// with the stride, square to its shin: toes up where the shin leans forward (heel strike), heel up where it
+    /// leans back (push-off).
+    #[test]
+    fn feet_have_heels_and_roll_with_the_stride() {
+        let standing = pose(&frame(0.0, 0.0), 1.75, &Figure::PLAIN, DVec3::ZERO);
+        let forward = DVec2::from_angle(standing.yaw_rad).extend(0.0);
+        for (foot, ankle) in [(11, 15), (12, 16)] {
+            let (c, a) = (standing.capsules[foot], standing.joints[ankle]);
+            assert!((c.a - a).dot(forward) < -0.04, "the heel 4+ cm behind the ankle: {c:?}");
+            assert!((c.b - a).dot(forward) > 0.12, "the toe ahead of it: {c:?}");
+            for end in [c.a, c.b] {
+                assert!((-0.02..0.03).contains(&(end.z - c.radius_m)), "on the ground: {c:?}");
+            }
+        }
+        let (mut toes_up, mut heels_up) = (0, 0);
+        for step in 0..40 {
+            let p = pose(&frame(1.3, f64::from(step) / 40.0), 1.75, &Figure::PLAIN, DVec3::ZERO);
+            for (foot, knee, ankle) in [(11, 13, 15), (12, 14, 16)] {
+                let (c, shin) = (p.capsules[foot], p.joints[ankle] - p.joints[knee]);
+                let along = (c.b - c.a).normalize();
+                assert!(
+                    along.dot(shin.normalize()).abs() < 0.1,
+                    "square to the shin: {c:?} {shin}"
+                );
+                let lean = shin.dot(forward);
+                if lean > 0.05 {
+                    assert!(c.b.z > c.a.z + 0.02, "toes up at heel strike: {c:?}");
+                    toes_up += 1;
+                } else if lean < -0.05 {
+                    assert!(c.a.z > c.b.z + 0.02, "heel up at push-off: {c:?}");
+                    heels_up += 1;
+                }
+            }
+        }
+        assert!(toes_up > 5 && heels_up > 5, "{toes_up} {heels_up}");
+    }
+
     /// A figure's parts hang on the body: each present one touches the body's own capsules (hair and hat on
     /// the head, a bag at the back or the hip, a skirt or coat over the thighs) and leaves the joints where they
     /// are (the build alone broadens the shoulders); absent ones are left out of the
