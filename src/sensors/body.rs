@@ -167,6 +167,16 @@ const FOOT_HEEL: (f64, f64) = (-0.035, -0.014);
 const FOOT_TOE: (f64, f64) = (0.09, -0.02);
 /// The share of the shin's lean from vertical that the foot's pitch follows.
 const FOOT_PITCH: f64 = 1.0;
+/// Shoulders follow a large head turn: a head turned beyond [`SHOULDER_TWIST`]`.0` radians from the hips
+/// (30°) takes the shoulders along by [`SHOULDER_TWIST`]`.1` of the excess (a look over the shoulder at the
+/// 80° limit: the shoulders 25° round, the head 55° on them). Land (2004), gaze shifts: the trunk joins the
+/// eyes and the head for shifts beyond about 60°.
+const SHOULDER_TWIST: (f64, f64) = (0.52, 0.5);
+
+/// The shoulders' twist about the spine for a head yaw (radians, relative to the hips), radians.
+fn shoulder_twist(head_yaw_rad: f64) -> f64 {
+    head_yaw_rad.signum() * SHOULDER_TWIST.1 * (head_yaw_rad.abs() - SHOULDER_TWIST.0).max(0.0)
+}
 
 /// The skull: an upright capsule of this radius (its width: 16.5 cm for a 1.75 m adult) and length, fractions of
 /// the body height (an adult's), from the head's centre (ear level: its lower end) up; with the jaw below its front
@@ -243,10 +253,13 @@ pub(crate) fn silhouette(
     // The torso: two capsules side by side (wider than deep: 35 cm by 21 cm for an average 1.75 m adult),
     // their axes closer at the waist than at the chest.
     let torso_r = 0.06 * g;
+    // The chest turns with the shoulders (their line's twist about the spine, see [`shoulder_twist`]).
+    let across = joints[5] - joints[6];
+    let twist = DMat3::from_rotation_z((-across.x).atan2(across.y));
     let torso_half = |side: f64| {
         (
             pelvis + DVec3::new(0.0, side * 0.03 * h * g, 0.0),
-            chest + DVec3::new(0.0, side * 0.042 * h * g, 0.0),
+            chest + twist * DVec3::new(0.0, side * 0.042 * h * g, 0.0),
         )
     };
     let ((l_waist, l_chest), (r_waist, r_chest)) = (torso_half(1.0), torso_half(-1.0));
@@ -271,7 +284,7 @@ pub(crate) fn silhouette(
     };
     let carry = match figure.carry {
         Some((Carry::Backpack, _)) => {
-            let off = back * ((torso_r + 0.045) * h);
+            let off = twist * back * ((torso_r + 0.045) * h);
             cap(
                 pelvis + up * (0.45 * torso_m) + off,
                 pelvis + up * (0.95 * torso_m) + off,
@@ -418,6 +431,12 @@ pub fn pose(frame: &PedFrame, height_m: f64, figure: &Figure, offset_body: DVec3
             r_wrist = r_wrist.lerp(wrist, blend);
         }
     }
+
+    // The shoulders, arms and what the hands hold turn about the spine with a large head turn.
+    let twist = DMat3::from_rotation_z(shoulder_twist(frame.head_yaw_rad));
+    let [l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist] =
+        [l_shoulder, r_shoulder, l_elbow, r_elbow, l_wrist, r_wrist].map(|p| twist * p);
+    let umbrella = umbrella.map(|(grip, top)| (twist * grip, twist * top));
 
     // Head: turned by the head yaw about the neck, pitched down when reading a phone.
     let neck = DVec3::new(0.0, 0.0, 0.87 * h);
@@ -638,6 +657,36 @@ mod tests {
             let down = (-p.gaze.z).asin();
             let want = if on_phone { PHONE_HEAD_PITCH_RAD } else { 0.0 };
             assert!((down - want).abs() < 1e-9, "pitch {down} vs {want}");
+        }
+    }
+
+    /// A look over the shoulder turns the shoulders, the chest and the arms with the head (by half the turn
+    /// beyond 30°), while the hips stay square to the walk and the gaze keeps the head's yaw; a glance leaves
+    /// the shoulders square.
+    #[test]
+    fn shoulders_follow_a_look_over_the_shoulder() {
+        let line = |p: &BodyPose| {
+            let d = p.joints[5] - p.joints[6];
+            (-d.x).atan2(d.y)
+        };
+        let hip_line = |p: &BodyPose| {
+            let d = p.joints[11] - p.joints[12];
+            (-d.x).atan2(d.y)
+        };
+        let wrap = |a: f64| (a + std::f64::consts::PI).rem_euclid(TAU) - std::f64::consts::PI;
+        for (head_yaw, want) in [(0.3, 0.0), (-0.5, 0.0), (1.4, 0.44), (-1.2, -0.34)] {
+            let mut f = frame(1.0, 0.3);
+            f.head_yaw_rad = head_yaw;
+            let p = pose(&f, 1.7, &Figure::PLAIN, DVec3::ZERO);
+            let twist = wrap(line(&p) - f.yaw_rad);
+            assert!((twist - want).abs() < 1e-9, "head {head_yaw}: shoulders {twist}, want {want}");
+            assert!(wrap(hip_line(&p) - f.yaw_rad).abs() < 1e-9, "hips stay square");
+            assert!((p.gaze.y.atan2(p.gaze.x) - (f.yaw_rad + head_yaw)).abs() < 1e-9);
+            // The chest's two halves turn with the shoulders, their waists do not.
+            let chest = p.capsules[0].b - p.capsules[17].b;
+            let waist = p.capsules[0].a - p.capsules[17].a;
+            assert!((wrap((-chest.x).atan2(chest.y) - f.yaw_rad) - want).abs() < 1e-9);
+            assert!(wrap((-waist.x).atan2(waist.y) - f.yaw_rad).abs() < 1e-9);
         }
     }
 
