@@ -679,7 +679,10 @@ mod tests {
             f.head_yaw_rad = head_yaw;
             let p = pose(&f, 1.7, &Figure::PLAIN, DVec3::ZERO);
             let twist = wrap(line(&p) - f.yaw_rad);
-            assert!((twist - want).abs() < 1e-9, "head {head_yaw}: shoulders {twist}, want {want}");
+            assert!(
+                (twist - want).abs() < 1e-9,
+                "head {head_yaw}: shoulders {twist}, want {want}"
+            );
             assert!(wrap(hip_line(&p) - f.yaw_rad).abs() < 1e-9, "hips stay square");
             assert!((p.gaze.y.atan2(p.gaze.x) - (f.yaw_rad + head_yaw)).abs() < 1e-9);
             // The chest's two halves turn with the shoulders, their waists do not.

@@ -19,7 +19,8 @@ impl Renderer {
         let tris = &mut self.tris;
         let mut draw = |tri: &crate::sensors::scene::Tri| {
             let v = tri.v.map(|p| m * p + t);
-            if v.iter().all(|p| p.z < NEAR_M) {
+            // Behind the near plane, or the far side of a closed mesh (seen from the camera at the origin).
+            if v.iter().all(|p| p.z < NEAR_M) || (tri.closed && (v[1] - v[0]).cross(v[2] - v[0]).dot(v[0]) > 0.0) {
                 return;
             }
             let mut poly = [Vec3::ZERO; 4];

@@ -107,6 +107,11 @@ impl Renderer {
             }
         }
         for tri in &frame.mesh.tris {
+            // The far side of a closed mesh from the sun lies in the shadow of its near side.
+            let [a, b, c] = tri.v;
+            if tri.closed && (b - a).cross(c - a).dot(dir) < 0.0 {
+                continue;
+            }
             self.shadow.draw(tri.v.map(|q| sun.project(q)), tri.prim);
         }
         self.sun = Some(sun);

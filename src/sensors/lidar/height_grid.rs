@@ -256,6 +256,7 @@ mod tests {
         PreTri::of(&Tri {
             v: [a.into(), b.into(), c.into()],
             prim: 0,
+            closed: false,
         })
     }
 

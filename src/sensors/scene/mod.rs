@@ -310,6 +310,9 @@ pub struct Tri {
     pub v: [Vec3; 3],
     /// Index into the primitive table.
     pub prim: u32,
+    /// Whether the triangle is part of a closed mesh wound counter-clockwise seen from outside (a capsule's):
+    /// facing away from a camera, it is hidden behind the mesh's own front and the camera skips it.
+    pub closed: bool,
 }
 
 /// Triangles and their primitives under construction. Primitive ids start at `base`: a frame's agents
@@ -343,10 +346,12 @@ impl Mesh {
         self.tris.push(Tri {
             v: [q[0], q[1], q[2]],
             prim,
+            closed: false,
         });
         self.tris.push(Tri {
             v: [q[0], q[2], q[3]],
             prim,
+            closed: false,
         });
     }
 
@@ -403,6 +408,7 @@ impl Mesh {
                 self.tris.push(Tri {
                     v: [peak + shift, a + shift, b + shift],
                     prim,
+                    closed: false,
                 });
             }
         }
@@ -437,17 +443,13 @@ impl Mesh {
         let poles = [c.a - axis * r, c.b + axis * r];
         for k in 0..N {
             let k1 = (k + 1) % N;
-            self.tris.push(Tri {
-                v: [poles[0], rings[0][k1], rings[0][k]],
-                prim,
-            });
-            self.tris.push(Tri {
-                v: [poles[1], rings[3][k], rings[3][k1]],
-                prim,
-            });
+            let closed = |v| Tri { v, prim, closed: true };
+            self.tris.push(closed([poles[0], rings[0][k1], rings[0][k]]));
+            self.tris.push(closed([poles[1], rings[3][k], rings[3][k1]]));
             for r2 in 0..3 {
                 let (p, q) = (&rings[r2], &rings[r2 + 1]);
-                self.quad([p[k], p[k1], q[k1], q[k]], prim);
+                self.tris.push(closed([p[k], p[k1], q[k1]]));
+                self.tris.push(closed([p[k], q[k1], q[k]]));
             }
         }
     }
@@ -524,6 +526,46 @@ pub fn ego_at(trace: &ClipTrace, t: SceneTime) -> (DVec3, f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A capsule's mesh is closed and wound counter-clockwise seen from outside (what lets the camera skip its
+    /// far side): every triangle's normal points away from the axis, and its edges pair up (each edge used
+    /// once in each direction); other meshes are not marked closed.
+    #[test]
+    fn capsule_meshes_are_closed_and_wound_outwards() {
+        let mut mesh = Mesh::default();
+        for (a, b, r) in [
+            (Vec3::ZERO, Vec3::new(0.0, 0.0, 0.5), 0.05),
+            (Vec3::new(1.0, 2.0, 0.3), Vec3::new(1.3, 1.8, 0.9), 0.11),
+            (Vec3::new(-2.0, 0.5, 1.0), Vec3::new(-2.4, 0.5, 0.2), 0.08),
+        ] {
+            mesh.clear(0);
+            mesh.capsule(&SceneCapsule { a, b, radius_m: r }, 7);
+            let mut edges = std::collections::BTreeMap::new();
+            for t in &mesh.tris {
+                assert!(t.closed && t.prim == 7);
+                let n = (t.v[1] - t.v[0]).cross(t.v[2] - t.v[0]);
+                let centroid = (t.v[0] + t.v[1] + t.v[2]) / 3.0;
+                // The nearest point of the axis segment.
+                let d = b - a;
+                let s = if d.length_squared() > 0.0 {
+                    ((centroid - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                assert!(n.dot(centroid - (a + d * s)) > 0.0, "inward triangle {t:?}");
+                for k in 0..3 {
+                    let key = |p: Vec3| p.to_array().map(f32::to_bits);
+                    *edges.entry((key(t.v[k]), key(t.v[(k + 1) % 3]))).or_insert(0) += 1;
+                }
+            }
+            for (&(p, q), &n) in &edges {
+                assert_eq!((n, edges.get(&(q, p))), (1, Some(&1)), "an open or doubled edge");
+            }
+        }
+        mesh.clear(0);
+        mesh.quad([Vec3::ZERO, Vec3::X, Vec3::ONE, Vec3::Y], 0);
+        assert!(mesh.tris.iter().all(|t| !t.closed));
+    }
 
     #[test]
     fn point_in_polygon_handles_a_square() {
