@@ -73,10 +73,12 @@ fn a_wall_at_a_known_distance_is_returned_within_a_millimetre() {
         Tri {
             v: [q[0], q[1], q[2]],
             prim: 0,
+            closed: false,
         },
         Tri {
             v: [q[0], q[2], q[3]],
             prim: 0,
+            closed: false,
         },
     ]);
     let l = Lidar {
