@@ -673,7 +673,7 @@ mod tests {
             let d = p.joints[11] - p.joints[12];
             (-d.x).atan2(d.y)
         };
-        let wrap = |a: f64| (a + std::f64::consts::PI).rem_euclid(TAU) - std::f64::consts::PI;
+        let wrap = crate::world::opendrive::geometry::wrap_angle;
         for (head_yaw, want) in [(0.3, 0.0), (-0.5, 0.0), (1.4, 0.44), (-1.2, -0.34)] {
             let mut f = frame(1.0, 0.3);
             f.head_yaw_rad = head_yaw;
