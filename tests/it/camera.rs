@@ -1250,7 +1250,8 @@ fn a_lanes_shading_does_not_depend_on_the_other_lanes() {
                 frame: &frame,
                 light: &light,
                 noise: &noise,
-                lights: &lights,
+                lamps: &lights.lamps,
+                heads: &lights.heads,
             };
             let shadow: [f32; LANES] = std::array::from_fn(|i| [0.0, 1.0, 0.25][i % 3]);
             let points = |lane: Option<usize>| {

@@ -6,6 +6,7 @@
 //! and [`post`] (tone map, rain streaks). Their building blocks:
 //!
 //! - [`raster`] — the visibility buffers (nearest primitive and depth per sample).
+//! - [`cull`] — the lights each tile of a band can see.
 //! - [`group`] — grouping of edge samples by primitive for shading.
 //! - [`lanes`] — lane math for shading several pixels at once.
 //! - [`light`] — lighting from the weather.
@@ -25,6 +26,7 @@
 //! primitive and each sample where they differ (edge antialiasing), then adds rain streaks and maps to sRGB.
 
 pub mod band;
+mod cull;
 pub mod dvs;
 pub mod expose;
 pub mod group;

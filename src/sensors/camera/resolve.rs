@@ -2,6 +2,7 @@
 //! visibility, runs of up to eight pixels of one primitive shaded at once, edge pixels' samples grouped by
 //! primitive and shaded per sample (antialiasing).
 
+use super::cull::TileLights;
 use super::*;
 
 /// Rows `y0..` of the images (as many as the slices hold).
@@ -33,6 +34,8 @@ pub(super) struct BandScratch {
     /// The row's linear colours, one channel each (`LANES − 1` of slack for whole-vector stores; the tone map
     /// reads groups of four).
     pub(super) rgb: [Vec<f32>; 3],
+    /// The lights each tile of the band can see.
+    pub(super) tiles: TileLights,
 }
 
 impl BandScratch {
@@ -49,6 +52,7 @@ impl BandScratch {
                 vec![0.0; w + LANES - 1],
                 vec![0.0; w + LANES - 1],
             ],
+            tiles: TileLights::default(),
         }
     }
 }
@@ -116,12 +120,14 @@ impl Renderer {
         let w = c.width_px as usize;
         let y0 = out.y0;
         let h = out.depth_m.len() / w;
-        let ctx = ShadeContext {
+        // The shading context, given the lights to test where it is used.
+        let base = ShadeContext {
             scene,
             frame,
             light: &self.light,
             noise: &self.noise,
-            lights: &self.lights,
+            lamps: &[],
+            heads: &[],
         };
         let view = View {
             cam,
@@ -141,8 +147,10 @@ impl Renderer {
             edge_colour,
             edge_tag,
             rgb,
+            tiles,
         } = taken.get_or_insert_with(|| BandScratch::new(w));
         vis.draw(&self.tris, &self.bins[y0 / BAND_ROWS], y0, h, c.height_px as usize);
+        tiles.cull(&self.lights, vis, &view, y0, h);
         // The edge pixels' samples, listed and shaded up to `LANES` of one primitive at a time (over the band, so
         // that the lanes fill).
         edges.clear();
@@ -167,11 +175,20 @@ impl Renderer {
         groups.group(edges.iter().map(|s| s.prim));
         edge_colour.resize(edges.len(), Vec3::ZERO);
         edge_tag.resize(edges.len(), 0);
+        let (lamps, heads) = tiles.band(&self.lights);
+        let band_ctx = ShadeContext { lamps, heads, ..base };
         for group in groups.groups() {
             for chunk in group.chunks(LANES) {
                 let at = |i: usize| &edges[chunk[i.min(chunk.len() - 1)] as usize];
                 let lane = |f: fn(&Sample) -> f32| lanes_from(|i| f(at(i)));
-                let (colour, tags) = self.shade(&ctx, &view, at(0).prim, lane(|s| s.key), lane(|s| s.u), lane(|s| s.v));
+                let (colour, tags) = self.shade(
+                    &band_ctx,
+                    &view,
+                    at(0).prim,
+                    lane(|s| s.key),
+                    lane(|s| s.u),
+                    lane(|s| s.v),
+                );
                 for (&o, (c, t)) in chunk.iter().zip(colour.lanes().into_iter().zip(tags)) {
                     edge_colour[o as usize] = c;
                     edge_tag[o as usize] = t;
@@ -213,6 +230,8 @@ impl Renderer {
                 let n = end - x;
                 let key = lanes_from(|i| row_key[x + i.min(n - 1)]);
                 let u = F::splat(x as f32 + 0.5) + lanes_from(|i| i as f32);
+                let (lamps, heads) = tiles.run(&self.lights, x, end);
+                let ctx = ShadeContext { lamps, heads, ..base };
                 let (colour, tags) = self.shade(&ctx, &view, prim, key, u, v_centre);
                 // All lanes are stored: those past `n` are overwritten by the pixels they fall on.
                 for (channel, lanes) in rgb.iter_mut().zip([colour.x, colour.y, colour.z]) {

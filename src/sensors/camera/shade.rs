@@ -107,9 +107,22 @@ pub struct ShadeContext<'a> {
     pub light: &'a Lighting,
     /// Texture noise.
     pub noise: &'a Noise,
-    /// Lights near the camera.
-    pub lights: &'a ActiveLights,
+    /// The street lamps to test (those near the camera that can reach the points shaded: [`super::cull`]).
+    pub lamps: &'a [Vec3],
+    /// The headlights to test, likewise.
+    pub heads: &'a [(Vec3, Vec3)],
 }
+
+/// A street lamp lights points within 40 m (squared, m²).
+pub const LAMP_REACH_M2: f32 = 1600.0;
+/// A headlight lights points within 60 m (squared, m²)…
+pub const HEAD_REACH_M2: f32 = 3600.0;
+/// …more than 0.1 m ahead of it…
+pub const HEAD_AHEAD_M: f32 = 0.1;
+/// …below its cut-off, a slope of 2 % above its horizontal…
+pub const HEAD_CUTOFF_SLOPE: f32 = 0.02;
+/// …and at most 0.7 times as far to the side as ahead.
+pub const HEAD_SPREAD: f32 = 0.7;
 
 /// Surface points of one primitive (one per lane), as the camera sees them.
 #[derive(Clone, Copy, Debug)]
@@ -394,10 +407,10 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         // Street lamps: `d` from the point to the lamp, `dir = d / |d|`. Written without normalising `d` (a
         // square root and a division per lamp and lane saved, the costliest part of a night frame).
         let lamp_intensity = F::splat(LAMP_INTENSITY * l.night);
-        for &lamp in &ctx.lights.lamps {
+        for &lamp in ctx.lamps {
             let d = V3::splat(lamp).sub(p);
             let d2 = d.length_squared();
-            let near = d2.simd_le(F::splat(1600.0));
+            let near = d2.simd_le(F::splat(LAMP_REACH_M2));
             if !near.any() {
                 continue;
             }
@@ -417,20 +430,22 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, F::ZERO)));
             }
         }
-        for &(pos, axis) in &ctx.lights.heads {
+        for &(pos, axis) in ctx.heads {
             let d = p.sub(V3::splat(pos));
             let d2 = d.length_squared();
             // A low beam: wide sideways, cut off just above the lamp's horizontal.
             let ahead = d.x * axis.x + d.y * axis.y;
-            let mut on = d2.simd_ge(F::splat(1e-4)) & d2.simd_le(F::splat(3600.0)) & ahead.simd_gt(F::splat(0.1));
+            let mut on = d2.simd_ge(F::splat(1e-4))
+                & d2.simd_le(F::splat(HEAD_REACH_M2))
+                & ahead.simd_gt(F::splat(HEAD_AHEAD_M));
             if !on.any() {
                 continue;
             }
             // Lanes behind the lamp divide by zero or less; `on` masks them.
             let per_ahead = one / ahead;
-            let side = ((d.x * axis.y - d.y * axis.x) * per_ahead * (1.0 / 0.7)).abs();
+            let side = ((d.x * axis.y - d.y * axis.x) * per_ahead * (1.0 / HEAD_SPREAD)).abs();
             let up = d.z * per_ahead;
-            let cut = ((F::splat(0.02) - up) * 25.0).max(F::ZERO).min(one);
+            let cut = ((F::splat(HEAD_CUTOFF_SLOPE) - up) * 25.0).max(F::ZERO).min(one);
             let beam = (one - side * side).max(F::ZERO) * cut;
             on &= beam.simd_gt(F::ZERO);
             if !on.any() {
