@@ -27,6 +27,7 @@ const CORPUS: &[(&str, &str, u32)] = &[
     ("negative_length.xodr", "xodr_invalid", 5),
     ("absurd_road_length.xodr", "xodr_invalid", 3),
     ("absurd_curvature.xodr", "xodr_invalid", 5),
+    ("param_poly3_longer_than_its_length.xodr", "xodr_invalid", 5),
     ("bad_lane_id.xodr", "xodr_invalid", 10),
     ("zero_width_only.xodr", "xodr_invalid", 3),
     ("non_numeric_length.xodr", "xodr_invalid", 5),

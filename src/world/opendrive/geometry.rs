@@ -145,6 +145,21 @@ impl Geometry {
         )
     }
 
+    /// The length of the polyline through `n + 1` evenly spaced points of the record (at most its arc length):
+    /// a record whose curve is much longer than its declared `length` is malformed.
+    pub(crate) fn traced_length(&self, n: usize) -> f64 {
+        let step = self.length / n.max(1) as f64;
+        let mut prev = self.eval(0.0).0;
+        (1..=n.max(1))
+            .map(|i| {
+                let p = self.eval(step * i as f64).0;
+                let d = p.distance(prev);
+                prev = p;
+                d
+            })
+            .sum()
+    }
+
     /// An upper estimate of |curvature| over the record, used to choose the station spacing.
     pub(crate) fn max_curvature(&self) -> f64 {
         match self.kind {

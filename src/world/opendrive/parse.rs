@@ -426,7 +426,7 @@ fn parse_geometry(cx: &Ctx, g: Node, running_s: f64) -> Result<Geometry, WorldEr
         }
         other => return Err(cx.invalid(shape, format!("unknown geometry shape <{other}>"))),
     };
-    Ok(Geometry {
+    let geometry = Geometry {
         s: s.max(0.0),
         x,
         y,
@@ -434,8 +434,27 @@ fn parse_geometry(cx: &Ctx, g: Node, running_s: f64) -> Result<Geometry, WorldEr
         length,
         kind,
         pos: cx.pos(g),
-    })
+    };
+    // A record's `length` is its curve's arc length. A polynomial whose curve runs far longer (a coefficient of
+    // 10^8 in a 20 m record) would put lanes kilometres long between the stations sampled along `length`, and
+    // everything built along them (spawn points every few metres) would not fit in memory.
+    let traced = geometry.traced_length(TRACE_STEPS);
+    if traced.is_nan() || traced > MAX_TRACED_RATIO * length + 1.0 {
+        return Err(cx.invalid(
+            shape,
+            format!(
+                "<{}> traces a curve of {traced:.1} m, but the geometry's length is {length} m (coefficients in the wrong unit?)",
+                shape.tag_name().name()
+            ),
+        ));
+    }
+    Ok(geometry)
 }
+
+/// Steps of the polyline that checks a geometry record's length ([`Geometry::traced_length`]).
+const TRACE_STEPS: usize = 32;
+/// How much longer than its declared length a record's traced curve may be (plus a metre).
+const MAX_TRACED_RATIO: f64 = 1.5;
 
 fn parse_section(cx: &Ctx, sec: Node, lht: bool) -> Result<RawSection, WorldError> {
     let s = cx.num_or(sec, "s", 0.0)?;
