@@ -217,6 +217,7 @@ mod tests {
         write_atomically(&path, b"profile").expect("writes");
         assert_eq!(drain(reader), b"profile");
         assert!(is_fifo(&path), "the FIFO is still a FIFO");
+        std::fs::remove_dir_all(path.parent().expect("dir")).ok();
 
         let (path, reader) = fifo("pieces");
         let mut file = AtomicFile::create(&path).expect("opens");

@@ -10,8 +10,8 @@ use super::lanes::{F, LANES, V3, exp_lanes, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use super::round::{floor_i32, floor_int};
 use crate::sensors::scene::{
-    CROSSWALK_PAINT, FrameScene, Mark, Material, PATTERN_PLAIN, PATTERN_STRIPES, PieceSurface, Prim, SceneCapsule,
-    StaticScene, body_capsule, body_pattern, crosswalk_across, road_marking, road_paint_near, tag,
+    CROSSWALK_PAINT, FrameScene, HEAD_LONG_HAIR, Mark, Material, PATTERN_PLAIN, PATTERN_STRIPES, PieceSurface, Prim,
+    SceneCapsule, StaticScene, body_capsule, body_pattern, crosswalk_across, road_marking, road_paint_near, tag,
 };
 use crate::util::mix::splitmix64;
 
@@ -359,7 +359,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         Material::Poster => emissive = V3::splat(prim.albedo * (0.8 * l.night)),
         Material::Body | Material::Head => {
             let pattern = body_pattern(prim.aux);
-            if pattern != PATTERN_PLAIN {
+            if prim.material == Material::Body && pattern != PATTERN_PLAIN {
                 let right = Vec3::new(prim.normal.y, -prim.normal.x, 0.0);
                 let m = pattern_share(pattern, p, right, pts.depth_m);
                 albedo = albedo.add(V3::splat(prim.albedo2).sub(albedo).scale(m));
@@ -371,7 +371,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                     // capsule's lower end (`body::silhouette`).
                     let rel = p.sub(V3::splat(c.a));
                     let dir = rel.scale(F::ONE / rel.length_squared().max(F::splat(1.0e-12)).sqrt());
-                    albedo = face(prim, dir, albedo);
+                    albedo = face(prim, dir, albedo, pattern == HEAD_LONG_HAIR);
                 }
                 // Cloth and skin darken towards a body part's outline (folds, self-shadowing, a rough
                 // surface's view dependence): `0.6 + 0.4 (n·v)⁺`, so that a limb shows against a torso of its
@@ -553,11 +553,11 @@ pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
 }
 
 /// A head's colours at unit directions `normal` from its centre: hair on the crown, the temples and the back down
-/// to the nape (`albedo2`), and a face on the skin around the gaze direction (`prim.normal`, level): eyes,
+/// to the nape (`albedo2`; `long_hair`: over the ears and the sides of the head too), and a face on the skin around the gaze direction (`prim.normal`, level): eyes,
 /// eyebrows in the hair's colour and a mouth, placed by the direction's components along the gaze, to the side
 /// and up.
 #[inline(always)]
-fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
+fn face(prim: &Prim, normal: V3, skin: V3, long_hair: bool) -> V3 {
     let fwd = prim.normal;
     let side = Vec3::new(fwd.y, -fwd.x, 0.0).normalize_or_zero();
     let (f, s, u) = (normal.dot_v(fwd), normal.dot_v(side).abs(), normal.z);
@@ -571,6 +571,14 @@ fn face(prim: &Prim, normal: V3, skin: V3) -> V3 {
     let hair = u.simd_gt(F::splat(0.25))
         | (f.simd_lt(F::splat(0.3)) & u.simd_gt(F::splat(0.08)))
         | (f.simd_lt(F::splat(0.05)) & u.simd_gt(F::splat(-0.7)) & !ear);
+    // Long hair falls from the parting over the ears and the sides of the head to below the jaw, so that only the
+    // face's oval shows skin (a three-quarter back view showed a bare cheek and temple beside the hair, which
+    // MediaPipe read as a face turned towards it).
+    let hair = if long_hair {
+        hair | (f.simd_lt(F::splat(0.45)) & u.simd_gt(F::splat(-0.8)))
+    } else {
+        hair
+    };
     let sq = |x: F| x * x;
     let eye = front & (sq(s - F::splat(0.33)) + sq(u - F::splat(0.06)) * F::splat(2.0)).simd_lt(F::splat(0.0081));
     let brow = front
@@ -694,6 +702,55 @@ mod tests {
             "{crosswalk_painted} {lanes_painted}"
         );
         assert!(lanes_painted < 3 * 2 * 400 * LANES / 2, "{lanes_painted}");
+    }
+
+    /// Short hair leaves the ears and cheeks bare; long hair covers the sides of the head down below the jaw and
+    /// leaves the face's oval bare. Both cover the back of the head and neither covers the face.
+    #[test]
+    fn long_hair_covers_the_sides_of_the_head_and_short_hair_leaves_the_ears_bare() {
+        let (hair, skin) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
+        let prim = Prim {
+            material: Material::Head,
+            tag: 0,
+            instance: 1,
+            albedo: skin,
+            albedo2: hair,
+            normal: Vec3::X,
+            aux: 0,
+        };
+        // Is the point of the head in direction `(forward, left, up)` drawn as hair?
+        let is_hair = |d: Vec3, long_hair: bool| {
+            let c = face(&prim, V3::splat(d.normalize()), V3::splat(skin), long_hair);
+            let (r, g) = (c.x.to_array()[0], c.y.to_array()[0]);
+            assert!(
+                (r, g) == (1.0, 0.0) || (r, g) == (0.0, 1.0),
+                "{d}: neither hair nor skin ({r}, {g})"
+            );
+            r == 1.0
+        };
+        let ear = Vec3::new(0.0, 1.0, -0.05);
+        let cheek = Vec3::new(0.3, 0.9, -0.3);
+        let back = Vec3::new(-1.0, 0.1, -0.2);
+        let face_oval = [
+            Vec3::new(1.0, 0.0, -0.1),
+            Vec3::new(0.8, 0.6, 0.0),
+            Vec3::new(0.8, 0.0, -0.6),
+        ];
+        assert!(
+            !is_hair(ear, false) && !is_hair(cheek, false),
+            "short hair: the ear and cheek are skin"
+        );
+        assert!(
+            is_hair(ear, true) && is_hair(cheek, true),
+            "long hair: the ear and cheek are under hair"
+        );
+        for long_hair in [false, true] {
+            assert!(is_hair(back, long_hair), "the back of the head is hair");
+            assert!(is_hair(Vec3::new(0.2, 0.0, 1.0), long_hair), "the crown is hair");
+            for d in face_oval {
+                assert!(!is_hair(d, long_hair), "{d}: the face is skin");
+            }
+        }
     }
 
     /// A striped top shows its second colour in the gaps between stripes, 4.5 cm on and 4.5 cm off along the

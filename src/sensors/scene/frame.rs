@@ -303,7 +303,7 @@ impl FrameScene {
             };
             self.capsules.push(sc);
             let (pattern, albedo2) = match material {
-                Material::Head => (PATTERN_PLAIN, outfit.hair),
+                Material::Head => (outfit.head_style, outfit.hair),
                 _ if patterned => outfit.pattern,
                 _ => (PATTERN_PLAIN, albedo),
             };

@@ -258,8 +258,8 @@ pub enum Material {
     /// Skin or clothing of a body part; `aux` holds the capsule's index in [`FrameScene::capsules`] (smooth
     /// normals) and the cloth's pattern ([`body_aux`]; its second colour is `albedo2`).
     Body,
-    /// A head: skin in front, hair on top and at the back (`albedo2`); `aux` as for [`Material::Body`],
-    /// `normal` is the body's forward axis.
+    /// A head: skin in front, hair on top and at the back (`albedo2`); `aux` as for [`Material::Body`], with how
+    /// the hair falls ([`HEAD_SHORT_HAIR`], [`HEAD_LONG_HAIR`]) in place of a pattern; `normal` is the gaze (level).
     Head,
 }
 
@@ -283,6 +283,12 @@ pub const PATTERN_PLAIN: u32 = 0;
 pub const PATTERN_STRIPES: u32 = 1;
 /// Checks ([`crate::plan::Pattern::Checks`]).
 pub const PATTERN_CHECKS: u32 = 2;
+/// A head's `aux` pattern bits ([`body_aux`]) say how its hair falls: short ([`HEAD_SHORT_HAIR`]: crown, temples
+/// and the back down to the nape, the ears bare; also buns and bald scalps) or long ([`HEAD_LONG_HAIR`]: over the
+/// ears and the sides of the head too, framing the face).
+pub const HEAD_SHORT_HAIR: u32 = 0;
+/// See [`HEAD_SHORT_HAIR`].
+pub const HEAD_LONG_HAIR: u32 = 1;
 
 /// One primitive: everything the shading and the label streams need of a surface.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -108,6 +108,8 @@ pub struct Outfit {
     pub parts: [(Material, Vec3); CAPSULES],
     /// Hair colour, linear RGB.
     pub hair: Vec3,
+    /// How the hair falls about the face ([`HEAD_SHORT_HAIR`] or [`HEAD_LONG_HAIR`]).
+    pub head_style: u32,
     /// The umbrella's canopy colour, linear RGB (none: no umbrella).
     pub umbrella: Option<Vec3>,
     /// The cloth pattern ([`body_aux`]'s code) and its second colour (linear RGB), and which capsules wear it
@@ -164,6 +166,11 @@ impl Outfit {
             }),
             // A bald head shows its scalp where hair would be.
             hair: if figure.hair == HairStyle::Bald { skin } else { hair },
+            head_style: if figure.hair == HairStyle::Long {
+                HEAD_LONG_HAIR
+            } else {
+                HEAD_SHORT_HAIR
+            },
             umbrella: figure.umbrella.map(linear),
             pattern: match figure.pattern {
                 Some((Pattern::Stripes, c)) => (PATTERN_STRIPES, linear(c)),
