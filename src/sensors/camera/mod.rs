@@ -29,6 +29,7 @@ pub mod band;
 mod cull;
 pub mod dvs;
 pub mod expose;
+mod figure;
 pub mod group;
 pub mod lanes;
 mod lens;

@@ -6,12 +6,13 @@
 use glam::{Vec2, Vec3};
 use std::ops::{Add, Mul, Sub};
 
+use super::figure::{capsule_normals, face, pattern_share};
 use super::lanes::{F, LANES, V3, exp_lanes, lanes_from, transpose_cells};
 use super::light::{HEADLAMP_INTENSITY, LAMP_INTENSITY, Lighting};
 use super::round::{floor_i32, floor_int};
 use crate::sensors::scene::{
-    CROSSWALK_PAINT, FrameScene, HEAD_LONG_HAIR, Mark, Material, PATTERN_PLAIN, PATTERN_STRIPES, PieceSurface, Prim,
-    SceneCapsule, StaticScene, body_capsule, body_pattern, crosswalk_across, road_marking, road_paint_near, tag,
+    CROSSWALK_PAINT, FrameScene, HEAD_LONG_HAIR, Mark, Material, PATTERN_PLAIN, PieceSurface, Prim, StaticScene,
+    body_capsule, body_pattern, crosswalk_across, road_marking, road_paint_near, tag,
 };
 use crate::util::mix::splitmix64;
 
@@ -137,35 +138,6 @@ pub struct Points {
     pub shadow: F,
     /// The points' depths along the optical axis, metres.
     pub depth_m: F,
-}
-
-/// Period of a striped top, metres (stripes 4.5 cm wide).
-const STRIPE_PERIOD_M: f32 = 0.09;
-/// Period of a checked top, metres.
-const CHECK_PERIOD_M: f32 = 0.08;
-
-/// How much of the second colour a patterned cloth shows at the lanes' points (0–1): soft-edged stripes of half
-/// the period along the height (and across the body, `right` the body's right, for checks), faded to their mean
-/// (0.5) from 10 m to 22 m deep, where a period spans under three pixels of a 1280-pixel-wide 90° camera and
-/// would alias (labels never see it).
-#[inline(always)]
-fn pattern_share(pattern: u32, p: V3, right: Vec3, depth_m: F) -> F {
-    let band = |q: F, period: f32| {
-        let t = q * (1.0 / period);
-        let f = t - floor_int(t).round_float();
-        // A triangle wave (0 at the stripe's middle, 1 at the gap's), edges soft over a sixth of the period.
-        let tri = (f * 2.0 - F::ONE).abs();
-        (tri * 3.0 - F::ONE).max(F::ZERO).min(F::ONE)
-    };
-    let m = match pattern {
-        PATTERN_STRIPES => band(p.z, STRIPE_PERIOD_M),
-        _ => {
-            let across = p.x * right.x + p.y * right.y;
-            (band(p.z, CHECK_PERIOD_M) + band(across, CHECK_PERIOD_M)) * 0.5
-        }
-    };
-    let fade = ((F::splat(22.0) - depth_m) * (1.0 / 12.0)).max(F::ZERO).min(F::ONE);
-    F::splat(0.5) + (m - F::splat(0.5)) * fade
 }
 
 /// A noise value per lane, scaled: `1 + amp × noise(q)`.
@@ -533,66 +505,11 @@ fn lane_max(v: F) -> f32 {
     v.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max)
 }
 
-/// The outward unit normals of a body capsule at the lanes' surface points (`+z` where a point is on the axis).
-#[inline(always)]
-fn capsule_normals(c: &SceneCapsule, p: V3) -> V3 {
-    let d = c.b - c.a;
-    let rel = p.sub(V3::splat(c.a));
-    let t = (rel.dot_v(d) / d.length_squared().max(1e-12)).max(F::ZERO).min(F::ONE);
-    let off = rel.sub(V3::splat(d).scale(t));
-    let len2 = off.length_squared();
-    let ok = len2.simd_gt(F::ZERO) & len2.is_finite();
-    V3::select(ok, off.scale(F::ONE / len2.sqrt()), V3::splat(Vec3::Z))
-}
-
 /// Applies fog over the lanes' distances.
 #[inline(always)]
 pub fn fog(light: &Lighting, colour: V3, dist_m: F) -> V3 {
     let f = exp_lanes(F::splat(-light.fog_per_m) * dist_m);
     colour.scale(f).add(V3::splat(light.fog).scale(F::ONE - f))
-}
-
-/// A head's colours at unit directions `normal` from its centre: hair on the crown, the temples and the back down
-/// to the nape (`albedo2`; `long_hair`: over the ears and the sides of the head too), and a face on the skin around the gaze direction (`prim.normal`, level): eyes,
-/// eyebrows in the hair's colour and a mouth, placed by the direction's components along the gaze, to the side
-/// and up.
-#[inline(always)]
-fn face(prim: &Prim, normal: V3, skin: V3, long_hair: bool) -> V3 {
-    let fwd = prim.normal;
-    let side = Vec3::new(fwd.y, -fwd.x, 0.0).normalize_or_zero();
-    let (f, s, u) = (normal.dot_v(fwd), normal.dot_v(side).abs(), normal.z);
-    let front = f.simd_gt(F::splat(0.55));
-    // Hair as a head of short hair wears it: the crown, the temples down to above the ears, and the whole back
-    // half of the head down to the nape, the ears left bare, so that a head seen from behind or three-quarters
-    // behind reads as hair, not as a face (MediaPipe took people seen from behind for people facing it when the
-    // sides of the back of the head were skin).
-    let ear =
-        s.simd_gt(F::splat(0.88)) & (u + F::splat(0.05)).abs().simd_lt(F::splat(0.15)) & f.simd_gt(F::splat(-0.05));
-    let hair = u.simd_gt(F::splat(0.25))
-        | (f.simd_lt(F::splat(0.3)) & u.simd_gt(F::splat(0.08)))
-        | (f.simd_lt(F::splat(0.05)) & u.simd_gt(F::splat(-0.7)) & !ear);
-    // Long hair falls from the parting over the ears and the sides of the head to below the jaw, so that only the
-    // face's oval shows skin (a three-quarter back view showed a bare cheek and temple beside the hair, which
-    // MediaPipe read as a face turned towards it).
-    let hair = if long_hair {
-        hair | (f.simd_lt(F::splat(0.45)) & u.simd_gt(F::splat(-0.8)))
-    } else {
-        hair
-    };
-    let sq = |x: F| x * x;
-    let eye = front & (sq(s - F::splat(0.33)) + sq(u - F::splat(0.06)) * F::splat(2.0)).simd_lt(F::splat(0.0081));
-    let brow = front
-        & (s - F::splat(0.33)).abs().simd_lt(F::splat(0.14))
-        & (u - F::splat(0.19)).abs().simd_lt(F::splat(0.035));
-    let mouth = front & s.simd_lt(F::splat(0.17)) & (u + F::splat(0.5)).abs().simd_lt(F::splat(0.045));
-    let mut colour = V3::select(hair | brow, V3::splat(prim.albedo2), skin);
-    colour = V3::select(eye, V3::splat(Vec3::new(0.02, 0.02, 0.025)), colour);
-    let lips = V3 {
-        x: skin.x * 0.45,
-        y: skin.y * 0.25,
-        z: skin.z * 0.25,
-    };
-    V3::select(mouth, lips, colour)
 }
 
 #[cfg(test)]
@@ -702,97 +619,5 @@ mod tests {
             "{crosswalk_painted} {lanes_painted}"
         );
         assert!(lanes_painted < 3 * 2 * 400 * LANES / 2, "{lanes_painted}");
-    }
-
-    /// Short hair leaves the ears and cheeks bare; long hair covers the sides of the head down below the jaw and
-    /// leaves the face's oval bare. Both cover the back of the head and neither covers the face.
-    #[test]
-    fn long_hair_covers_the_sides_of_the_head_and_short_hair_leaves_the_ears_bare() {
-        let (hair, skin) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
-        let prim = Prim {
-            material: Material::Head,
-            tag: 0,
-            instance: 1,
-            albedo: skin,
-            albedo2: hair,
-            normal: Vec3::X,
-            aux: 0,
-        };
-        // Is the point of the head in direction `(forward, left, up)` drawn as hair?
-        let is_hair = |d: Vec3, long_hair: bool| {
-            let c = face(&prim, V3::splat(d.normalize()), V3::splat(skin), long_hair);
-            let (r, g) = (c.x.to_array()[0], c.y.to_array()[0]);
-            assert!(
-                (r, g) == (1.0, 0.0) || (r, g) == (0.0, 1.0),
-                "{d}: neither hair nor skin ({r}, {g})"
-            );
-            r == 1.0
-        };
-        let ear = Vec3::new(0.0, 1.0, -0.05);
-        let cheek = Vec3::new(0.3, 0.9, -0.3);
-        let back = Vec3::new(-1.0, 0.1, -0.2);
-        let face_oval = [
-            Vec3::new(1.0, 0.0, -0.1),
-            Vec3::new(0.8, 0.6, 0.0),
-            Vec3::new(0.8, 0.0, -0.6),
-        ];
-        assert!(
-            !is_hair(ear, false) && !is_hair(cheek, false),
-            "short hair: the ear and cheek are skin"
-        );
-        assert!(
-            is_hair(ear, true) && is_hair(cheek, true),
-            "long hair: the ear and cheek are under hair"
-        );
-        for long_hair in [false, true] {
-            assert!(is_hair(back, long_hair), "the back of the head is hair");
-            assert!(is_hair(Vec3::new(0.2, 0.0, 1.0), long_hair), "the crown is hair");
-            for d in face_oval {
-                assert!(!is_hair(d, long_hair), "{d}: the face is skin");
-            }
-        }
-    }
-
-    /// A striped top shows its second colour in the gaps between stripes, 4.5 cm on and 4.5 cm off along the
-    /// height; checks mix both directions; beyond 22 m deep both are their mean (no aliasing), and between 10
-    /// and 22 m they fade towards it.
-    #[test]
-    fn cloth_patterns_alternate_with_their_period_and_fade_with_depth() {
-        use crate::sensors::scene::PATTERN_CHECKS;
-        let at = |pattern: u32, x: f32, z: f32, depth_m: f32| {
-            let p = V3::splat(Vec3::new(x, 0.0, z));
-            pattern_share(pattern, p, Vec3::X, F::splat(depth_m)).to_array()[0]
-        };
-        let period = STRIPE_PERIOD_M;
-        // 0 at a stripe's middle (f = 0.5), 1 in the middle of the gap (f = 0), at every period.
-        for k in 10..20 {
-            let z = k as f32 * period;
-            assert!(at(PATTERN_STRIPES, 0.0, z + 0.5 * period, 3.0) < 1e-4, "stripe at {z}");
-            assert!(at(PATTERN_STRIPES, 0.0, z + 0.01 * period, 3.0) > 0.9, "gap at {z}");
-            assert!(
-                (at(PATTERN_STRIPES, 0.0, z + 0.5 * period, 16.0) - 0.25).abs() < 1e-3,
-                "half faded"
-            );
-            assert!((at(PATTERN_STRIPES, 0.0, z, 30.0) - 0.5).abs() < 1e-6, "faded at 30 m");
-        }
-        // Stripes do not change across the body; checks do.
-        let z = 1.2 + 0.5 * CHECK_PERIOD_M;
-        assert_eq!(
-            at(PATTERN_STRIPES, 0.0, 12.0 * period, 3.0),
-            at(PATTERN_STRIPES, 0.37, 12.0 * period, 3.0)
-        );
-        let across: Vec<f32> = (0..8)
-            .map(|i| at(PATTERN_CHECKS, i as f32 * 0.25 * CHECK_PERIOD_M, z, 3.0))
-            .collect();
-        assert!(
-            across.iter().any(|&m| m < 0.05) && across.iter().any(|&m| m > 0.45),
-            "{across:?}"
-        );
-        // The mean over a period is one half.
-        let mean = (0..900)
-            .map(|i| at(PATTERN_STRIPES, 0.0, i as f32 * period / 900.0 + 1.0, 3.0))
-            .sum::<f32>()
-            / 900.0;
-        assert!((mean - 0.5).abs() < 0.01, "{mean}");
     }
 }
