@@ -310,9 +310,13 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
         let k = span_keys8(k_row, kx, x0, step, start);
         let old_k = F::new(*kk);
         let nearer = k.simd_gt(old_k);
-        *kk = nearer.select(k, old_k).to_array();
+        // `fast_max` is `vmaxps(k, old)`: `k` where it is greater, else the old key, NaN and signed zeros
+        // included, so the same bits as the selection. Written as a selection of the loaded values, both
+        // stores became masked stores (`vmaskmovps`), which are microcoded and slow on AMD's cores; the
+        // primitives' blend goes through `black_box` so that it stays a blend and a plain store.
+        *kk = k.fast_max(old_k).to_array();
         let old_p: F = bytemuck::cast(*pp);
-        *pp = bytemuck::cast(nearer.select(prim_lanes, old_p));
+        *pp = bytemuck::cast(std::hint::black_box(nearer.select(prim_lanes, old_p)));
     }
     let mut i = eights;
     if i + 4 <= n {
@@ -357,7 +361,8 @@ fn depth_test_span_keys(keys: &mut [f32], k_row: f32, kx: f32, x0: f32) {
         };
         let k = span_keys8(k_row, kx, x0, 1.0, start);
         let old_k = F::new(*kk);
-        *kk = k.simd_gt(old_k).select(k, old_k).to_array();
+        // The selection's bits without a masked store (see `depth_test_span`).
+        *kk = k.fast_max(old_k).to_array();
     }
     let mut i = eights;
     if i + 4 <= n {
