@@ -388,11 +388,13 @@ pub fn pose(frame: &PedFrame, height_m: f64, figure: &Figure, offset_body: DVec3
     };
     let (l_shoulder, mut l_elbow, mut l_wrist) = arm(1.0, -0.8 * theta);
     // An umbrella: the left arm holds it still (no swing), the upper arm hanging a little forward, the forearm
-    // raised forward and across to a grip in front of the chest; the shaft leans back from the grip to a top
-    // above and just ahead of the head's centre, so the canopy's rim clears the head.
+    // raised about 45° forward and across to a grip at chest height some 20 cm ahead of the chest, so that the
+    // bent arm shows beside the body seen from the side (a forearm raised steeply put the grip against the chest,
+    // where a side view hid the arm; MediaPipe then found the holder in fewer crops); the shaft leans back from
+    // the grip to a top above and just ahead of the head's centre, so the canopy's rim clears the head.
     let umbrella = figure.umbrella.map(|_| {
         l_elbow = l_shoulder + DVec3::new(0.15, 0.1, -1.0).normalize() * upper;
-        let fore_dir = DVec3::new(0.45, -0.35, 0.8).normalize();
+        let fore_dir = DVec3::new(0.65, -0.35, 0.65).normalize();
         l_wrist = l_elbow + fore_dir * fore;
         let grip = l_wrist + fore_dir * (HAND_LENGTH * h);
         (grip, DVec3::new(0.07 * h, 0.3 * grip.y, h + 0.33))
