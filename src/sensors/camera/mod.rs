@@ -326,15 +326,15 @@ mod tests {
     fn the_row_tone_map_equals_the_per_value_formula() {
         let lut = build_lut(1.0);
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        // Every row length up to 13 (whole quads and a rest), values below 0, in range and beyond LUT_MAX.
-        for n in 0..=13 {
+        // Every row length up to 20 (whole vectors and a rest), values below 0, in range and beyond LUT_MAX.
+        for n in 0..=20 {
             let mut value = |i: usize| match i % 4 {
                 0 => rng.random_range(-1.0..0.0),
                 1 => rng.random_range(0.0..0.01),
                 2 => rng.random_range(0.0..LUT_MAX),
                 _ => rng.random_range(LUT_MAX..20.0),
             };
-            let rgb: [Vec<f32>; 3] = std::array::from_fn(|c| (0..n + 3).map(|i| value(i + c)).collect());
+            let rgb: [Vec<f32>; 3] = std::array::from_fn(|c| (0..n + LANES - 1).map(|i| value(i + c)).collect());
             let mut out = vec![0u8; n * 3];
             tone_map(&rgb, [&lut, &lut, &lut], &mut out);
             let expected: Vec<u8> = (0..n * 3)

@@ -1,4 +1,4 @@
-//! Post-processing of a band's colours: tone mapping to sRGB four pixels at a time (through a lookup table of
+//! Post-processing of a band's colours: tone mapping to sRGB eight pixels at a time (through a lookup table of
 //! the sRGB curve), and rain streaks placed once per frame and drawn band by band.
 
 use super::*;
@@ -38,37 +38,35 @@ pub(super) fn shoulder_inverse(mapped: f64) -> f64 {
     -(1.0 - mapped).ln() / 1.1
 }
 
-/// Maps a row of linear colours (one slice per channel, at least as long as the row) to interleaved sRGB
-/// bytes through each channel's lookup table: `LUT[sqrt(x / LUT_MAX) × (LUT_LEN − 1)]`, four pixels at a time (`wide`:
-/// SSE square roots, correctly rounded, and truncations, so the same values as one at a time).
+/// Maps a row of linear colours (one slice per channel, at least `LANES − 1` longer than the row, rounded up to
+/// whole vectors) to interleaved sRGB bytes through each channel's lookup table: `LUT[sqrt(x / LUT_MAX) ×
+/// (LUT_LEN − 1)]`, `LANES` pixels at a time (`wide`: square roots correctly rounded, and truncations, so the same
+/// values as one at a time; eight lanes took 5 % less of a clear-noon frame than four).
 pub(super) fn tone_map(rgb: &[Vec<f32>; 3], luts: [&[u8; LUT_LEN]; 3], out: &mut [u8]) {
     #[inline(always)]
-    fn index(v: f32x4) -> [usize; 4] {
-        let s = (v.max(f32x4::ZERO) * (1.0 / LUT_MAX)).min(f32x4::ONE).sqrt();
-        // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds check.
-        let i = (s * (LUT_LEN - 1) as f32).fast_trunc_int().to_array();
-        let m = LUT_LEN - 1;
-        // Spelled out: `array::map` is not always inlined here.
-        [
-            i[0] as usize & m,
-            i[1] as usize & m,
-            i[2] as usize & m,
-            i[3] as usize & m,
-        ]
+    fn index(v: F) -> [i32; LANES] {
+        let s = (v.max(F::ZERO) * (1.0 / LUT_MAX)).min(F::ONE).sqrt();
+        (s * (LUT_LEN - 1) as f32).fast_trunc_int().to_array()
     }
     let w = out.len() / 3;
-    let [r, g, b] = rgb.each_ref().map(|c| &c[..w.div_ceil(4) * 4]);
+    let [r, g, b] = rgb.each_ref().map(|c| &c[..w.div_ceil(LANES) * LANES]);
+    // `s ≤ 1`: the mask changes no index and lets the compiler drop the bounds checks.
+    let m = LUT_LEN - 1;
     for (((px, r), g), b) in out
-        .chunks_mut(12)
-        .zip(r.chunks_exact(4))
-        .zip(g.chunks_exact(4))
-        .zip(b.chunks_exact(4))
+        .chunks_mut(3 * LANES)
+        .zip(r.chunks_exact(LANES))
+        .zip(g.chunks_exact(LANES))
+        .zip(b.chunks_exact(LANES))
     {
-        let load = |c: &[f32]| index(f32x4::new([c[0], c[1], c[2], c[3]]));
+        let load = |c: &[f32]| index(lanes_from(|i| c[i]));
         let (r, g, b) = (load(r), load(g), load(b));
-        for (i, o) in px.chunks_exact_mut(3).enumerate() {
-            o.copy_from_slice(&[luts[0][r[i]], luts[1][g[i]], luts[2][b[i]]]);
+        let mut bytes = [0u8; 3 * LANES];
+        for (i, o) in bytes.chunks_exact_mut(3).enumerate() {
+            o[0] = luts[0][r[i] as usize & m];
+            o[1] = luts[1][g[i] as usize & m];
+            o[2] = luts[2][b[i] as usize & m];
         }
+        px.copy_from_slice(&bytes[..px.len()]);
     }
 }
 
