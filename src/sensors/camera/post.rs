@@ -41,7 +41,7 @@ pub(super) fn shoulder_inverse(mapped: f64) -> f64 {
 /// Maps a row of linear colours (one slice per channel, at least `LANES − 1` longer than the row, rounded up to
 /// whole vectors) to interleaved sRGB bytes through each channel's lookup table: `LUT[sqrt(x / LUT_MAX) ×
 /// (LUT_LEN − 1)]`, `LANES` pixels at a time (`wide`: square roots correctly rounded, and truncations, so the same
-/// values as one at a time; eight lanes took 5 % less of a clear-noon frame than four).
+/// values as one at a time; at eight lanes 5.2 % of a clear-noon frame's perf samples, at four 9.3 %).
 pub(super) fn tone_map(rgb: &[Vec<f32>; 3], luts: [&[u8; LUT_LEN]; 3], out: &mut [u8]) {
     #[inline(always)]
     fn index(v: F) -> [i32; LANES] {
