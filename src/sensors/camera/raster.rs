@@ -311,12 +311,12 @@ fn depth_test_span(keys: &mut [f32], prims: &mut [u32], k_row: f32, kx: f32, x0:
         let old_k = F::new(*kk);
         let nearer = k.simd_gt(old_k);
         // `fast_max` is `vmaxps(k, old)`: `k` where it is greater, else the old key, NaN and signed zeros
-        // included, so the same bits as the selection. Written as a selection of the loaded values, both
-        // stores became masked stores (`vmaskmovps`), which are microcoded and slow on AMD's cores; the
-        // primitives' blend goes through `black_box` so that it stays a blend and a plain store.
+        // included, so the same bits as the selection; the primitives merge bitwise under the mask (the same
+        // bits as a selection too). Written as selections of the loaded values, both stores became masked
+        // stores (`vmaskmovps`), which are microcoded and slow on AMD's cores (a tenth of a clear-noon frame).
         *kk = k.fast_max(old_k).to_array();
         let old_p: F = bytemuck::cast(*pp);
-        *pp = bytemuck::cast(std::hint::black_box(nearer.select(prim_lanes, old_p)));
+        *pp = bytemuck::cast(old_p ^ ((old_p ^ prim_lanes) & nearer));
     }
     let mut i = eights;
     if i + 4 <= n {
