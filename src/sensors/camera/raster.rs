@@ -467,11 +467,21 @@ mod tests {
 
     #[test]
     fn the_simd_depth_test_equals_the_scalar_one() {
-        // Spans of every length 0..=29 (eights, a four, single samples) over keys with ties, NaN-pattern ids
-        // (EMPTY) and sloped keys, at every sample and every other one.
+        // Spans of every length 0..=29 (eights, a four, single samples) over keys with ties (signed zeros
+        // included), NaN keys old and new, NaN-pattern ids (EMPTY) and sloped keys, at every sample and every
+        // other one: the vector path's maximum must keep the scalar test's bits.
         for (n, step) in (0..=29usize).flat_map(|n| [(n, 1.0f32), (n, 2.0)]) {
-            for (k_row, kx) in [(0.5f32, 0.0f32), (0.2, 0.05), (0.9, -0.07), (0.45, 1.0e-3)] {
-                let keys: Vec<f32> = (0..n).map(|i| [0.0, 0.5, 0.3, 0.7, 0.45][i % 5]).collect();
+            for (k_row, kx) in [
+                (0.5f32, 0.0f32),
+                (0.2, 0.05),
+                (0.9, -0.07),
+                (0.45, 1.0e-3),
+                (0.0, 0.0),
+                (f32::NAN, 0.0),
+            ] {
+                let keys: Vec<f32> = (0..n)
+                    .map(|i| [0.0, 0.5, 0.3, 0.7, 0.45, -0.0, f32::NAN][i % 7])
+                    .collect();
                 let prims: Vec<u32> = (0..n).map(|i| if i % 3 == 0 { EMPTY } else { i as u32 * 7 }).collect();
                 let (mut k1, mut p1) = (keys.clone(), prims.clone());
                 depth_test_span(&mut k1, &mut p1, k_row, kx, 3.0, step, 42);
