@@ -18,6 +18,7 @@
 mod car;
 mod frame;
 mod furniture;
+mod outfit;
 mod paint;
 mod parked;
 mod recolour;
@@ -39,6 +40,7 @@ use crate::world::{CURB_HEIGHT_M, LaneType, ObstacleKind, RoadNetwork, TravelDir
 pub use car::*;
 pub use frame::*;
 pub use furniture::*;
+pub use outfit::*;
 pub use paint::*;
 pub use parked::*;
 pub use recolour::*;

@@ -1,12 +1,9 @@
 //! The static part of a clip's scene ([`StaticScene`]), built once per clip: the lane pieces near the ego's path
 //! in culling clusters (roads at their elevation, sidewalks raised by the curb, curb faces), a terrain plane,
 //! buildings, trees, poles, street lamps (synthesised along sidewalks) and traffic lights, each pedestrian's
-//! [`Outfit`] and each car's paint.
+//! [`Outfit`] ([`Outfit::of`]) and each car's paint.
 
 use super::*;
-
-/// The share of a flat surface's albedo that hair of the same colour reflects (strands self-shadow).
-const HAIR_ALBEDO_SCALE: f32 = 0.6;
 
 /// A spatially coherent run of static triangles with its bounding sphere, for culling.
 #[derive(Clone, Debug, PartialEq)]
@@ -99,94 +96,6 @@ pub struct StaticScene {
     pub car_paint: Vec<Vec3>,
     /// Factor on the procedural textures' contrast (the clip's `look`; 1 without domain randomisation).
     pub texture_contrast: f32,
-}
-
-/// What a body wears: the material and colour of each capsule (see [`body::pose`]'s order), and its hair.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Outfit {
-    /// Per capsule: shading model and linear colour.
-    pub parts: [(Material, Vec3); CAPSULES],
-    /// Hair colour, linear RGB.
-    pub hair: Vec3,
-    /// How the hair falls about the face ([`HEAD_SHORT_HAIR`] or [`HEAD_LONG_HAIR`]).
-    pub head_style: u32,
-    /// The umbrella's canopy colour, linear RGB (none: no umbrella).
-    pub umbrella: Option<Vec3>,
-    /// The cloth pattern ([`body_aux`]'s code) and its second colour (linear RGB), and which capsules wear it
-    /// (the torso and shoulders, a dress or coat).
-    pub pattern: (u32, Vec3),
-    pub patterned: [bool; CAPSULES],
-}
-
-impl Outfit {
-    /// The outfit of an identity; `key` seeds sleeve and leg length.
-    pub fn of(identity: &Identity, seed: u64, key: u64) -> Outfit {
-        let h = splitmix64(seed ^ 0xb0d1 ^ splitmix64(key));
-        let figure = &identity.figure;
-        let coat = figure.garment == Garment::Coat;
-        let short_sleeves = h & 3 == 0 && !coat;
-        // Under a skirt or a dress: bare legs or dark tights, as often as shorts under trousers are rare.
-        let bare_legs = match figure.garment {
-            Garment::Skirt | Garment::Dress => (h >> 2) & 1 == 0,
-            Garment::Trousers => (h >> 2) & 7 == 0,
-            Garment::Coat => false,
-        };
-        let (skin, top, bottom) = (
-            linear(identity.skin_rgb),
-            linear(identity.top_rgb),
-            linear(identity.bottom_rgb),
-        );
-        let tights = linear([28, 26, 30]);
-        let shoes = linear(identity.shoes_rgb);
-        // Hair shades darker than a flat surface of its colour: light enters between the strands and is absorbed
-        // there (a head of dark hair seen from behind reads as nearly black in a photo).
-        let hair = linear(identity.hair_rgb) * HAIR_ALBEDO_SCALE;
-        let accessory = |c: Option<[u8; 3]>| linear(c.unwrap_or([60, 60, 60]));
-        // A dress is one garment in the top's colour; a skirt is the bottom's.
-        let skirt = if figure.garment == Garment::Skirt { bottom } else { top };
-        Outfit {
-            parts: WEAR.map(|w| match w {
-                Wear::Top => (Material::Body, top),
-                Wear::Bottom => (Material::Body, bottom),
-                Wear::Skin => (Material::Body, skin),
-                Wear::Shoes => (Material::Body, shoes),
-                Wear::Head => (Material::Head, skin),
-                Wear::Sleeve if short_sleeves => (Material::Body, skin),
-                Wear::Sleeve => (Material::Body, top),
-                Wear::Leg if bare_legs => (Material::Body, skin),
-                Wear::Leg if figure.garment != Garment::Trousers && figure.garment != Garment::Coat => {
-                    (Material::Body, tights)
-                }
-                Wear::Leg => (Material::Body, bottom),
-                Wear::Hair => (Material::Body, hair),
-                Wear::Headwear if figure.hood => (Material::Body, top),
-                Wear::Headwear => (Material::Body, accessory(figure.headwear)),
-                Wear::Carry => (Material::Body, accessory(figure.carry.map(|c| c.1))),
-                Wear::Garment => (Material::Body, skirt),
-            }),
-            // A bald head shows its scalp where hair would be.
-            hair: if figure.hair == HairStyle::Bald { skin } else { hair },
-            head_style: if figure.hair == HairStyle::Long {
-                HEAD_LONG_HAIR
-            } else {
-                HEAD_SHORT_HAIR
-            },
-            umbrella: figure.umbrella.map(linear),
-            pattern: match figure.pattern {
-                Some((Pattern::Stripes, c)) => (PATTERN_STRIPES, linear(c)),
-                Some((Pattern::Checks, c)) => (PATTERN_CHECKS, linear(c)),
-                None => (PATTERN_PLAIN, top),
-            },
-            // The torso and shoulders (capsules 0, 1 and 17) and a dress or coat; the arms stay plain in the top's
-            // colour: stripes running on from the torso across the arms hid their outline (MediaPipe found people
-            // in striped tops on arms and torso in 75 % of crops against 97 % when plain).
-            patterned: std::array::from_fn(|i| match WEAR[i] {
-                Wear::Top => matches!(i, 0 | 1 | 17),
-                Wear::Garment => matches!(figure.garment, Garment::Dress | Garment::Coat),
-                _ => false,
-            }),
-        }
-    }
 }
 
 /// An sRGB colour (0–255) in linear RGB.
