@@ -265,9 +265,9 @@ pub(crate) fn silhouette(
     let ((l_waist, l_chest), (r_waist, r_chest)) = (torso_half(1.0), torso_half(-1.0));
     let skull_axis = head_rot * DVec3::Z * (SKULL_LENGTH * head_s * h);
     let hair = match figure.hair {
-        // Long hair falls from the crown down the back of the head onto the shoulder blades, narrower than the
-        // skull, so that a head seen from behind keeps its round outline above the hair.
-        HairStyle::Long => cap(in_head(-0.018, 0.015), in_head(-0.035, -0.105), 0.04 * head_s),
+        // Long hair falls from the crown down the back of the head onto the shoulder blades, as wide as the skull
+        // (narrower, MediaPipe took more long-haired people seen from behind for people facing it).
+        HairStyle::Long => cap(in_head(-0.018, 0.015), in_head(-0.035, -0.105), HEAD_RADIUS * head_s),
         HairStyle::Bun => cap(in_head(-0.062, 0.03), in_head(-0.062, 0.03), 0.026 * head_s),
         HairStyle::Short | HairStyle::Bald => Capsule::ABSENT,
     };
