@@ -25,7 +25,7 @@ pub(super) fn pattern_share(pattern: u32, p: V3, right: Vec3, depth_m: F) -> F {
         let f = t - floor_int(t).round_float();
         // A triangle wave (0 at the stripe's middle, 1 at the gap's), edges soft over a sixth of the period.
         let tri = (f * 2.0 - F::ONE).abs();
-        (tri * 3.0 - F::ONE).max(F::ZERO).min(F::ONE)
+        (tri * 3.0 - F::ONE).fast_max(F::ZERO).fast_min(F::ONE)
     };
     let m = match pattern {
         PATTERN_STRIPES => band(p.z, STRIPE_PERIOD_M),
@@ -34,7 +34,9 @@ pub(super) fn pattern_share(pattern: u32, p: V3, right: Vec3, depth_m: F) -> F {
             (band(p.z, CHECK_PERIOD_M) + band(across, CHECK_PERIOD_M)) * 0.5
         }
     };
-    let fade = ((F::splat(22.0) - depth_m) * (1.0 / 12.0)).max(F::ZERO).min(F::ONE);
+    let fade = ((F::splat(22.0) - depth_m) * (1.0 / 12.0))
+        .fast_max(F::ZERO)
+        .fast_min(F::ONE);
     F::splat(0.5) + (m - F::splat(0.5)) * fade
 }
 
@@ -43,7 +45,9 @@ pub(super) fn pattern_share(pattern: u32, p: V3, right: Vec3, depth_m: F) -> F {
 pub(super) fn capsule_normals(c: &SceneCapsule, p: V3) -> V3 {
     let d = c.b - c.a;
     let rel = p.sub(V3::splat(c.a));
-    let t = (rel.dot_v(d) / d.length_squared().max(1e-12)).max(F::ZERO).min(F::ONE);
+    let t = (rel.dot_v(d) / d.length_squared().max(1e-12))
+        .fast_max(F::ZERO)
+        .fast_min(F::ONE);
     let off = rel.sub(V3::splat(d).scale(t));
     let len2 = off.length_squared();
     let ok = len2.simd_gt(F::ZERO) & len2.is_finite();

@@ -2,7 +2,9 @@
 //! libm, an exponential. Built on `wide::f32x8`: one AVX register in the x86-64 build (`.cargo/config.toml`
 //! enables AVX2), two SSE2 registers in a build for any x86-64 CPU. Every operation is plain IEEE single
 //! precision without fused multiply-adds, so the same inputs give the same bits on every machine and in both
-//! builds, and each lane equals the scalar formula it replaces (tests below).
+//! builds, and each lane equals the scalar formula it replaces (tests below). Clamps against a constant use
+//! `fast_max` / `fast_min` (one `vmaxps` / `vminps`): with a bound that is not NaN they give the same bits as
+//! `max` / `min`, which add a NaN test of the bound and a blend (a test below).
 
 use glam::Vec3;
 
@@ -192,7 +194,7 @@ impl std::ops::Mul for V3 {
 /// `e^x` per lane (Cephes' `expf` polynomial, relative error below 2·10⁻⁷), `x` clamped to [−87.3, 88.3].
 #[inline(always)]
 pub fn exp_lanes(x: F) -> F {
-    let x = x.max(F::splat(-87.3)).min(F::splat(88.3));
+    let x = x.fast_max(F::splat(-87.3)).fast_min(F::splat(88.3));
     let n = (x * std::f32::consts::LOG2_E).fast_round_int();
     let nf = n.round_float();
     let r = x - nf * 0.693_359_4 - nf * -2.121_944_4e-4;
@@ -219,6 +221,26 @@ mod tests {
             let want = f64::from(x).exp();
             let rel = ((f64::from(got) - want) / want).abs();
             prop_assert!(rel < 4.0e-7, "exp({}) = {} against {} ({:e})", x, got, want, rel);
+        }
+    }
+
+    #[test]
+    fn clamps_against_a_constant_are_the_same_bits_fast_or_not() {
+        let x = F::new([
+            f32::NAN,
+            -0.0,
+            0.0,
+            -1.0e-30,
+            1.0e-30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.5,
+        ]);
+        for bound in [0.0, -0.0, 1.0, -87.3, 1.0e-12, f32::INFINITY] {
+            let b = F::splat(bound);
+            let bits = |v: F| v.to_array().map(f32::to_bits);
+            assert_eq!(bits(x.fast_max(b)), bits(x.max(b)), "max against {bound}");
+            assert_eq!(bits(x.fast_min(b)), bits(x.min(b)), "min against {bound}");
         }
     }
 

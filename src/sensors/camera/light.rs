@@ -119,12 +119,12 @@ impl Lighting {
     /// The sky's colour in the lanes' view directions (unit, world frame), the sun's disc included.
     #[inline(always)]
     pub fn sky(&self, dir: V3) -> V3 {
-        let up = dir.z.max(F::ZERO);
+        let up = dir.z.fast_max(F::ZERO);
         let mut c = V3::lerp(self.horizon, self.zenith, horizon_to_zenith(up));
         let cos_sun = dir.dot_v(self.sun_dir);
         let glowing = cos_sun.simd_gt(F::splat(0.9));
         if glowing.any() {
-            let g = ((cos_sun - 0.9) / 0.1).max(F::ZERO);
+            let g = ((cos_sun - 0.9) / 0.1).fast_max(F::ZERO);
             let g2 = g * g;
             let g4 = g2 * g2;
             let disc = cos_sun.simd_gt(F::splat(0.9996)).select(F::splat(4.0), F::ZERO);
@@ -133,7 +133,7 @@ impl Lighting {
         }
         let below = dir.z.simd_lt(F::ZERO);
         if below.any() {
-            let s = below.select((-dir.z * 4.0).min(F::ONE), F::ZERO);
+            let s = below.select((-dir.z * 4.0).fast_min(F::ONE), F::ZERO);
             c = c.scale(F::ONE - s).add(V3::splat(self.ground_ambient).scale(s));
         }
         c
@@ -153,7 +153,7 @@ static HORIZON_TO_ZENITH: std::sync::LazyLock<[f32; GRADIENT_STEPS + 2]> = std::
 #[inline(always)]
 fn horizon_to_zenith(up: F) -> F {
     let table = &*HORIZON_TO_ZENITH;
-    let s = up.min(F::ONE).sqrt() * GRADIENT_STEPS as f32;
+    let s = up.fast_min(F::ONE).sqrt() * GRADIENT_STEPS as f32;
     let i = floor_int(s).max(I::ZERO).min(I::splat(GRADIENT_STEPS as i32));
     let f = s - i.round_float();
     let ia = i.to_array();

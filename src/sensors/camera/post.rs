@@ -45,7 +45,7 @@ pub(super) fn shoulder_inverse(mapped: f64) -> f64 {
 pub(super) fn tone_map(rgb: &[Vec<f32>; 3], luts: [&[u8; LUT_LEN]; 3], out: &mut [u8]) {
     #[inline(always)]
     fn index(v: F) -> [i32; LANES] {
-        let s = (v.max(F::ZERO) * (1.0 / LUT_MAX)).min(F::ONE).sqrt();
+        let s = (v.fast_max(F::ZERO) * (1.0 / LUT_MAX)).fast_min(F::ONE).sqrt();
         (s * (LUT_LEN - 1) as f32).fast_trunc_int().to_array()
     }
     let w = out.len() / 3;

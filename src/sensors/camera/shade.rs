@@ -166,7 +166,7 @@ fn road_wear(nz: &Noise, x: F, y: F, ray_len: F, tex: f32) -> F {
         let patched = nz.sample_lanes(cx, cy + 91.0).simd_gt(F::splat(0.6));
         wear = (patched & inside).select(F::splat(1.0 - 0.2 * tex), F::ONE);
     }
-    let near = (F::ONE - ray_len * (1.0 / 25.0)).max(F::ZERO);
+    let near = (F::ONE - ray_len * (1.0 / 25.0)).fast_max(F::ZERO);
     if near.simd_gt(F::ZERO).any() {
         let c = nz.sample_lanes(x * 0.5 + 11.0, y * 0.5 - 5.0).abs();
         wear *= c
@@ -246,7 +246,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
         Material::Terrain => {
             ground = true;
             let patch = nz.sample_lanes(x * 0.21, y * 0.21);
-            let s = (F::splat(0.5) + F::splat(0.6 * tex) * patch).max(F::ZERO).min(one);
+            let s = (F::splat(0.5) + F::splat(0.6 * tex) * patch)
+                .fast_max(F::ZERO)
+                .fast_min(one);
             albedo = V3::lerp(prim.albedo, Vec3::new(0.11, 0.09, 0.05), s);
             albedo = albedo.scale(grain(nz, x * 2.9, y * 2.9, 0.2 * tex));
         }
@@ -342,14 +344,14 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                     // The face is placed by the directions from the head's centre (a sphere's normals): the skull
                     // capsule's lower end (`body::silhouette`).
                     let rel = p.sub(V3::splat(c.a));
-                    let dir = rel.scale(F::ONE / rel.length_squared().max(F::splat(1.0e-12)).sqrt());
+                    let dir = rel.scale(F::ONE / rel.length_squared().fast_max(F::splat(1.0e-12)).sqrt());
                     albedo = face(prim, dir, albedo, pattern == HEAD_LONG_HAIR);
                 }
                 // Cloth and skin darken towards a body part's outline (folds, self-shadowing, a rough
                 // surface's view dependence): `0.6 + 0.4 (n·v)⁺`, so that a limb shows against a torso of its
                 // own colour.
-                let n_dot_v = -normal.dot(pts.ray) / pts.ray_len.max(F::splat(1.0e-6));
-                albedo = albedo.scale(F::splat(0.6) + F::splat(0.4) * n_dot_v.max(F::ZERO));
+                let n_dot_v = -normal.dot(pts.ray) / pts.ray_len.fast_max(F::splat(1.0e-6));
+                albedo = albedo.scale(F::splat(0.6) + F::splat(0.4) * n_dot_v.fast_max(F::ZERO));
             }
             albedo = albedo.scale(grain(nz, z * 23.0, x * 7.0 + y * 5.0, 0.06 * tex));
         }
@@ -357,9 +359,9 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     if ground && l.wet > 0.0 {
         // Darker when wet, and puddles (a low-frequency noise mask) that mirror the sky and the lights.
         let mask = (nz.sample_lanes(x * 0.35, y * 0.35) - 0.15) * 4.0;
-        let puddle = mask.max(F::ZERO).min(one) * l.wet;
+        let puddle = mask.fast_max(F::ZERO).fast_min(one) * l.wet;
         albedo = albedo.scale(F::splat(1.0 - 0.4 * l.wet) - F::splat(0.2) * puddle);
-        gloss = gloss.max(F::splat(l.wet * 0.25) + F::splat(0.6) * puddle);
+        gloss = gloss.fast_max(F::splat(l.wet * 0.25) + F::splat(0.6) * puddle);
     }
     let glossy = gloss.simd_gt(F::ZERO).any();
 
@@ -371,7 +373,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     };
 
     // Light received.
-    let ndl = normal.dot_v(l.sun_dir).max(F::ZERO);
+    let ndl = normal.dot_v(l.sun_dir).fast_max(F::ZERO);
     let up = F::splat(0.5) + F::splat(0.5) * normal.z;
     let mut light = V3::lerp(l.ground_ambient, l.sky_ambient, up).add(V3::splat(l.sun).scale(ndl * pts.shadow));
     let mut glints = V3::ZERO;
@@ -388,15 +390,15 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             }
             // Diffuse, from a lamp that shines downwards (light falls off away from below it):
             // `fall · (n·dir)⁺ · dir.z⁺` with `fall = I / (|d|² + 1)`, as `I · (n·d)⁺ · d.z⁺ / ((|d|² + 1) |d|²)`.
-            let fall_per_d2 = lamp_intensity / ((d2 + one) * d2.max(F::splat(1.0e-12)));
-            let k = fall_per_d2 * normal.dot(d).max(F::ZERO) * d.z.max(F::ZERO);
+            let fall_per_d2 = lamp_intensity / ((d2 + one) * d2.fast_max(F::splat(1.0e-12)));
+            let k = fall_per_d2 * normal.dot(d).fast_max(F::ZERO) * d.z.fast_max(F::ZERO);
             light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, F::ZERO)));
             if glossy {
                 // Blinn-Phong `(n·h)^32` with the half vector `h ∝ dir + view`, here `d + view · |d|`
                 // (the same direction), as `((n·h)⁺² / |h|²)^16`.
                 let h = d.add(view.scale(d2.sqrt()));
-                let nh = normal.dot(h).max(F::ZERO);
-                let s2 = nh * nh / h.length_squared().max(F::splat(1.0e-12));
+                let nh = normal.dot(h).fast_max(F::ZERO);
+                let s2 = nh * nh / h.length_squared().fast_max(F::splat(1.0e-12));
                 let s8 = s2 * s2 * s2 * s2;
                 let g = fall_per_d2 * d2 * 6.0 * gloss * s8 * s8 * s8 * s8;
                 glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, F::ZERO)));
@@ -417,15 +419,17 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             let per_ahead = one / ahead;
             let side = ((d.x * axis.y - d.y * axis.x) * per_ahead * (1.0 / HEAD_SPREAD)).abs();
             let up = d.z * per_ahead;
-            let cut = ((F::splat(HEAD_CUTOFF_SLOPE) - up) * 25.0).max(F::ZERO).min(one);
-            let beam = (one - side * side).max(F::ZERO) * cut;
+            let cut = ((F::splat(HEAD_CUTOFF_SLOPE) - up) * 25.0)
+                .fast_max(F::ZERO)
+                .fast_min(one);
+            let beam = (one - side * side).fast_max(F::ZERO) * cut;
             on &= beam.simd_gt(F::ZERO);
             if !on.any() {
                 continue;
             }
             // `fall · (−n·dir)⁺` with `fall = I · beam / (|d|² + 30)` and `dir = d / |d|`, in one division.
             let fall_per_d = F::splat(HEADLAMP_INTENSITY * l.night) * beam / ((d2 + 30.0) * d2.sqrt());
-            let k = fall_per_d * (-normal.dot(d)).max(F::ZERO);
+            let k = fall_per_d * (-normal.dot(d)).fast_max(F::ZERO);
             light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, F::ZERO)));
         }
     }
@@ -433,7 +437,7 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     if glossy {
         let r = normal.scale(F::splat(2.0) * view.dot(normal)).sub(view);
         let r = V3 { z: r.z.abs(), ..r };
-        let cos = normal.dot(view).max(F::ZERO);
+        let cos = normal.dot(view).fast_max(F::ZERO);
         let c5 = {
             let m = one - cos;
             let m2 = m * m;
