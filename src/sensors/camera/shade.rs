@@ -379,8 +379,11 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
     let mut glints = V3::ZERO;
     if l.night > 0.0 {
         // Street lamps: `d` from the point to the lamp, `dir = d / |d|`. Written without normalising `d` (a
-        // square root and a division per lamp and lane saved, the costliest part of a night frame).
+        // square root and a division per lamp and lane saved, the costliest part of a night frame). All lamps
+        // have one colour, so their light is summed as one factor per lane and coloured once.
         let lamp_intensity = F::splat(LAMP_INTENSITY * l.night);
+        let (n_dot_v, one_plus_v2) = (normal.dot(view), one + view.length_squared());
+        let (mut lamps_sum, mut glints_sum) = (F::ZERO, F::ZERO);
         for &lamp in ctx.lamps {
             let d = V3::splat(lamp).sub(p);
             let d2 = d.length_squared();
@@ -391,19 +394,29 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             // Diffuse, from a lamp that shines downwards (light falls off away from below it):
             // `fall · (n·dir)⁺ · dir.z⁺` with `fall = I / (|d|² + 1)`, as `I · (n·d)⁺ · d.z⁺ / ((|d|² + 1) |d|²)`.
             let fall_per_d2 = lamp_intensity / ((d2 + one) * d2.fast_max(F::splat(1.0e-12)));
-            let k = fall_per_d2 * normal.dot(d).fast_max(F::ZERO) * d.z.fast_max(F::ZERO);
-            light = light.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(k, F::ZERO)));
+            let n_dot_d = normal.dot(d);
+            let k = fall_per_d2 * n_dot_d.fast_max(F::ZERO) * d.z.fast_max(F::ZERO);
+            lamps_sum += near.select(k, F::ZERO);
             if glossy {
-                // Blinn-Phong `(n·h)^32` with the half vector `h ∝ dir + view`, here `d + view · |d|`
-                // (the same direction), as `((n·h)⁺² / |h|²)^16`.
-                let h = d.add(view.scale(d2.sqrt()));
-                let nh = normal.dot(h).fast_max(F::ZERO);
-                let s2 = nh * nh / h.length_squared().fast_max(F::splat(1.0e-12));
-                let s8 = s2 * s2 * s2 * s2;
-                let g = fall_per_d2 * d2 * 6.0 * gloss * s8 * s8 * s8 * s8;
-                glints = glints.add(V3::splat(Vec3::new(1.0, 0.78, 0.5)).scale(near.select(g, F::ZERO)));
+                // Blinn-Phong `(n·h)^32` with the half vector `h ∝ dir + view`, here `h = d + view · |d|` (the
+                // same direction), as `((n·h)⁺² / |h|²)^16`: `n·h = n·d + |d| n·view` and
+                // `|h|² = |d|² (1 + |view|²) + 2 |d| d·view`, from what the diffuse term has worked out.
+                let len = d2.sqrt();
+                let nh = (n_dot_d + len * n_dot_v).fast_max(F::ZERO);
+                let h2 = d2 * one_plus_v2 + (len + len) * d.dot(view);
+                let s2 = nh * nh / h2.fast_max(F::splat(1.0e-12));
+                let s4 = s2 * s2;
+                let s8 = s4 * s4;
+                let s16 = s8 * s8;
+                glints_sum += near.select(fall_per_d2 * d2 * (s16 * s16), F::ZERO);
             }
         }
+        let lamp_colour = Vec3::new(1.0, 0.78, 0.5);
+        light = light.add(V3::splat(lamp_colour).scale(lamps_sum));
+        if glossy {
+            glints = V3::splat(lamp_colour).scale(glints_sum * gloss * 6.0);
+        }
+        let mut heads_sum = F::ZERO;
         for &(pos, axis) in ctx.heads {
             let d = p.sub(V3::splat(pos));
             let d2 = d.length_squared();
@@ -428,10 +441,11 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
                 continue;
             }
             // `fall · (−n·dir)⁺` with `fall = I · beam / (|d|² + 30)` and `dir = d / |d|`, in one division.
-            let fall_per_d = F::splat(HEADLAMP_INTENSITY * l.night) * beam / ((d2 + 30.0) * d2.sqrt());
-            let k = fall_per_d * (-normal.dot(d)).fast_max(F::ZERO);
-            light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9)).scale(on.select(k, F::ZERO)));
+            let fall_per_d = beam / ((d2 + 30.0) * d2.sqrt());
+            heads_sum += on.select(fall_per_d * (-normal.dot(d)).fast_max(F::ZERO), F::ZERO);
         }
+        // Every headlight has one colour and intensity too.
+        light = light.add(V3::splat(Vec3::new(1.0, 0.97, 0.9) * (HEADLAMP_INTENSITY * l.night)).scale(heads_sum));
     }
     let mut colour = albedo.mul(light).add(emissive).add(glints);
     if glossy {
