@@ -6,7 +6,7 @@
 use glam::Vec3;
 use std::ops::Add;
 
-use super::lanes::{F, I, V3, lanes_from};
+use super::lanes::{F, I, V3, exp_lanes, lanes_from};
 use super::round::floor_int;
 use crate::spec::types::WeatherParams;
 
@@ -40,6 +40,9 @@ pub struct Lighting {
     /// Whether the sun casts shadows.
     pub shadows: bool,
 }
+
+/// The distance at which the sky is fogged, metres.
+pub const SKY_FOG_M: f32 = 1.0e4;
 
 /// Luminous intensity of a street lamp (linear units × m²).
 pub const LAMP_INTENSITY: f32 = 16.0;
@@ -116,6 +119,23 @@ impl Lighting {
         }
     }
 
+    /// The sky's colour through fog at [`SKY_FOG_M`], in every direction, where fog hides the sky entirely: the
+    /// fog's colour, bit for bit what `shade::fog(self, self.sky(dir), SKY_FOG_M)` gives, so that a renderer
+    /// need not work the sky out (thick fog). `None` where some of the sky shows through.
+    ///
+    /// Exact because the fog's transmittance `f` at that distance is then so small that `1 − f` rounds to 1
+    /// and the sky's share, `sky · f` with the sky at its brightest (its horizon, zenith or ground colour plus
+    /// 4.4 suns: glow and disc), is under half a unit in the last place of the fog's colour in each channel.
+    pub fn sky_hidden_by_fog(&self) -> Option<Vec3> {
+        let f = exp_lanes(F::splat(-self.fog_per_m * SKY_FOG_M)).to_array()[0];
+        let brightest =
+            self.horizon.max(self.zenith).max(self.ground_ambient).max_element() + 4.4 * self.sun.max_element();
+        // Half a unit in the last place of `x` is at least `x · 2⁻²⁵`.
+        let hidden =
+            1.0 - f == 1.0 && self.fog.min_element() > 0.0 && brightest * f < self.fog.min_element() * 2.0f32.powi(-25);
+        hidden.then_some(self.fog)
+    }
+
     /// The sky's colour in the lanes' view directions (unit, world frame), the sun's disc included.
     #[inline(always)]
     pub fn sky(&self, dir: V3) -> V3 {
@@ -167,6 +187,7 @@ fn horizon_to_zenith(up: F) -> F {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sensors::camera::lanes::LANES as LANES_N;
     use crate::spec::types::WeatherPreset;
 
     #[test]
@@ -176,6 +197,47 @@ mod tests {
         assert!(noon.sun.x > 1.0 && night.sun.length() < 1e-3);
         assert!(night.night > 0.99 && noon.night < 0.01);
         assert!(noon.shadows && !night.shadows);
+    }
+
+    #[test]
+    fn a_sky_hidden_by_fog_is_the_fog_bit_for_bit() {
+        let mut hidden = Vec::new();
+        for preset in WeatherPreset::ALL {
+            let l = Lighting::from_weather(&preset.params());
+            let Some(fog) = l.sky_hidden_by_fog() else {
+                continue;
+            };
+            hidden.push(preset);
+            // Directions all round, the sun's own and below the horizon included.
+            let mut dirs: Vec<Vec3> = (0..4000)
+                .map(|i| {
+                    let (az, el) = (i as f32 * 2.399, (i as f32 / 4000.0) * 3.1 - 1.55);
+                    Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())
+                })
+                .collect();
+            dirs.push(l.sun_dir);
+            for chunk in dirs.chunks(LANES_N) {
+                let dir = V3::from_lanes(std::array::from_fn(|i| chunk[i.min(chunk.len() - 1)]));
+                let got = crate::sensors::camera::shade::fog(&l, l.sky(dir), F::splat(SKY_FOG_M)).lanes();
+                for c in got {
+                    assert_eq!(
+                        c.to_array().map(f32::to_bits),
+                        fog.to_array().map(f32::to_bits),
+                        "{preset:?}"
+                    );
+                }
+            }
+        }
+        // Thick fog hides the sky (foggy noon, night fog), and so does night rain's light fog over a dark sky;
+        // thin fog by day does not.
+        assert_eq!(
+            hidden,
+            [
+                WeatherPreset::FoggyNoon,
+                WeatherPreset::NightRainy,
+                WeatherPreset::NightFoggy
+            ]
+        );
     }
 
     #[test]

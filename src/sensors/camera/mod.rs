@@ -120,6 +120,8 @@ struct Sample {
 pub struct Renderer {
     camera: Camera,
     light: Lighting,
+    /// The sky's colour where fog hides it ([`Lighting::sky_hidden_by_fog`]): no need to work it out.
+    fogged_sky: Option<Vec3>,
     noise: Noise,
     /// The frame's projected triangles, in drawing order, and per band of rows the ones that reach it.
     tris: Vec<Setup>,
@@ -180,6 +182,7 @@ impl Renderer {
             .then(|| expose::NoiseModel::new(imaging.shot_noise, imaging.read_noise, seed));
         Renderer {
             camera,
+            fogged_sky: light.sky_hidden_by_fog(),
             light,
             noise: Noise::new(seed ^ 0x7e57_0000),
             tris: Vec::new(),

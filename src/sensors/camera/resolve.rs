@@ -275,9 +275,15 @@ impl Renderer {
         let sv = (v - view.cy) * view.inv_f;
         let ray = V3::splat(view.fwd) + V3::splat(view.right).scale(su) + V3::splat(view.down).scale(sv);
         if prim == EMPTY {
+            if let Some(fog) = self.fogged_sky {
+                return (V3::splat(fog), [tag::SKY; LANES]);
+            }
             let dir = ray.scale(F::ONE / ray.length_squared().sqrt());
             let sky = self.light.sky(dir);
-            return (shade::fog(&self.light, sky, F::splat(1.0e4)), [tag::SKY; LANES]);
+            return (
+                shade::fog(&self.light, sky, F::splat(light::SKY_FOG_M)),
+                [tag::SKY; LANES],
+            );
         }
         let prim: &Prim = ctx.frame.prim(ctx.scene, prim);
         let z = F::ONE / key;
