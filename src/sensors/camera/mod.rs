@@ -61,7 +61,6 @@ use resolve::*;
 use round::floor_int;
 use shade::{ActiveLights, Noise, ShadeContext};
 use shadows::*;
-use wide::f32x4;
 
 /// Samples per pixel along each axis.
 pub const SS: usize = 2;

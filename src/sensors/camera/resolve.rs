@@ -64,16 +64,17 @@ impl Clone for BandBuffers {
 }
 
 /// A row's depth labels from its pixels' first samples' keys: `1 / key` metres (the sky's key 0 gives the far
-/// plane). Four pixels at a time: an IEEE division per lane, the same values as one at a time.
+/// plane). `LANES` pixels at a time: an IEEE division per lane, the same values as one at a time.
 pub(super) fn depth_labels(keys: &[f32], depth_m: &mut [f32]) {
-    for (d, k) in depth_m.chunks_mut(4).zip(keys.chunks(4)) {
-        let first = f32x4::new(std::array::from_fn(|i| k.get(i).copied().unwrap_or(1.0)));
-        let depth = (f32x4::ONE / first).min(f32x4::splat(SKY_DEPTH_M)).to_array();
-        // A fixed-size copy where the chunk is whole (a slice copy of unknown length calls memcpy).
-        match <&mut [f32; 4]>::try_from(&mut *d) {
-            Ok(d) => *d = depth,
-            Err(_) => d.copy_from_slice(&depth[..d.len()]),
-        }
+    let (whole, rest) = depth_m.as_chunks_mut::<LANES>();
+    let (whole_keys, rest_keys) = keys.as_chunks::<LANES>();
+    let depth = |k: F| (F::ONE / k).fast_min(F::splat(SKY_DEPTH_M)).to_array();
+    for (d, k) in whole.iter_mut().zip(whole_keys) {
+        *d = depth(F::new(*k));
+    }
+    let last = depth(lanes_from(|i| rest_keys.get(i).copied().unwrap_or(1.0)));
+    for (d, v) in rest.iter_mut().zip(last) {
+        *d = v;
     }
 }
 

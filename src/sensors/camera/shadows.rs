@@ -44,12 +44,14 @@ impl SunView {
         let half = SHADOW_PX as f32 * 0.5;
         let x = d.dot_v(self.u) * self.scale + half - 0.5;
         let y = d.dot_v(self.v) * self.scale + half - 0.5;
-        let depth = (d.dot_v(self.dir) + 0.08).to_array();
+        let depth = d.dot_v(self.dir) + 0.08;
         let (x0, y0) = (floor_int(x), floor_int(y));
         let (fx, fy) = (x - x0.round_float(), y - y0.round_float());
         let (xa, ya) = (x0.to_array(), y0.to_array());
         let last = (SHADOW_PX - 1) as i32;
-        let mut c = [[1.0f32; LANES]; 4];
+        // The four texels' keys per lane (−∞, lit, off the map), then compared with the lanes' depths at
+        // once: lit where the key is not beyond the point.
+        let mut texels = [[f32::NEG_INFINITY; LANES]; 4];
         for i in 0..LANES {
             if xa[i] < 0 || ya[i] < 0 || xa[i] >= last || ya[i] >= last {
                 continue;
@@ -59,13 +61,13 @@ impl SunView {
             let Some(q) = key.get(k..k + SHADOW_PX + 2) else {
                 continue;
             };
-            let lit = |key: f32| if key > depth[i] { 0.0 } else { 1.0 };
-            c[0][i] = lit(q[0]);
-            c[1][i] = lit(q[1]);
-            c[2][i] = lit(q[SHADOW_PX]);
-            c[3][i] = lit(q[SHADOW_PX + 1]);
+            texels[0][i] = q[0];
+            texels[1][i] = q[1];
+            texels[2][i] = q[SHADOW_PX];
+            texels[3][i] = q[SHADOW_PX + 1];
         }
-        let [l00, l10, l01, l11] = c.map(F::new);
+        let c = texels.map(|k| F::new(k).simd_gt(depth).select(F::ZERO, F::ONE));
+        let [l00, l10, l01, l11] = c;
         let a = l00 + (l10 - l00) * fx;
         let b = l01 + (l11 - l01) * fx;
         a + (b - a) * fy
