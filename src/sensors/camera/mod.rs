@@ -325,6 +325,28 @@ mod tests {
     }
 
     #[test]
+    fn instance_labels_equal_the_per_pixel_lookup_for_every_row_length() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for w in 0..=40usize {
+            // Runs of primitives (the sky's among them) of one to twenty pixels.
+            let mut prims = Vec::new();
+            while prims.len() < w {
+                let p = [EMPTY, 3, 7, 12][rng.random_range(0..4usize)];
+                prims.extend(std::iter::repeat_n(p, rng.random_range(1..=20usize)));
+            }
+            prims.truncate(w);
+            let instance_of = |p: u32| p as u16 * 10 + 1;
+            let mut got = vec![u16::MAX; w];
+            resolve::instance_labels(&prims, &mut got, instance_of);
+            let expected: Vec<u16> = prims
+                .iter()
+                .map(|&p| if p == EMPTY { 0 } else { instance_of(p) })
+                .collect();
+            assert_eq!(got, expected, "w {w}");
+        }
+    }
+
+    #[test]
     fn the_row_tone_map_equals_the_per_value_formula() {
         let lut = build_lut(1.0);
         let mut rng = ChaCha8Rng::seed_from_u64(5);

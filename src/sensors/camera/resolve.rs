@@ -78,6 +78,31 @@ pub(super) fn depth_labels(keys: &[f32], depth_m: &mut [f32]) {
     }
 }
 
+/// A row's instance labels from its pixels' first samples' primitives (`instance_of` a primitive; the sky's
+/// 0): eight pixels at a time where they all show the primitive before them (most of a row), one at a time
+/// where it changes.
+pub(super) fn instance_labels(prims: &[u32], instance: &mut [u16], instance_of: impl Fn(u32) -> u16) {
+    let mut last = (EMPTY, 0u16);
+    let (whole, rest) = instance.as_chunks_mut::<LANES>();
+    let (whole_prims, rest_prims) = prims.as_chunks::<LANES>();
+    let one_by_one = |ids: &mut [u16], prims: &[u32], last: &mut (u32, u16)| {
+        for (i, &p) in ids.iter_mut().zip(prims) {
+            if p != last.0 {
+                *last = (p, if p == EMPTY { 0 } else { instance_of(p) });
+            }
+            *i = last.1;
+        }
+    };
+    for (ids, prims) in whole.iter_mut().zip(whole_prims) {
+        if prims.iter().all(|&p| p == last.0) {
+            *ids = [last.1; LANES];
+        } else {
+            one_by_one(ids, prims, &mut last);
+        }
+    }
+    one_by_one(rest, rest_prims, &mut last);
+}
+
 impl Renderer {
     /// Resolves the visibility buffer into the images, in bands of rows on the current rayon pool (each pixel
     /// is a pure function of the buffers, so the bytes do not depend on how the bands are spread).
@@ -205,13 +230,9 @@ impl Renderer {
             let (grid_prim, grid_key) = (&vis.grid.prim[labels.clone()], &vis.grid.key[labels.clone()]);
             // Labels: the first sample's depth (the sky's key 0 gives the far plane) and instance.
             depth_labels(grid_key, &mut out.depth_m[labels.clone()]);
-            let mut last = (EMPTY, 0u16);
-            for (i, &p) in out.instance[labels.clone()].iter_mut().zip(grid_prim) {
-                if p != last.0 {
-                    last = (p, if p == EMPTY { 0 } else { frame.prim(scene, p).instance });
-                }
-                *i = last.1;
-            }
+            instance_labels(grid_prim, &mut out.instance[labels.clone()], |p| {
+                frame.prim(scene, p).instance
+            });
             let row_prim = &vis.prim[labels.clone()];
             let row_key = &vis.key[labels.clone()];
             // Pixels whose samples see one primitive: shaded at their centres, up to `LANES` neighbours of one
