@@ -425,12 +425,19 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             let mut on = d2.simd_ge(F::splat(1e-4))
                 & d2.simd_le(F::splat(HEAD_REACH_M2))
                 & ahead.simd_gt(F::splat(HEAD_AHEAD_M));
-            if !on.any() {
+            // A lane is in the beam only if it is within its spread (`|side| < 1`) and below its cut-off
+            // (`up < HEAD_CUTOFF_SLOPE`): tested first without a division, with a margin far beyond rounding, so
+            // that a lamp whose beam misses every lane costs no division (the light is the same either way).
+            let cross = d.x * axis.y - d.y * axis.x;
+            let margin = F::splat(1.0 + 1.0e-4);
+            let may = cross.abs().simd_lt(ahead * (HEAD_SPREAD * margin))
+                & d.z.simd_lt(ahead * (HEAD_CUTOFF_SLOPE * margin) + ahead.abs() * 1.0e-4);
+            if !(on & may).any() {
                 continue;
             }
             // Lanes behind the lamp divide by zero or less; `on` masks them.
             let per_ahead = one / ahead;
-            let side = ((d.x * axis.y - d.y * axis.x) * per_ahead * (1.0 / HEAD_SPREAD)).abs();
+            let side = (cross * per_ahead * (1.0 / HEAD_SPREAD)).abs();
             let up = d.z * per_ahead;
             let cut = ((F::splat(HEAD_CUTOFF_SLOPE) - up) * 25.0)
                 .fast_max(F::ZERO)
