@@ -447,7 +447,8 @@ pub fn surface(ctx: &ShadeContext, prim: &Prim, pts: &Points) -> (V3, [u8; LANES
             if !on.any() {
                 continue;
             }
-            // `fall · (−n·dir)⁺` with `fall = I · beam / (|d|² + 30)` and `dir = d / |d|`, in one division.
+            // `fall · (−n·dir)⁺` with `fall = I · beam / (|d|² + 30)` and `dir = d / |d|`, in one division (`I`
+            // applied after the loop, with the colour).
             let fall_per_d = beam / ((d2 + 30.0) * d2.sqrt());
             heads_sum += on.select(fall_per_d * (-normal.dot(d)).fast_max(F::ZERO), F::ZERO);
         }
