@@ -187,7 +187,6 @@ fn horizon_to_zenith(up: F) -> F {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sensors::camera::lanes::LANES as LANES_N;
     use crate::spec::types::WeatherPreset;
 
     #[test]
@@ -197,47 +196,6 @@ mod tests {
         assert!(noon.sun.x > 1.0 && night.sun.length() < 1e-3);
         assert!(night.night > 0.99 && noon.night < 0.01);
         assert!(noon.shadows && !night.shadows);
-    }
-
-    #[test]
-    fn a_sky_hidden_by_fog_is_the_fog_bit_for_bit() {
-        let mut hidden = Vec::new();
-        for preset in WeatherPreset::ALL {
-            let l = Lighting::from_weather(&preset.params());
-            let Some(fog) = l.sky_hidden_by_fog() else {
-                continue;
-            };
-            hidden.push(preset);
-            // Directions all round, the sun's own and below the horizon included.
-            let mut dirs: Vec<Vec3> = (0..4000)
-                .map(|i| {
-                    let (az, el) = (i as f32 * 2.399, (i as f32 / 4000.0) * 3.1 - 1.55);
-                    Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())
-                })
-                .collect();
-            dirs.push(l.sun_dir);
-            for chunk in dirs.chunks(LANES_N) {
-                let dir = V3::from_lanes(std::array::from_fn(|i| chunk[i.min(chunk.len() - 1)]));
-                let got = crate::sensors::camera::shade::fog(&l, l.sky(dir), F::splat(SKY_FOG_M)).lanes();
-                for c in got {
-                    assert_eq!(
-                        c.to_array().map(f32::to_bits),
-                        fog.to_array().map(f32::to_bits),
-                        "{preset:?}"
-                    );
-                }
-            }
-        }
-        // Thick fog hides the sky (foggy noon, night fog), and so does night rain's light fog over a dark sky;
-        // thin fog by day does not.
-        assert_eq!(
-            hidden,
-            [
-                WeatherPreset::FoggyNoon,
-                WeatherPreset::NightRainy,
-                WeatherPreset::NightFoggy
-            ]
-        );
     }
 
     #[test]

@@ -574,6 +574,49 @@ mod tests {
     }
 
     #[test]
+    fn a_sky_hidden_by_fog_is_the_fog_bit_for_bit() {
+        use crate::sensors::camera::light::SKY_FOG_M;
+        use crate::spec::types::WeatherPreset;
+        let mut hidden = Vec::new();
+        for preset in WeatherPreset::ALL {
+            let l = Lighting::from_weather(&preset.params());
+            let Some(fog) = l.sky_hidden_by_fog() else {
+                continue;
+            };
+            hidden.push(preset);
+            // Directions all round, the sun's own and below the horizon included.
+            let mut dirs: Vec<Vec3> = (0..4000)
+                .map(|i| {
+                    let (az, el) = (i as f32 * 2.399, (i as f32 / 4000.0) * 3.1 - 1.55);
+                    Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())
+                })
+                .collect();
+            dirs.push(l.sun_dir);
+            for chunk in dirs.chunks(LANES) {
+                let dir = V3::from_lanes(std::array::from_fn(|i| chunk[i.min(chunk.len() - 1)]));
+                let got = super::fog(&l, l.sky(dir), F::splat(SKY_FOG_M)).lanes();
+                for c in got {
+                    assert_eq!(
+                        c.to_array().map(f32::to_bits),
+                        fog.to_array().map(f32::to_bits),
+                        "{preset:?}"
+                    );
+                }
+            }
+        }
+        // Thick fog hides the sky (foggy noon, night fog), and so does night rain's light fog over a dark sky;
+        // thin fog by day does not.
+        assert_eq!(
+            hidden,
+            [
+                WeatherPreset::FoggyNoon,
+                WeatherPreset::NightRainy,
+                WeatherPreset::NightFoggy
+            ]
+        );
+    }
+
+    #[test]
     fn lane_road_paint_equals_road_paint_point_by_point() {
         use crate::sensors::scene::{PieceSurface, road_paint};
         use rand::{RngExt, SeedableRng};
