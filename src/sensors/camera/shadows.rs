@@ -122,16 +122,14 @@ impl Renderer {
     pub(super) fn choose_lights(&mut self, scene: &StaticScene, frame: &FrameScene, cam: Vec3, pose: &CameraPose) {
         self.lights.lamps.clear();
         self.lights.heads.clear();
-        if self.light.night <= 0.0 {
+        // Street lamps and headlights light the scene once the day has faded.
+        if self.light.night < LIGHTS_ON_NIGHT {
             return;
         }
-        // Street lamps switch on as the day fades (headlights are on whenever it is not full day).
-        if self.light.night >= LAMPS_ON_NIGHT {
-            nearest(&scene.lamps, |l| l.pos, cam, 90.0, 16, &mut self.nearby);
-            self.lights
-                .lamps
-                .extend(self.nearby.iter().map(|&(_, i)| scene.lamps[i as usize].pos));
-        }
+        nearest(&scene.lamps, |l| l.pos, cam, 90.0, 16, &mut self.nearby);
+        self.lights
+            .lamps
+            .extend(self.nearby.iter().map(|&(_, i)| scene.lamps[i as usize].pos));
         // The ego's own headlights (under the camera), then the nearest traffic's.
         let fwd = pose.forward.as_vec3();
         let axis = Vec3::new(fwd.x, fwd.y, 0.0).normalize_or_zero();
