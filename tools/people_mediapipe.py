@@ -22,7 +22,8 @@ crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those
 pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing, view, mirrored),
 to join with the dataset's pedestrians table. `--per-attribute` also prints, by what the person wears (hood, hat, hair, garment,
 age group, umbrella) and by whether our nose keypoint is visible (a head turned towards the camera), how many found
-back views MediaPipe mirrored. Prints one row per weather; `--check` exits 1 unless the figures hold: by
+back views MediaPipe mirrored. Prints one row per weather (with how many distinct pedestrians its crops show: a
+weather's figures weigh that many people, and one person's crops move them together); `--check` exits 1 unless the figures hold: by
 default issue 44's (found ≥ 94 % in every weather, ≥ 80 % of joints, background ≤ 5 %), or the floors given with
 `--min-found-weather`, `--min-found`, `--min-joints` and `--max-background` (CI's regression floors, .ci/run).
 """
@@ -92,6 +93,8 @@ def main() -> int:
     per_joint = {}
     per_view = {}
     crop_rows = []
+    # The distinct pedestrians behind each weather's crops (a weather's figures weigh as many people as this).
+    people_of = {}
     for path in sorted(glob.glob(str(root / "tables/annotations/*.parquet"))):
         t = pq.read_table(path).to_pydict()
         clip = t["clip_id"][0] if t["clip_id"] else None
@@ -107,6 +110,7 @@ def main() -> int:
         if len(rows) > a.per_clip:
             rows = [rows[int(k * len(rows) / a.per_clip)] for k in range(a.per_clip)]
         s = per.setdefault(weather[clip], {"crops": 0, "found": 0, "joints": 0, "agree": 0, "bg": 0, "bg_found": 0})
+        seen = people_of.setdefault(weather[clip], set())
         shown = set(rows[int(k * len(rows) / 6)] for k in range(6)) if rows else set()
         for i in rows:
             frame = t["frame"][i]
@@ -118,6 +122,7 @@ def main() -> int:
                 continue
             x0, y0, x1, y1 = crop_box(b, w, h)
             s["crops"] += 1
+            seen.add((clip, t["pedestrian"][i]))
             res = pose.process(np.ascontiguousarray(rgb[y0:y1, x0:x1]))
             if a.sheet and i in shown:
                 crop = Image.fromarray(rgb[y0:y1, x0:x1])
@@ -184,21 +189,23 @@ def main() -> int:
                     break
     ok = True
     total = {k: 0 for k in ["crops", "found", "joints", "agree", "bg", "bg_found"]}
-    print(f"{'weather':14s} {'crops':>5s} {'found':>7s} {'joints ok':>10s} {'background':>11s}")
+    print(f"{'weather':14s} {'people':>6s} {'crops':>5s} {'found':>7s} {'joints ok':>10s} {'background':>11s}")
     for wx in sorted(per):
         s = per[wx]
         for k in total:
             total[k] += s[k]
         found = s["found"] / max(1, s["crops"])
         print(
-            f"{wx:14s} {s['crops']:5d} {100 * found:6.1f}% {100 * s['agree'] / max(1, s['joints']):9.1f}% "
+            f"{wx:14s} {len(people_of[wx]):6d} {s['crops']:5d} {100 * found:6.1f}% "
+            f"{100 * s['agree'] / max(1, s['joints']):9.1f}% "
             f"{100 * s['bg_found'] / max(1, s['bg']):10.1f}%"
         )
         ok &= s["crops"] > 0 and found >= a.min_found_weather
     joints = total["agree"] / max(1, total["joints"])
     bg = total["bg_found"] / max(1, total["bg"])
     print(
-        f"{'all':14s} {total['crops']:5d} {100 * total['found'] / max(1, total['crops']):6.1f}% {100 * joints:9.1f}% "
+        f"{'all':14s} {sum(len(v) for v in people_of.values()):6d} {total['crops']:5d} "
+        f"{100 * total['found'] / max(1, total['crops']):6.1f}% {100 * joints:9.1f}% "
         f"{100 * bg:10.1f}%  ({total['joints']} joints, {total['bg']} background crops)"
     )
     ok &= joints >= a.min_joints and bg <= a.max_background
