@@ -17,7 +17,8 @@ Run: `python3 tools/people_mediapipe.py DATASET [--per-clip 60] [--check] [--she
 view our keypoints give: *back* where our left shoulder lies left of our right one in the image by 8 %+ of the box
 height, *front* the other way round, *side* in between; a found front or back view is *mirrored* where MediaPipe's
 left shoulder lies on the other side of its right one than ours (its joints are counted apart). `--sheet` also writes a crop sheet: per weather (a row), six
-crops evenly spread over the clip's, scaled to 200 px tall, a red bar over those where no person was found.
+crops evenly spread over the weather's (over its clips in order), scaled to 200 px tall, a red bar over those where
+no person was found.
 `--per-joint` also prints each joint's agreement over all weathers; `--crops FILE.csv` writes one row per
 pedestrian crop (clip, weather, frame, pedestrian, box height, found, joints compared and agreeing, view, mirrored),
 to join with the dataset's pedestrians table. `--per-attribute` also prints, by what the person wears (hood, hat, hair, garment,
@@ -111,7 +112,6 @@ def main() -> int:
             rows = [rows[int(k * len(rows) / a.per_clip)] for k in range(a.per_clip)]
         s = per.setdefault(weather[clip], {"crops": 0, "found": 0, "joints": 0, "agree": 0, "bg": 0, "bg_found": 0})
         seen = people_of.setdefault(weather[clip], set())
-        shown = set(rows[int(k * len(rows) / 6)] for k in range(6)) if rows else set()
         for i in rows:
             frame = t["frame"][i]
             rgb = np.asarray(Image.open(root / f"sensors/rgb/{clip}/{frame:06d}.png").convert("RGB"))
@@ -124,12 +124,8 @@ def main() -> int:
             s["crops"] += 1
             seen.add((clip, t["pedestrian"][i]))
             res = pose.process(np.ascontiguousarray(rgb[y0:y1, x0:x1]))
-            if a.sheet and i in shown:
-                crop = Image.fromarray(rgb[y0:y1, x0:x1])
-                crop = np.asarray(crop.resize((max(1, round(200 * crop.width / crop.height)), 200))).copy()
-                if not res.pose_landmarks:
-                    crop[:6] = [220, 0, 0]
-                sheet.setdefault(weather[clip], []).append(crop)
+            # The sheet's candidates: every crop, kept as where to find it (six per weather are drawn at the end).
+            sheet.setdefault(weather[clip], []).append((clip, frame, (x0, y0, x1, y1), bool(res.pose_landmarks)))
             row = {"clip_id": clip, "weather": weather[clip], "frame": frame, "pedestrian": t["pedestrian"][i],
                    "height_px": b[3] - b[1], "found": int(bool(res.pose_landmarks)), "joints": 0, "agree": 0}
             crop_rows.append(row)
@@ -237,10 +233,19 @@ def main() -> int:
             for r in crop_rows:
                 f.write(",".join(f"{v:.1f}" if isinstance(v, float) else str(v) for v in r.values()) + "\n")
     if a.sheet and sheet:
+        drawn = {}
+        for wx, crops in sheet.items():
+            for clip, frame, (x0, y0, x1, y1), found in (crops[j] for j in sorted({int(k * len(crops) / 6) for k in range(6)})):
+                rgb = Image.open(root / f"sensors/rgb/{clip}/{frame:06d}.png").convert("RGB")
+                crop = rgb.crop((x0, y0, x1, y1))
+                crop = np.asarray(crop.resize((max(1, round(200 * crop.width / crop.height)), 200))).copy()
+                if not found:
+                    crop[:6] = [220, 0, 0]
+                drawn.setdefault(wx, []).append(crop)
         rows_px = []
-        width = max(sum(c.shape[1] for c in crops) for crops in sheet.values())
-        for wx in sorted(sheet):
-            row = np.concatenate(sheet[wx], axis=1)
+        width = max(sum(c.shape[1] for c in crops) for crops in drawn.values())
+        for wx in sorted(drawn):
+            row = np.concatenate(drawn[wx], axis=1)
             rows_px.append(np.pad(row, ((0, 0), (0, width - row.shape[1]), (0, 0)), constant_values=255))
         Image.fromarray(np.concatenate(rows_px, axis=0)).save(a.sheet)
     if a.check and not ok:
