@@ -235,7 +235,8 @@ def main() -> int:
     if a.sheet and sheet:
         drawn = {}
         for wx, crops in sheet.items():
-            for clip, frame, (x0, y0, x1, y1), found in (crops[j] for j in sorted({int(k * len(crops) / 6) for k in range(6)})):
+            picks = sorted({int(k * len(crops) / 6) for k in range(6)})
+            for clip, frame, (x0, y0, x1, y1), found in (crops[j] for j in picks):
                 rgb = Image.open(root / f"sensors/rgb/{clip}/{frame:06d}.png").convert("RGB")
                 crop = rgb.crop((x0, y0, x1, y1))
                 crop = np.asarray(crop.resize((max(1, round(200 * crop.width / crop.height)), 200))).copy()
