@@ -250,15 +250,15 @@ pub(crate) fn silhouette(
     let torso_m = (chest - pelvis).length();
     let up = (chest - pelvis).normalize_or(DVec3::Z);
     let back = DVec3::new(-up.z, 0.0, up.x);
-    // The torso: two capsules side by side (wider than deep: 35 cm by 21 cm for an average 1.75 m adult),
-    // their axes closer at the waist than at the chest.
+    // The torso: two capsules side by side (wider than deep: 35 cm by 21 cm for an average 1.75 m adult), axes closer at
+    // the waist than at the chest; the hem about the hip joints, so that trousers show the seat (BENCHMARKS).
     let torso_r = 0.06 * g;
     // The chest turns with the shoulders (their line's twist about the spine, see [`shoulder_twist`]).
     let across = joints[5] - joints[6];
     let twist = DMat3::from_rotation_z((-across.x).atan2(across.y));
     let torso_half = |side: f64| {
         (
-            pelvis + DVec3::new(0.0, side * 0.03 * h * g, 0.0),
+            pelvis + DVec3::new(0.0, side * 0.03 * h * g, 0.0) + up * (0.05 * h),
             chest + twist * DVec3::new(0.0, side * 0.042 * h * g, 0.0),
         )
     };
@@ -328,7 +328,7 @@ pub(crate) fn silhouette(
         cap(neck, head_centre, 0.035),
         cap(j(9), hand(j(7), j(9)), 0.02),
         cap(j(10), hand(j(8), j(10)), 0.02),
-        cap(j(11), j(12), 0.05 * g),
+        cap(j(11), j(12), 0.055 * g), // hips 38.5 cm across, dressed, for an average 1.75 m adult
         cap(r_waist, r_chest, torso_r),
         hair,
         headwear,
