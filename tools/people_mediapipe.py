@@ -125,7 +125,8 @@ def main() -> int:
             seen.add((clip, t["pedestrian"][i]))
             res = pose.process(np.ascontiguousarray(rgb[y0:y1, x0:x1]))
             # The sheet's candidates: every crop, kept as where to find it (six per weather are drawn at the end).
-            sheet.setdefault(weather[clip], []).append((clip, frame, (x0, y0, x1, y1), bool(res.pose_landmarks)))
+            if a.sheet:
+                sheet.setdefault(weather[clip], []).append((clip, frame, (x0, y0, x1, y1), bool(res.pose_landmarks)))
             row = {"clip_id": clip, "weather": weather[clip], "frame": frame, "pedestrian": t["pedestrian"][i],
                    "height_px": b[3] - b[1], "found": int(bool(res.pose_landmarks)), "joints": 0, "agree": 0}
             crop_rows.append(row)
