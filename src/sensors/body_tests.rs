@@ -339,3 +339,44 @@ fn a_top_ends_about_the_hip_joints_and_the_seat_shows_below_it() {
         assert!((0.37..0.40).contains(&across), "hips {across:.3} m across");
     }
 }
+
+/// Under a hood the hair is tucked in, and its capsule is the hood's fabric gathered at the nape: behind the
+/// neck (4–9 cm), as wide as it (15–22 cm across), at the neck's height, whatever the hair (fails on a hood
+/// drawn as a bare dome, where long hair hung below it and short hair had no capsule).
+#[test]
+fn a_hood_is_gathered_at_the_nape_behind_the_neck() {
+    use crate::plan::HairStyle;
+    let h = 1.75;
+    let forward = DVec2::from_angle(0.3).extend(0.0);
+    for hair in [HairStyle::Long, HairStyle::Short, HairStyle::Bun, HairStyle::Bald] {
+        for speed in [0.0, 1.3] {
+            let hooded = Figure {
+                hair,
+                hood: true,
+                ..Figure::PLAIN
+            };
+            let p = pose(&frame(speed, 0.25), h, &hooded, DVec3::ZERO);
+            let (nape, neck) = (p.capsules[18], p.capsules[13]);
+            assert!(nape.radius_m > 0.0, "{hair:?}: a capsule");
+            let mid = 0.5 * (nape.a + nape.b);
+            let behind = (neck.a - mid).dot(forward);
+            assert!(
+                (0.04..0.09).contains(&behind),
+                "{hair:?}: {behind:.3} m behind the neck"
+            );
+            let across = nape.a.distance(nape.b) + 2.0 * nape.radius_m;
+            assert!((0.15..0.22).contains(&across), "{hair:?}: {across:.3} m across");
+            assert!((mid.z - neck.a.z).abs() < 0.03, "{hair:?}: at the neck's height");
+        }
+    }
+    // Without a hood, long hair still falls from the crown.
+    let long = Figure {
+        hair: HairStyle::Long,
+        ..Figure::PLAIN
+    };
+    let p = pose(&frame(0.0, 0.0), h, &long, DVec3::ZERO);
+    assert!(
+        p.capsules[18].a.z.max(p.capsules[18].b.z) > p.capsules[13].b.z,
+        "from the crown"
+    );
+}

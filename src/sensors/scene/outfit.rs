@@ -64,6 +64,8 @@ impl Outfit {
                     (Material::Body, tights)
                 }
                 Wear::Leg => (Material::Body, bottom),
+                // A hood's fabric gathered at the nape takes the hair's capsule ([`crate::sensors::body`]).
+                Wear::Hair if figure.hood => (Material::Body, top),
                 Wear::Hair => (Material::Body, hair),
                 Wear::Headwear if figure.hood => (Material::Body, top),
                 Wear::Headwear => (Material::Body, accessory(figure.headwear)),
@@ -105,6 +107,23 @@ impl Outfit {
 mod tests {
     use super::*;
     use crate::plan::identity::rider_identity;
+
+    /// A hood is the top's colour, and so is the capsule that takes the hair's place under it (the hood's
+    /// fabric gathered at the nape); without a hood the hair is the hair's colour.
+    #[test]
+    fn a_hoods_gathered_back_is_the_tops_colour() {
+        let mut identity = rider_identity(7, 0);
+        let hair = WEAR.iter().position(|w| matches!(w, Wear::Hair)).unwrap();
+        let headwear = WEAR.iter().position(|w| matches!(w, Wear::Headwear)).unwrap();
+        let top = WEAR.iter().position(|w| matches!(w, Wear::Top)).unwrap();
+        identity.figure.hood = true;
+        let o = Outfit::of(&identity, 7, 0);
+        assert_eq!(o.parts[hair].1, o.parts[top].1);
+        assert_eq!(o.parts[headwear].1, o.parts[top].1);
+        identity.figure.hood = false;
+        let o = Outfit::of(&identity, 7, 0);
+        assert_eq!(o.parts[hair].1, o.hair);
+    }
 
     /// A top's pattern lies on the torso's two halves; a checked top's on the shoulders too, a striped top's
     /// shoulders stay plain (level bands of height would paint the shoulder line one colour); the arms are never
